@@ -1,0 +1,102 @@
+# Makefile -- lensmat.  `make` builds ./lensmat (installing missing Debian packages
+# first, see scripts/install-deps.sh); `make check` runs every test, also under
+# AddressSanitizer and UBSan; `make bench` prints BENCH lines; `make fuzz` fuzzes long.
+# Engines that need big libraries (Embree, OpenCV, libgpiod) are built as modules
+# under build/lib/ that lensmat loads only when a dialogue first uses them; each
+# brings its own src/ENGINE/module.mk.
+
+CC      ?= cc
+CLANG   ?= clang
+VERSION := 0.1
+WARN    := -Wall -Wextra
+# -ffp-contract=off: the classic dialogue must round like the original (no fma).
+BASE    := -std=c11 -D_POSIX_C_SOURCE=200809L -DLENSMAT_VERSION=\"$(VERSION)\" \
+           -ffp-contract=off -Isrc -Ibuild/gen $(WARN)
+OPT     := -O2 -g
+SAN     := -O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all \
+           -fno-omit-frame-pointer
+LIBS    := -lreadline -lm
+
+PROMPTS := $(wildcard prompts/*.txt)
+GEN     := $(patsubst prompts/%.txt,build/gen/prompts_%.h,$(PROMPTS))
+# The core: the dialogue layer and the paraxial engine (libc, libm, readline only).
+CORE    := $(wildcard src/dialogue/*.c src/paraxial/*.c)
+LIBCORE := $(filter-out src/dialogue/main.c,$(CORE))
+OBJ     := $(patsubst src/%.c,build/obj/%.o,$(CORE))
+SANOBJ  := $(patsubst src/%.c,build/asan/%.o,$(CORE))
+LIBOBJ  := $(patsubst src/%.c,build/obj/%.o,$(LIBCORE))
+SANLIB  := $(patsubst src/%.c,build/asan/%.o,$(LIBCORE))
+UNIT    := $(wildcard tests/unit_*.c)
+DEPS    := build/.deps
+
+all: lensmat
+
+$(DEPS): scripts/install-deps.sh
+	@mkdir -p build
+	sh scripts/install-deps.sh
+	@touch $@
+
+build/gen/prompts_%.h: prompts/%.txt scripts/gen_prompts.sh
+	@mkdir -p $(@D)
+	sh scripts/gen_prompts.sh $* $< $@
+
+build/obj/%.o: src/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -MMD -MP -c $< -o $@
+
+build/asan/%.o: src/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -MMD -MP -c $< -o $@
+
+lensmat: $(OBJ)
+	$(CC) $(OPT) -o $@ $(OBJ) $(LIBS)
+
+build/asan/lensmat: $(SANOBJ)
+	$(CC) $(SAN) -o $@ $(SANOBJ) $(LIBS)
+
+# Unit tests: one program per tests/unit_*.c, linked with the core (not main.c).
+build/obj/unit_%: tests/unit_%.c $(LIBOBJ)
+	$(CC) $(BASE) $(OPT) -Itests -o $@ $< $(LIBOBJ) $(LIBS)
+build/asan/unit_%: tests/unit_%.c $(SANLIB)
+	$(CC) $(BASE) $(SAN) -Itests -o $@ $< $(SANLIB) $(LIBS)
+
+# libFuzzer target for the answer lexer (clang from Debian).
+build/fuzz_answers: tests/fuzz_answers.c src/dialogue/lex.c src/dialogue/lex.h | $(DEPS)
+	@mkdir -p $(@D)
+	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
+	    tests/fuzz_answers.c src/dialogue/lex.c -lm
+
+# The transcribed original program, for differential tests (built from ../shared,
+# never copied into this tree).
+ORIG_DIR := ../shared/original-lensmat
+build/original/lensmat: | $(DEPS)
+	@mkdir -p $(@D)
+	if [ -f $(ORIG_DIR)/lensmat.cpp ]; then \
+	  g++ -O2 -ffp-contract=off -w -o $@ $(ORIG_DIR)/lensmat.cpp; fi
+
+TEST_BINS := lensmat build/asan/lensmat build/fuzz_answers build/original/lensmat \
+             $(patsubst tests/%.c,build/obj/%,$(UNIT)) \
+             $(patsubst tests/%.c,build/asan/%,$(UNIT))
+
+-include $(wildcard src/*/module.mk)
+
+check: $(TEST_BINS) $(MODULE_TEST_BINS)
+	@sh tests/run.sh
+
+bench: lensmat build/original/lensmat $(MODULE_BENCH_BINS)
+	@sh scripts/bench.sh
+
+fuzz: build/fuzz_answers
+	@mkdir -p build/fuzz-corpus
+	build/fuzz_answers -max_total_time=$${FUZZ_SECONDS:-600} build/fuzz-corpus \
+	    tests/fuzz-corpus
+
+example: lensmat
+	./lensmat --example example.rec
+
+clean:
+	rm -rf build lensmat example.rec
+
+.PHONY: all check bench fuzz example clean
+.SECONDARY:
+-include $(OBJ:.o=.d) $(SANOBJ:.o=.d)

@@ -1,0 +1,20 @@
+#!/bin/sh
+# install-deps.sh -- make sure every Debian package lensmat builds or tests with is
+# installed; apt-get only what is missing.  Idempotent: a second run only checks.
+# Run by make (through the build/.deps stamp); safe to run by hand.
+set -e
+PKGS="gcc g++ make libreadline-dev libgsl-dev libembree-dev libgpiod-dev
+      libopencv-dev clang libclang-rt-14-dev python3"
+missing=""
+for p in $PKGS; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||
+        missing="$missing $p"
+done
+[ -z "$missing" ] && exit 0
+echo "install-deps: installing:$missing"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -qq --no-install-recommends $missing

@@ -1,0 +1,267 @@
+/* ask.c -- one session's input and record file.  Answers are blank-separated tokens
+ * (several per line, like the original's cin >>); a line may start with "input:" so
+ * that `grep input: rec` replays.  On a terminal a bad answer is explained and asked
+ * again; in a replay it is reported as FILE:LINE and the session stops (exit 2).
+ * The record is flushed before every read, and SIGINT/SIGTERM are only let in while
+ * we wait for input, so an interrupted session keeps every accepted answer. */
+#include <errno.h>
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <readline/readline.h>
+#include <readline/history.h>
+#include "ask.h"
+
+static char history_path[4096];
+
+static void on_signal(int sig)
+{
+    static const char msg[] =
+        "\nlensmat: interrupted; the record file keeps every answer accepted so far\n";
+    ssize_t r = write(2, msg, sizeof msg - 1);
+    (void)r;
+    _exit(128 + sig);
+}
+
+static void signals_setup(sigset_t *set)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    sigemptyset(set);
+    sigaddset(set, SIGINT);
+    sigaddset(set, SIGTERM);
+    sigprocmask(SIG_BLOCK, set, NULL);
+}
+
+static void history_setup(void)
+{
+    const char *home = getenv("HOME");
+    if (!home) return;
+    snprintf(history_path, sizeof history_path, "%s/.lensmat_history", home);
+    using_history();
+    read_history(history_path);
+}
+
+int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
+               int original)
+{
+    sigset_t set;
+    memset(io, 0, sizeof *io);
+    io->original = original;
+    io->rec_name = rec_name;
+    io->in = in;
+    io->src = in_name;
+    io->rec = fopen(rec_name, "w");
+    if (!io->rec) {
+        fprintf(stderr, "lensmat: cannot write the record file %s: %s\n", rec_name,
+                strerror(errno));
+        return -1;
+    }
+    io->interactive = in == stdin && isatty(0) && isatty(1);
+    if (io->interactive) history_setup();
+    signals_setup(&set);
+    io->cur = "";
+    return 0;
+}
+
+int lm_io_close(lm_io *io)
+{
+    int bad = fflush(stdout) != 0;
+    if (io->rec && (ferror(io->rec) | fclose(io->rec))) {
+        fprintf(stderr, "lensmat: error writing the record file %s\n", io->rec_name);
+        bad = 1;
+    }
+    free(io->buf);
+    io->rec = NULL;
+    return bad ? -1 : 0;
+}
+
+void lm_say(lm_io *io, int where, const char *fmt, ...)
+{
+    va_list ap;
+    if (where & LM_OUT) {
+        va_start(ap, fmt);
+        vprintf(fmt, ap);
+        va_end(ap);
+    }
+    if (where & LM_REC) {
+        va_start(ap, fmt);
+        vfprintf(io->rec, fmt, ap);
+        va_end(ap);
+    }
+}
+
+double lm_clean(const lm_io *io, double v) { return io->original ? v : v + 0.0; }
+
+void lm_matrix(lm_io *io, int where, const char *elem_fmt, double a, double b,
+               double c, double d)
+{
+    double e[4] = {a, b, c, d};
+    for (int i = 0; i < 4; i++) {
+        lm_say(io, where, elem_fmt, lm_clean(io, e[i]));
+        if (i % 2) lm_say(io, where, "\n");
+    }
+}
+
+/* Read the next answer line.  Returns 0, or -1 at end of input. */
+static int read_line(lm_io *io)
+{
+    sigset_t set;
+    ssize_t n;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    fflush(stdout);
+    fflush(io->rec);
+    sigprocmask(SIG_UNBLOCK, &set, NULL);
+    if (io->interactive) {
+        char *l = readline("");
+        sigprocmask(SIG_BLOCK, &set, NULL);
+        if (!l) return -1;
+        if (*l) {
+            add_history(l);
+            if (*history_path) {
+                if (append_history(1, history_path) != 0) write_history(history_path);
+                history_truncate_file(history_path, 1000);
+            }
+        }
+        free(io->buf);
+        io->buf = l;
+        io->cap = strlen(l) + 1;
+    } else {
+        n = getline(&io->buf, &io->cap, io->in);
+        sigprocmask(SIG_BLOCK, &set, NULL);
+        if (n < 0) return -1;
+    }
+    io->line++;
+    io->cur = lm_line_start(io->buf);
+    return 0;
+}
+
+/* Fetch the next token, reading lines as needed.  0, -1 at end of input, or -2 for a
+ * token too long to be an answer. */
+static int next_token(lm_io *io, char *tok)
+{
+    for (;;) {
+        int n = lm_next_token(&io->cur, tok, LM_TOKEN_MAX);
+        if (n > 0) return 0;
+        if (n < 0) return -2;
+        if (read_line(io) < 0) return -1;
+    }
+}
+
+/* Report a bad answer.  Terminal: explain, drop the rest of the line, ask again
+ * (LM_GO).  Replay: FILE:LINE message and LM_FAIL. */
+static int complain(lm_io *io, const char *what, const char *fmt, const char *tok)
+{
+    char msg[512];
+    snprintf(msg, sizeof msg, fmt, tok);
+    if (io->interactive) {
+        fprintf(stderr, "lensmat: %s: %s; please answer again.\n", what, msg);
+        io->cur = "";
+        return LM_GO;
+    }
+    fprintf(stderr, "lensmat: %s:%ld: %s: %s\n", io->src, io->line > 0 ? io->line : 1,
+            what, msg);
+    return LM_FAIL;
+}
+
+static int end_of_input(lm_io *io, const char *what)
+{
+    if (io->interactive) {
+        printf("\n");
+        fprintf(stderr, "lensmat: session ended; the record file %s keeps every "
+                "answer so far\n", io->rec_name);
+        return LM_QUIT;
+    }
+    fprintf(stderr, "lensmat: %s:%ld: end of input while asking for %s\n", io->src,
+            io->line + 1, what);
+    return LM_FAIL;
+}
+
+/* Check a parsed number against the spec; NULL if fine, else the complaint. */
+static const char *violates(const lm_numspec *spec, enum lm_num_status st, double v)
+{
+    if (st == LM_NUM_PLANE) return (spec->flags & LM_ALLOW_PLANE) ? NULL :
+        "'%s': infinity is allowed only for a radius (a plane surface)";
+    if (st != LM_NUM_OK) return NULL;
+    if ((spec->flags & LM_POSITIVE) && !(v > 0)) return "'%s' must be greater than 0";
+    if ((spec->flags & LM_NONNEG) && v < 0) return "'%s' must not be negative";
+    if ((spec->flags & LM_AT_LEAST) && v < spec->min)
+        return "'%s' lies left of the previous surface (locations must not decrease)";
+    return NULL;
+}
+
+int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec *spec,
+                  double *v)
+{
+    char tok[LM_TOKEN_MAX], echo[64];
+    if (rec) lm_say(io, LM_REC, "%s", rec);
+    for (;;) {
+        int r;
+        enum lm_num_status st;
+        const char *bad;
+        if (out) lm_say(io, LM_OUT, "%s", out);
+        r = next_token(io, tok);
+        if (r == -1) return end_of_input(io, spec->what);
+        if (r == -2) {
+            if (complain(io, spec->what, "%san answer longer than 255 characters", "")) 
+                return LM_FAIL;
+            continue;
+        }
+        st = lm_parse_number(tok, v);
+        if (st != LM_NUM_OK && st != LM_NUM_PLANE) {
+            if (complain(io, spec->what, st == LM_NUM_SYNTAX ? "'%s' is not a number" :
+                         st == LM_NUM_NAN ? "'%s': nan is not a number" :
+                         "'%s' is out of range (|x| <= 1e30)", tok)) return LM_FAIL;
+            continue;
+        }
+        bad = violates(spec, st, *v);
+        if (bad) {
+            if (complain(io, spec->what, bad, tok)) return LM_FAIL;
+            continue;
+        }
+        if (st == LM_NUM_PLANE) snprintf(echo, sizeof echo, "plane");
+        else lm_format_echo(*v, echo, sizeof echo);
+        if ((spec->flags & LM_ALLOW_PLANE) && *v == 0.0) *v = INFINITY;
+        lm_say(io, LM_REC, "input: %s\n", echo);
+        return LM_GO;
+    }
+}
+
+int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int *yes)
+{
+    char tok[LM_TOKEN_MAX];
+    if (rec) lm_say(io, LM_REC, "%s", rec);
+    for (;;) {
+        int r, c;
+        if (out) lm_say(io, LM_OUT, "%s", out);
+        r = next_token(io, tok);
+        if (r == -1) return end_of_input(io, what);
+        c = r == 0 ? lm_parse_yn(tok) : 0;
+        if (!c) {
+            if (complain(io, what, "'%s': answer y or n", r == 0 ? tok : "(too long)"))
+                return LM_FAIL;
+            continue;
+        }
+        *yes = c == 'y';
+        lm_say(io, LM_REC, "input: %c\n", c);
+        return LM_GO;
+    }
+}
+
+void lm_check_leftover(lm_io *io)
+{
+    char tok[LM_TOKEN_MAX];
+    if (io->interactive) return;
+    if (lm_next_token(&io->cur, tok, sizeof tok) != 0)
+        fprintf(stderr, "lensmat: %s:%ld: warning: answers after the end of the "
+                "dialogue were ignored\n", io->src, io->line);
+}

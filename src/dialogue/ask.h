@@ -1,0 +1,61 @@
+/* ask.h -- the session: where answers come from (terminal with readline, or a
+ * replayed file), the record file, and asking one question.  Every dialogue talks to
+ * the user through this and nothing else. */
+#ifndef ASK_H
+#define ASK_H
+#include <stdio.h>
+#include "lex.h"
+
+/* Return codes of every ask: go on, stop cleanly (Ctrl-D on a terminal), or stop
+ * with an error already reported (replay: exit status 2). */
+enum { LM_GO = 0, LM_QUIT = 1, LM_FAIL = 2 };
+
+typedef struct lm_io {
+    FILE *rec;              /* the record file; every accepted answer is flushed */
+    const char *rec_name;
+    FILE *in;               /* answers when not interactive */
+    const char *src;        /* name for messages: a file name or "<stdin>" */
+    long line;              /* line number of the current answer line */
+    int interactive;        /* terminal: readline, re-ask on errors */
+    int original;           /* --original: keep the original program's bytes */
+    char *buf;              /* current answer line */
+    size_t cap;
+    const char *cur;        /* unread part of buf */
+} lm_io;
+
+/* Output streams for lm_say. */
+enum { LM_OUT = 1, LM_REC = 2, LM_BOTH = 3 };
+
+/* Answers come from `in` (named in_name in messages); on a terminal stdin they are
+ * read with readline.  Returns 0, or -1 (message printed) if OUTFILE cannot be made. */
+int  lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
+                int original);
+int  lm_io_close(lm_io *io);          /* flushes and closes; 0 or -1 */
+void lm_say(lm_io *io, int where, const char *fmt, ...);
+void lm_matrix(lm_io *io, int where, const char *elem_fmt, double a, double b,
+               double c, double d);
+double lm_clean(const lm_io *io, double v);   /* -0 -> 0 unless --original */
+
+/* Constraints a number answer must meet. */
+enum {
+    LM_ALLOW_PLANE = 1,     /* inf / plane / 0 accepted (a plane surface): *v = inf */
+    LM_POSITIVE = 2,        /* > 0 */
+    LM_NONNEG = 4,          /* >= 0 */
+    LM_AT_LEAST = 8         /* >= spec.min */
+};
+typedef struct lm_numspec {
+    const char *what;       /* "the radius of the lens surface", for messages */
+    unsigned flags;
+    double min;
+} lm_numspec;
+
+/* Print `out` on stdout and `rec` in the record (either may be NULL), read one
+ * number, echo it to the record as "input: ...".  Returns LM_GO, LM_QUIT, LM_FAIL. */
+int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec *spec,
+                  double *v);
+/* The same for a y/n answer; *yes is 1 or 0. */
+int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int *yes);
+/* After the last question: warn about answers left unread (replay only). */
+void lm_check_leftover(lm_io *io);
+
+#endif
