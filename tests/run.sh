@@ -1,0 +1,39 @@
+#!/bin/sh
+# run.sh -- every test of lensmat.  Sources tests/t_*.sh in order; each defines its
+# checks with the helpers below.  Ends with the line "N passed, N failed" and exits
+# non-zero if anything failed.  Run from the top of the tree (make check does).
+TOP=$(pwd)
+BIN=$TOP/lensmat
+ASAN=$TOP/build/asan/lensmat
+GOLDEN=$TOP/golden
+SHARED=$TOP/../shared
+ORIG=$TOP/build/original/lensmat
+WORK=$(mktemp -d)
+export LC_ALL=C
+PASSED=0
+FAILED=0
+trap 'rm -rf "$WORK"' EXIT
+
+pass() { PASSED=$((PASSED + 1)); [ -n "$VERBOSE" ] && echo "PASS $*"; return 0; }
+fail() { FAILED=$((FAILED + 1)); echo "FAIL $*"; return 0; }
+# check NAME CMD...: passes when CMD exits 0
+check() { n=$1; shift; if "$@" >"$WORK/check.out" 2>&1; then pass "$n"
+          else fail "$n"; sed 's/^/    /' "$WORK/check.out" | head -20; fi; }
+# unit BINARY: counts the PASS/FAIL lines a C unit test prints
+unit() {
+    if [ ! -x "$1" ]; then fail "$1 (not built)"; return; fi
+    "$1" > "$WORK/unit.out" 2>&1; rc=$?
+    p=$(grep -c '^PASS' "$WORK/unit.out"); f=$(grep -c '^FAIL' "$WORK/unit.out")
+    PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
+    grep '^FAIL' "$WORK/unit.out" | sed "s|^|$(basename "$1"): |"
+    if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
+        fail "$1 exited $rc"; tail -20 "$WORK/unit.out"; fi
+}
+have_shared() { [ -d "$SHARED/reference/lensmat" ] && [ -x "$ORIG" ]; }
+
+for t in "$TOP"/tests/t_*.sh; do
+    [ -n "$VERBOSE" ] && echo "== $(basename "$t")"
+    . "$t"
+done
+echo "$PASSED passed, $FAILED failed"
+[ "$FAILED" -eq 0 ]
