@@ -57,14 +57,14 @@ static int is_decimal(const char *s)
 
 enum lm_num_status lm_parse_number(const char *tok, double *v)
 {
-    const char *word = (*tok == '+') ? tok + 1 : tok;
+    const char *word = (*tok == '+' || *tok == '-') ? tok + 1 : tok;
 
     if (!strcasecmp(word, "inf") || !strcasecmp(word, "infinity") ||
         !strcasecmp(word, "plane")) {
-        *v = INFINITY;
+        *v = *tok == '-' ? -INFINITY : INFINITY;
         return LM_NUM_PLANE;
     }
-    if (!strcasecmp(word, "nan") || !strcasecmp(tok, "-nan")) return LM_NUM_NAN;
+    if (!strcasecmp(word, "nan")) return LM_NUM_NAN;
     if (!is_decimal(tok)) return LM_NUM_SYNTAX;
     *v = strtod(tok, NULL);
     if (!isfinite(*v) || fabs(*v) > LM_NUM_LIMIT) return LM_NUM_RANGE;
