@@ -60,11 +60,12 @@ build/obj/unit_%: tests/unit_%.c $(LIBOBJ)
 build/asan/unit_%: tests/unit_%.c $(SANLIB)
 	$(CC) $(BASE) $(SAN) -Itests -o $@ $< $(SANLIB) $(LIBS)
 
-# libFuzzer target for the answer lexer (clang from Debian).
-build/fuzz_answers: tests/fuzz_answers.c src/dialogue/lex.c src/dialogue/lex.h | $(DEPS)
+# libFuzzer target for the answer reader and number parser (clang from Debian): the
+# core sources (not main.c) compiled with the fuzzer's instrumentation.
+build/fuzz_answers: tests/fuzz_answers.c $(LIBCORE) $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
-	    tests/fuzz_answers.c src/dialogue/lex.c -lm
+	    tests/fuzz_answers.c $(LIBCORE) $(LIBS)
 
 # The transcribed original program, for differential tests (built from ../shared,
 # never copied into this tree).

@@ -23,7 +23,7 @@ END {
     print "    " up "_NPROMPTS"
     print "};"
     print "static const char *const " name "_prompts[" up "_NPROMPTS] = {"
-    for (i = 0; i < n; i++) print "    [" keys[i] "] = " vals[i] ","
+    for (i = 0; i < n; i++) print "    [" keys[i] "] = (" vals[i] "),"
     print "};"
 }' "$in" > "$out.tmp"
 mv "$out.tmp" "$out"

@@ -1,0 +1,13 @@
+# t_70_fuzz.sh -- a short libFuzzer run of the answer reader and number parser,
+# from the seed corpus tests/fuzz-corpus (the long run is `make fuzz`).
+fuzz_short() {
+    mkdir -p "$WORK/fuzz"
+    "$TOP/build/fuzz_answers" -max_total_time="${FUZZ_SHORT_SECONDS:-15}" -timeout=5 \
+        -print_final_stats=1 "$WORK/fuzz" "$TOP/tests/fuzz-corpus" > "$WORK/fuzz.log" 2>&1 ||
+        { tail -30 "$WORK/fuzz.log"; return 1; }
+}
+if [ -x "$TOP/build/fuzz_answers" ]; then
+    check "fuzz: answer reader and number parser (short run)" fuzz_short
+else
+    fail "fuzz target not built"
+fi
