@@ -84,7 +84,12 @@ TEST_BINS := lensmat build/asan/lensmat build/fuzz_answers build/original/lensma
 check: $(TEST_BINS) $(MODULE_TEST_BINS)
 	@sh tests/run.sh
 
-bench: lensmat build/original/lensmat $(MODULE_BENCH_BINS)
+build/bench/%: tests/bench/%.c | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) -O2 -o $@ $<
+
+bench: lensmat build/original/lensmat build/bench/benchrun build/bench/baseline \
+       $(MODULE_BENCH_BINS)
 	@sh scripts/bench.sh
 
 fuzz: build/fuzz_answers
