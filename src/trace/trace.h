@@ -1,0 +1,306 @@
+/* trace.h -- public face of the ray-tracing engine (the document's opticrt, on Embree 3).
+ * STATUS: ready (API v1) -- callers may build on it; later changes only add at the end
+ * of struct trace_api and bump nothing for additions.
+ *
+ * The engine lives in the module build/lib/lensmat-trace.so; a caller never links
+ * Embree: it gets the one exported function with
+ *     trace_get_api_fn get = (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
+ *     const trace_api *tr = get ? get(TRACE_ABI) : NULL;
+ * and calls everything through that table.  The engine never prints and never exits:
+ * functions return an id >= 0 or TRACE_OK on success, a negative TRACE_E* code on
+ * failure with a message from tr->error(scene) (or the err buffer passed in).
+ *
+ * Geometry is in double everywhere.  Embree (single precision) only proposes the
+ * nearest candidate; every hit is re-intersected in double with the analytic surface
+ * or the triangle's plane, and refraction, Fresnel and bookkeeping are in double.
+ *
+ * Sides and indices (n_front, n_back):
+ *   - plane and axial surfaces (conic, asphere, spherical cap): "front" is the side
+ *     light travelling along +axis comes from (the -axis side), "back" the +axis side;
+ *   - full spheres: front = outside, back = inside;
+ *   - triangles: front = the side the triangle normal (v1-v0)x(v2-v0) points to, as
+ *     opticrt's p.n ("medium 1 is pointed to by the surface normal").
+ *
+ * Polarisation: each ray carries the 2x2 coherency matrix of its field in a local
+ * transverse basis (e, d x e) -- the s and p powers and their coherence -- and it is
+ * re-decomposed into the s/p basis of every interface it meets, so s and p are never
+ * averaged.  Hits report the powers along the basis of the last interface (s, p).
+ *
+ * Results are bit-identical for any thread count: rays are numbered in the order the
+ * sources were added, each thread traces a contiguous block of every batch, and the
+ * sinks are called from the calling thread in ray order (within a ray: depth-first,
+ * refracted before reflected). */
+#ifndef TRACE_H
+#define TRACE_H
+#include <stddef.h>
+#include <stdint.h>
+
+#define TRACE_ABI 1
+#define TRACE_API_SYMBOL "trace_get_api"
+
+enum {
+    TRACE_OK = 0,
+    TRACE_EINVAL = -1,     /* bad parameter (message says which) */
+    TRACE_ENOMEM = -2,
+    TRACE_EEMBREE = -3,    /* Embree device or build failed */
+    TRACE_ECANCEL = -4,    /* a sink asked to stop */
+    TRACE_EABI = -5
+};
+
+/* What a surface does to light. */
+enum trace_kind {
+    TRACE_REFRACT,   /* interface between n_front and n_back: Fresnel split (or TIR) */
+    TRACE_MIRROR,    /* perfect mirror: everything reflected, no refracted ray */
+    TRACE_ABSORB,    /* ends the ray; its power counts as absorbed */
+    TRACE_DETECT     /* ends the ray and records a hit; its power counts as detected */
+};
+
+typedef struct trace_material {
+    int kind;              /* enum trace_kind */
+    double n_front, n_back;
+} trace_material;
+
+/* Analytic surfaces. */
+enum trace_shape {
+    TRACE_PLANE,     /* point `at`, normal `axis`; aperture disc/annulus or rectangle */
+    TRACE_AXIAL,     /* vertex `at`, axis `axis`: conic + even asphere sag (below) */
+    TRACE_SPHERE     /* closed sphere: centre `at`, radius `radius` */
+};
+enum trace_aperture { TRACE_AP_DISC, TRACE_AP_RECT };
+
+#define TRACE_MAXASPH 8
+/* Axial sag along the axis at distance s from it:
+ *   z(s) = c s^2 / (1 + sqrt(1 - (1+k) c^2 s^2)) + sum_i asph[i] s^(2i+2)
+ * with c = 1/radius (radius 0 or inf: flat), k the conic constant (0 sphere,
+ * -1 paraboloid), asph[0] = A2 (s^2), asph[1] = A4 (s^4), ...  Conics without
+ * aspheric terms are intersected in closed form (stable quadratic), aspheres by
+ * safeguarded Newton from the conic root.  Radius > 0: centre of curvature on the
+ * +axis side (the paraxial engine's sign). */
+typedef struct trace_surface {
+    int shape;                 /* enum trace_shape */
+    double at[3];
+    double axis[3];            /* need not be unit; normalised on adding */
+    double up[3];              /* rectangle: direction of `height` (_|_ axis) */
+    double radius;
+    double conic;
+    double asph[TRACE_MAXASPH];
+    int nasph;
+    int aperture;              /* enum trace_aperture (PLANE, AXIAL) */
+    double r_outer, r_inner;   /* disc: semi-diameter (0: unbounded for PLANE, the
+                                  conic's own limit for AXIAL) and inner hole radius */
+    double width, height;      /* rectangle */
+} trace_surface;
+
+/* Triangle meshes: vertices (3 doubles each) and indices (3 per triangle).
+ * Degenerate (zero-area), non-finite or out-of-range triangles are refused with
+ * their number.  Optional per-triangle media (2 doubles: n_front n_back) override
+ * the material's.  Optional underlying analytic surface: hits are refined to it. */
+enum trace_refine {
+    TRACE_REFINE_NONE,    /* the triangle's plane (point and flat normal) */
+    TRACE_REFINE_NORMAL,  /* the triangle's point, the analytic normal there
+                             ("replace the triangle by the tangent plane") */
+    TRACE_REFINE_FULL     /* re-intersect the analytic surface near the triangle hit:
+                             exact point and normal */
+};
+typedef struct trace_mesh {
+    const double *vertex;      /* nvertex * 3 */
+    long nvertex;
+    const uint32_t *index;     /* ntri * 3; NULL: vertex holds 3 per triangle */
+    long ntri;
+    const double *media;       /* ntri * 2 or NULL */
+    const trace_surface *underlying;   /* NULL: none (copied on adding) */
+    int refine;                /* enum trace_refine (ignored without underlying) */
+} trace_mesh;
+
+/* Sources.  Rays get consecutive numbers in the order sources are added. */
+enum trace_source_type {
+    TRACE_SRC_RAYS,       /* explicit rays: ray[i] (origin, direction, power) */
+    TRACE_SRC_AIMED,      /* point `at`, rays toward count points evenly spaced from
+                             to0 to to1 (opticrt's five rays) */
+    TRACE_SRC_FAN,        /* point `at`, count rays in the plane of dir and up,
+                             angles evenly from -half_angle to +half_angle */
+    TRACE_SRC_CONE,       /* point `at`, hexapolar cone about dir: rings rings of
+                             6*r rays up to half_angle, plus the axial ray */
+    TRACE_SRC_GRID,       /* collimated along dir: square grid of count x count
+                             cell centres across the disc of `radius` about `at`
+                             (cells outside the disc dropped) */
+    TRACE_SRC_GAUSSIAN    /* laser beam, waist `waist` (1/e^2 radius) at `at`,
+                             along dir, wavelength: hyperboloid of skew rays with
+                             far-field half-angle lambda/(pi w0) (~lambda/D), polar
+                             grid of rings x 6r rays to trunc*waist, weighted
+                             exp(-2 rho^2/w0^2) */
+};
+enum trace_pol { TRACE_UNPOLARISED, TRACE_LINEAR };
+
+typedef struct trace_ray {
+    double o[3], d[3];
+    double power;              /* <= 0: source power / count */
+} trace_ray;
+
+typedef struct trace_source {
+    int type;                  /* enum trace_source_type */
+    double at[3], dir[3], up[3];
+    double to0[3], to1[3];
+    double half_angle;         /* radians */
+    double radius;
+    double waist, wavelength, trunc;   /* trunc 0: 2 */
+    long count;
+    int rings;
+    double power;              /* total; 0: 1 */
+    double n_medium;           /* index where the rays start; 0: 1 */
+    int pol;                   /* enum trace_pol */
+    double pol_dir[3];         /* TRACE_LINEAR: E direction (projected _|_ ray) */
+    const trace_ray *ray;      /* TRACE_SRC_RAYS: count rays (copied on adding) */
+} trace_source;
+
+typedef struct trace_options {
+    int max_depth;         /* interactions per path before it is cut off (default 16) */
+    double cutoff;         /* a ray under cutoff * its source ray's power is cut off
+                              (default 1e-6) */
+    int fresnel;           /* 1: Fresnel s/p powers (default); 0: refracted ray keeps
+                              its power (pure geometry, reflections only at TIR) */
+    int reflections;       /* 1: follow Fresnel-reflected rays (default); 0: their
+                              power is cut off (sequential lens work) */
+    int threads;           /* 0: all cores */
+    double escape_length;  /* length of the segment drawn for an escaping ray (1) */
+    long batch;            /* rays per batch (0: 8192); bounds memory */
+} trace_options;
+
+/* Records handed to sinks. */
+enum trace_end {
+    TRACE_END_NONE,        /* segment to the next interface */
+    TRACE_END_DETECT, TRACE_END_ABSORB, TRACE_END_ESCAPE, TRACE_END_CUTOFF
+};
+typedef struct trace_segment {
+    uint64_t ray;          /* source-ray number */
+    int depth;             /* interactions before this segment */
+    int end;               /* enum trace_end: what happened at p1 */
+    int surface;           /* surface id at p1 (-1: escaped) */
+    double p0[3], p1[3];
+    double power;          /* s + p power along the segment */
+} trace_segment;
+
+typedef struct trace_hit {
+    uint64_t ray;
+    int depth;             /* interactions before reaching the detector */
+    uint32_t history;      /* bit i set: interaction i was a reflection (i < 32) */
+    int surface;
+    long prim;             /* triangle number (meshes), else -1 */
+    double pos[3], dir[3], normal[3];
+    double s_dir[3];       /* the s unit vector of the basis (s, dir x s) */
+    double power_s, power_p;   /* along s_dir and dir x s_dir */
+    double length;         /* geometric path length from the source */
+    double opl;            /* optical path length (sum n * length) */
+} trace_hit;
+
+/* Every callback returns 0 to go on, non-zero to cancel the trace (TRACE_ECANCEL).
+ * All are called from the thread that called run(), in ray order.  NULL: not wanted
+ * (nothing is kept for it). */
+typedef struct trace_sink {
+    void *ctx;
+    int (*segment)(void *ctx, const trace_segment *seg);
+    int (*hit)(void *ctx, const trace_hit *hit);
+    int (*progress)(void *ctx, uint64_t done, uint64_t total);   /* per batch */
+} trace_sink;
+
+typedef struct trace_summary {
+    uint64_t rays;             /* source rays */
+    uint64_t segments;
+    uint64_t interactions;     /* interface events (refraction, reflection, TIR) */
+    uint64_t tir;              /* total internal reflections */
+    uint64_t hits;             /* detector hits */
+    uint64_t cut_depth, cut_power, cut_reflection;  /* how rays were cut off */
+    uint64_t medium_mismatch;  /* rays whose carried index differed from the side
+                                  of the surface they hit (inconsistent scene) */
+    uint64_t failures;         /* numerical failures (non-finite); counted as cut */
+    int max_depth_seen;
+    /* Power: emitted = detected + absorbed + escaped + cutoff (to ~1e-15 relative) */
+    double emitted, detected, absorbed, escaped, cutoff;
+    double build_ms, trace_ms;
+} trace_summary;
+
+/* A sequential lens as the classic dialogue enters it: surfaces left to right with
+ * radius (0 or inf: plane; > 0: centre to the right), vertex z on the axis (the z
+ * axis) and the index to the right; spheres become analytic TRACE_AXIAL surfaces. */
+typedef struct trace_lens_surface {
+    double radius, z, n_right;
+    double semi_diameter;      /* 0: unbounded (up to the sphere's own limit) */
+} trace_lens_surface;
+typedef struct trace_lens {
+    double n_object;           /* index left of the first surface */
+    int nsurf;
+    const trace_lens_surface *surf;
+    int mounts;                /* 1: absorbing annulus outside each semi-diameter */
+    double z_detector;         /* NaN: none; else a detector plane there */
+} trace_lens;
+
+/* One meridional ray of a fan (object on the axis or in the y-z plane). */
+typedef struct trace_fan_ray {
+    double h;                  /* height at the first surface's vertex plane */
+    double z_cross;            /* where it crosses the axis after the last surface */
+    double lsa;                /* z_cross - z_paraxial (longitudinal aberration) */
+    double y_image;            /* height at z_paraxial (transverse aberration) */
+    double opl;                /* optical path from the object (or the first vertex
+                                  plane when the object is at infinity) to z_paraxial */
+    int status;                /* 0 ok; 1 vignetted/missed; 2 TIR; 3 parallel exit */
+} trace_fan_ray;
+
+/* Result of the Fresnel formulas (section 51, Born & Wolf): amplitude coefficients
+ * (real: no TIR; at TIR the reflection phases are in r*_phase) and power
+ * coefficients; T includes the n2 cos t / (n1 cos i) factor. */
+typedef struct trace_fresnel_coef {
+    double rs, rp, ts, tp;         /* amplitudes (rs, rp magnitude at TIR) */
+    double rs_phase, rp_phase;     /* radians: 0 or pi outside TIR */
+    double Rs, Rp, Ts, Tp;         /* powers: Rs + Ts = Rp + Tp = 1 */
+    double cos_t;                  /* 0 at TIR */
+    int tir;
+} trace_fresnel_coef;
+
+typedef struct trace_scene trace_scene;
+
+typedef struct trace_api {
+    int abi;                                   /* TRACE_ABI */
+    const char *(*version)(void);              /* engine and Embree versions */
+
+    trace_scene *(*scene_new)(void);           /* NULL: out of memory; no Embree yet */
+    void (*scene_free)(trace_scene *sc);
+    const char *(*error)(const trace_scene *sc);    /* last error message */
+
+    /* Each returns the new surface id (>= 0) or a TRACE_E* code. */
+    int (*add_surface)(trace_scene *sc, const trace_surface *s, const trace_material *m);
+    int (*add_mesh)(trace_scene *sc, const trace_mesh *mesh, const trace_material *m);
+    /* TRACE_OK (number of its first ray in *first, may be NULL) or an error. */
+    int (*add_source)(trace_scene *sc, const trace_source *src, uint64_t *first);
+
+    void (*options_default)(trace_options *o);
+    /* Build the acceleration structure now (else run() does it, creating the Embree
+     * device on first use).  Returns TRACE_OK or an error; build_ms in *ms. */
+    int (*build)(trace_scene *sc, double *ms);
+    /* Trace every source.  sink may be NULL; sum may be NULL. */
+    int (*run)(trace_scene *sc, const trace_options *o, const trace_sink *sink,
+               trace_summary *sum);
+
+    /* Physics helpers (pure functions, also what run() uses). */
+    /* Refract unit direction d at unit normal nrm (either orientation) from index
+     * n1 into n2: 1 and out = refracted unit direction, or 0 at TIR (out =
+     * reflected direction).  Exact vector Snell law at every angle. */
+    int (*refract)(const double d[3], const double nrm[3], double n1, double n2,
+                   double out[3]);
+    void (*fresnel)(double n1, double n2, double cos_i, trace_fresnel_coef *out);
+
+    /* Sequential lenses. */
+    int (*add_lens)(trace_scene *sc, const trace_lens *lens);   /* id of surface 1 */
+    /* Trace nrays meridional rays of heights h[i] at the first vertex plane from the
+     * object point (0, y_obj, z_obj) (z_obj = -INFINITY: a collimated beam parallel
+     * to the axis) through the lens, geometry only, and compare with the paraxial
+     * image z_paraxial supplied by the caller.  TRACE_OK or error (message in err). */
+    int (*lens_fan)(const trace_lens *lens, double z_obj, double y_obj,
+                    double z_paraxial, int nrays, const double *h,
+                    trace_fan_ray *out, char *err, size_t errcap);
+} trace_api;
+
+typedef const trace_api *(*trace_get_api_fn)(int abi);
+/* Exported by lensmat-trace.so: the table, or NULL if abi != TRACE_ABI. */
+const trace_api *trace_get_api(int abi);
+
+#endif
