@@ -1,0 +1,117 @@
+/* scene.h -- the trace front end's public face: a scene as plain data (surfaces,
+ * meshes, sources, settings, outputs), its readers (scene files, the document's
+ * triangle and media files, OBJ), and running a scene through the trace engine with
+ * its outputs (segments in the seed's p.l form, detector hits as CSV, a summary).
+ * The readers need nothing but libc and libm (they are fuzzed alone); running needs
+ * the engine, so the dialogue reaches all of this through the table returned by the
+ * module's exported function lm_scene_api() (see lm_engine_symbol in engine.h). */
+#ifndef SCENE_H
+#define SCENE_H
+#include <stddef.h>
+
+enum sc_shape { SC_PLANE, SC_SPHERE, SC_CAP, SC_CONIC, SC_ASPHERE, SC_MESH };
+enum sc_kind { SC_REFRACT, SC_MIRROR, SC_ABSORB, SC_DETECT, SC_MEDIA };
+enum sc_source_type { SC_RAY, SC_FAN, SC_POINT, SC_CONE, SC_COLLIMATED, SC_GAUSSIAN };
+
+#define SC_MAXCOEF 8
+#define SC_ERRMAX 1024
+
+/* One surface.  Axial shapes (cap, conic, asphere) have a vertex, a unit axis and a
+ * signed radius of curvature (centre at vertex + radius*axis; 0 = flat); their sag
+ * along the axis is z(s) = c s^2 / (1 + sqrt(1 - (1+k) c^2 s^2)) + sum coef[i] s^(2i+2)
+ * with c = 1/radius (the trace engine's conventions, trace.h).  Sides: planes and
+ * axial shapes: n1 is where light travelling along the axis (plane: the normal)
+ * comes from, n2 the other side.  Spheres: n1 outside, n2 inside.  Mesh triangles,
+ * as opticrt's p.n: n1 is the side their normal (v1-v0)x(v2-v0) points to.
+ * SC_MEDIA: per-triangle n1 n2 from a media file. */
+typedef struct sc_surface {
+    int shape, kind;
+    double n1, n2;
+    double at[3];         /* plane point, sphere centre, axial vertex */
+    double axis[3];       /* plane normal, axial direction (unit) */
+    double up[3];         /* rectangle orientation (plane only; unit, _|_ axis) */
+    double radius;        /* sphere radius, radius of curvature (0: flat) */
+    double conic;
+    double coef[SC_MAXCOEF];
+    int ncoef;
+    double aperture;      /* disc / semi-diameter; 0 with rect[] set: a rectangle */
+    double rect[2];       /* rectangle width (along up x axis) and height (along up) */
+    int tessellate;       /* >0: replace the analytic surface by a mesh of that level */
+    int refine;           /* mesh: refine hits to the underlying analytic surface */
+    /* meshes (SC_MESH, or tessellated analytic surfaces after sc_tessellate) */
+    long ntri;
+    double *tri;          /* 9 doubles per triangle */
+    double *media;        /* 2 per triangle (n1 n2), or NULL */
+    double sphere[4];     /* file mesh: underlying sphere cx cy cz r, r = 0: none */
+    char *mesh_file, *media_file;
+    const char *src;      /* defined at src:line (for messages) */
+    long line;
+} sc_surface;
+
+typedef struct sc_source {
+    int type;                 /* enum sc_source_type */
+    double from[3], dir[3];   /* dir: unit */
+    double up[3];             /* fan: the plane of dir and up (unit, _|_ dir) */
+    double to[2][3];          /* fan toward count points on the segment to[0]-to[1] */
+    int has_to;
+    double angle;             /* half angle, degrees (fan, cone) */
+    double radius;            /* point: pupil radius at `toward`; collimated: beam */
+    double toward[3];
+    double waist, wavelength, trunc;   /* gaussian (trunc: rings reach trunc*waist) */
+    long count;               /* fan: rays; collimated: grid N (N x N cells) */
+    int rings;                /* point, cone, gaussian: hexapolar rings */
+    double power;             /* total power of the source (default 1) */
+    double medium;            /* index where its rays start (default 1) */
+    int polarised;            /* 1: linear along pol[] (else unpolarised) */
+    double pol[3];
+    const char *src;          /* defined at src:line */
+    long line;
+} sc_source;
+
+typedef struct sc_scene {
+    sc_surface *surf;
+    int nsurf;
+    sc_source *source;
+    int nsource;
+    int depth;                /* recursion depth limit (default 10) */
+    double cutoff;            /* intensity cutoff, relative (default 1e-6) */
+    int threads;              /* 0: all cores */
+    int fresnel, reflections; /* on (1, default) or off */
+    double escape;            /* length drawn for an escaping ray (default 1) */
+    char *out_segments, *out_hits, *out_summary;
+    char *name;               /* the scene file, for messages */
+    char *dir;                /* its folder: mesh files are relative to it */
+} sc_scene;
+
+/* One ray as the sources emit it. */
+typedef struct sc_ray {
+    double o[3], d[3];
+    double power;
+} sc_ray;
+
+/* Readers.  Each parses a buffer (name: for messages), returns 0 or -1 with
+ * "NAME:LINE: what is wrong" in err (SC_ERRMAX bytes).  They never print. */
+int  sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
+                    char *err);
+int  sc_parse_triangles(const char *text, size_t len, const char *name, double **tri,
+                        long *ntri, char *err);
+int  sc_parse_media(const char *text, size_t len, const char *name, long ntri,
+                    double **media, char *err);
+int  sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
+                  long *ntri, char *err);
+/* Validate triangles (finite, non-degenerate): 0 or -1 with the triangle's number. */
+int  sc_check_triangles(const double *tri, long ntri, const char *name, char *err);
+/* A whole scene file with its mesh and media files: 0 or -1 (err set). */
+int  sc_load(const char *path, sc_scene *sc, char *err);
+void sc_free(sc_scene *sc);
+/* The rays of a point source (hexapolar rings filling the disc of `radius` about
+ * `toward`, perpendicular to from->toward): 1 + 3 rings (rings + 1) of them. */
+long sc_point_count(const sc_source *s);
+void sc_point_rays(const sc_source *s, sc_ray *out);
+
+/* Tessellate an analytic surface: axial shapes and discs into 6 level^2 triangles
+ * (hexapolar rings, vertices on the surface), rectangles into 2 level^2, spheres
+ * into 4 level (level - 1) (level >= 2).  Oriented as the surface's normal. */
+int  sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, char *err);
+
+#endif

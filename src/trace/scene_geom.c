@@ -1,0 +1,215 @@
+/* scene_geom.c -- the trace front end's geometry: the rays of a point source that
+ * fills a pupil (the engine makes the other kinds of source itself), and the
+ * tessellation of analytic surfaces into triangle meshes whose vertices lie on the
+ * surface (for the error-against-run-time table).  libc and libm only. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "scene.h"
+
+#define PI 3.14159265358979323846
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void cross3(const double *a, const double *b, double *c)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+static int normalize(double *v)
+{
+    double m = sqrt(dot3(v, v));
+    if (!(m > 0) || !isfinite(m)) return -1;
+    v[0] /= m; v[1] /= m; v[2] /= m;
+    return 0;
+}
+
+/* A unit vector perpendicular to unit d: the axis least aligned with d, projected. */
+static void perpendicular(const double *d, double *u)
+{
+    double m;
+    int k = fabs(d[0]) < fabs(d[1]) ? (fabs(d[0]) < fabs(d[2]) ? 0 : 2)
+                                    : (fabs(d[1]) < fabs(d[2]) ? 1 : 2);
+    u[0] = u[1] = u[2] = 0;
+    u[k] = 1;
+    m = dot3(u, d);
+    for (int i = 0; i < 3; i++) u[i] -= m * d[i];
+    normalize(u);
+}
+
+long sc_point_count(const sc_source *s) { return 1 + 3L * s->rings * (s->rings + 1); }
+
+void sc_point_rays(const sc_source *s, sc_ray *out)
+{
+    double d[3], u[3], v[3];
+    long n = sc_point_count(s), i = 0;
+    for (int k = 0; k < 3; k++) d[k] = s->toward[k] - s->from[k];
+    normalize(d);
+    perpendicular(d, u);
+    cross3(d, u, v);
+    for (int r = 0; r <= s->rings; r++)
+        for (int j = 0; j < (r ? 6 * r : 1); j++, i++) {
+            double rho = s->rings ? s->radius * r / s->rings : 0;
+            double phi = r ? 2 * PI * j / (6 * r) : 0;
+            memcpy(out[i].o, s->from, sizeof out[i].o);
+            for (int k = 0; k < 3; k++)
+                out[i].d[k] = s->toward[k] - s->from[k] +
+                              rho * (cos(phi) * u[k] + sin(phi) * v[k]);
+            normalize(out[i].d);
+            out[i].power = s->power / (double)n;
+        }
+}
+
+/* ---- tessellation --------------------------------------------------------------- */
+
+typedef struct mesh { double *t; long n, cap; } mesh;
+
+static int put(mesh *m, const double *a, const double *b, const double *c)
+{
+    if (m->n == m->cap) {
+        long cap = m->cap ? 2 * m->cap : 64;
+        double *t = realloc(m->t, (size_t)cap * 9 * sizeof *t);
+        if (!t) return -1;
+        m->t = t;
+        m->cap = cap;
+    }
+    memcpy(m->t + 9 * m->n, a, 3 * sizeof *a);
+    memcpy(m->t + 9 * m->n + 3, b, 3 * sizeof *b);
+    memcpy(m->t + 9 * m->n + 6, c, 3 * sizeof *c);
+    m->n++;
+    return 0;
+}
+
+/* Sag of an axial surface at distance s from the axis. */
+static double sag(const sc_surface *f, double s)
+{
+    double c = f->radius != 0 ? 1 / f->radius : 0, s2 = s * s, z, p = s2;
+    double q = 1 - (1 + f->conic) * c * c * s2;
+    z = c * s2 / (1 + sqrt(q > 0 ? q : 0));
+    for (int i = 0; i < f->ncoef; i++, p *= s2) z += f->coef[i] * p;
+    return z;
+}
+
+/* Point of an axial surface or disc at polar (s, phi) in the frame (u, v, axis). */
+static void axial_point(const sc_surface *f, const double *u, const double *v, double s,
+                        double phi, double *p)
+{
+    double z = f->shape == SC_PLANE ? 0 : sag(f, s);
+    for (int k = 0; k < 3; k++)
+        p[k] = f->at[k] + z * f->axis[k] + s * (cos(phi) * u[k] + sin(phi) * v[k]);
+}
+
+/* Hexapolar rings: ring k holds 6k vertices; neighbouring rings are zipped by angle.
+ * With v = u x axis the triangles' normals point along -axis: their front side is
+ * the surface's n1 side (trace.h). */
+static int tess_axial(const sc_surface *f, int level, mesh *m)
+{
+    double u[3], v[3], a = f->aperture;
+    perpendicular(f->axis, u);
+    cross3(u, f->axis, v);
+    for (int k = 1; k <= level; k++) {
+        long nin = k == 1 ? 1 : 6L * (k - 1), nout = 6L * k, i = 0, j = 0;
+        double rin = a * (k - 1) / level, rout = a * k / level;
+        while (i < (k == 1 ? 0 : nin) || j < nout) {
+            double p[3], q[3], r[3];
+            double ai = 2 * PI * (double)(i + 1) / (double)nin;
+            double aj = 2 * PI * (double)(j + 1) / (double)nout;
+            axial_point(f, u, v, rin, 2 * PI * (double)i / (double)nin, p);
+            axial_point(f, u, v, rout, 2 * PI * (double)j / (double)nout, q);
+            if (j < nout && (k == 1 || i == nin || aj <= ai)) {
+                axial_point(f, u, v, rout, aj, r);
+                j++;
+            } else {
+                axial_point(f, u, v, rin, ai, r);
+                i++;
+            }
+            if (put(m, p, q, r)) return -1;
+        }
+    }
+    return 0;
+}
+
+static int tess_rect(const sc_surface *f, int level, mesh *m)
+{
+    double v[3], u[3];
+    memcpy(v, f->up, sizeof v);
+    cross3(f->axis, v, u);       /* u x v = -axis: normals toward the n1 side */
+    for (int i = 0; i < level; i++)
+        for (int j = 0; j < level; j++) {
+            double c[4][3];
+            for (int q = 0; q < 4; q++) {
+                double x = ((double)(i + (q == 1 || q == 2)) / level - 0.5) * f->rect[0];
+                double y = ((double)(j + (q >= 2)) / level - 0.5) * f->rect[1];
+                for (int k = 0; k < 3; k++) c[q][k] = f->at[k] + x * u[k] + y * v[k];
+            }
+            if (put(m, c[0], c[1], c[2]) || put(m, c[0], c[2], c[3])) return -1;
+        }
+    return 0;
+}
+
+/* Put triangle a b c turned so that its normal points away from `centre`. */
+static int put_outward(mesh *m, const double *a, const double *b, const double *c,
+                       const double *centre)
+{
+    double e1[3], e2[3], n[3], mid[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+        mid[k] = (a[k] + b[k] + c[k]) / 3 - centre[k];
+    }
+    cross3(e1, e2, n);
+    return dot3(n, mid) >= 0 ? put(m, a, b, c) : put(m, a, c, b);
+}
+
+/* Latitude bands x 2 level longitudes; the bands at the poles are fans. */
+static int tess_sphere(const sc_surface *f, int level, mesh *m)
+{
+    int nlon = 2 * level;
+    for (int i = 0; i < level; i++)
+        for (int j = 0; j < nlon; j++) {
+            double c[4][3];   /* (i, j) (i, j+1) (i+1, j+1) (i+1, j) */
+            for (int q = 0; q < 4; q++) {
+                double th = PI * (i + (q >= 2)) / level;
+                double ph = 2 * PI * (j + (q == 1 || q == 2)) / nlon;
+                c[q][0] = f->at[0] + f->radius * sin(th) * cos(ph);
+                c[q][1] = f->at[1] + f->radius * sin(th) * sin(ph);
+                c[q][2] = f->at[2] + f->radius * cos(th);
+            }
+            if (i > 0 && put_outward(m, c[0], c[1], c[2], f->at)) return -1;
+            if (i < level - 1 && put_outward(m, c[0], c[2], c[3], f->at)) return -1;
+        }
+    return 0;
+}
+
+int sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, char *err)
+{
+    mesh m = {0};
+    int rc;
+    *tri = NULL;
+    *ntri = 0;
+    if (level < 1 || (s->shape == SC_SPHERE && level < 2)) {
+        snprintf(err, SC_ERRMAX, "tessellate %d: too coarse for this surface", level);
+        return -1;
+    }
+    switch (s->shape) {
+    case SC_PLANE: rc = s->aperture > 0 ? tess_axial(s, level, &m) : tess_rect(s, level, &m); break;
+    case SC_SPHERE: rc = tess_sphere(s, level, &m); break;
+    case SC_CAP: case SC_CONIC: case SC_ASPHERE: rc = tess_axial(s, level, &m); break;
+    default:
+        snprintf(err, SC_ERRMAX, "only analytic surfaces can be tessellated");
+        return -1;
+    }
+    if (rc) {
+        free(m.t);
+        snprintf(err, SC_ERRMAX, "out of memory tessellating (level %d)", level);
+        return -1;
+    }
+    if (sc_check_triangles(m.t, m.n, "tessellation", err)) {
+        free(m.t);
+        return -1;
+    }
+    *tri = m.t;
+    *ntri = m.n;
+    return 0;
+}

@@ -1,0 +1,1044 @@
+/* scene_read.c -- the trace front end's readers: scene files (one directive per
+ * line, '#' comments), the document's triangle files (three lines "x y z" per
+ * triangle, as opticrt reads sphercap.t), media files ("n1 n2" per triangle, as
+ * opticrt's p.n) and OBJ meshes (v and f lines).  Buffers in, plain data out, every
+ * error as "FILE:LINE: what"; nothing here prints, opens a device or needs Embree,
+ * so the whole file is fuzzed alone (tests/fuzz_trace_scene.c). */
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include "scene.h"
+
+#define PI 3.14159265358979323846
+
+#define MAXTOK 64          /* items on one line */
+#define NUMLEN 64          /* longest number token */
+#define MAXTRI 50000000L   /* triangles in one mesh (1.8 GB of doubles) */
+#define MAXSURF 100000
+#define MAXSOURCE 10000
+
+/* ---- lines and tokens --------------------------------------------------------- */
+
+typedef struct tok { const char *s; size_t n; } tok;
+
+typedef struct reader {
+    const char *p, *end, *name;
+    long line;
+    tok t[MAXTOK];
+    int nt;
+    char *err;
+} reader;
+
+static int fail(reader *r, const char *fmt, ...)
+{
+    va_list ap;
+    int k = snprintf(r->err, SC_ERRMAX, "%s:%ld: ", r->name, r->line);
+    if (k < 0 || k >= SC_ERRMAX) k = 0;
+    va_start(ap, fmt);
+    vsnprintf(r->err + k, SC_ERRMAX - k, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static int is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+/* Next line with at least one item (comments and blank lines skipped).  1 with the
+ * items in r->t, 0 at the end, -1 on an error. */
+static int next_line(reader *r)
+{
+    while (r->p < r->end) {
+        const char *nl = memchr(r->p, '\n', (size_t)(r->end - r->p));
+        const char *e = nl ? nl : r->end, *q = r->p;
+        r->line++;
+        r->p = nl ? nl + 1 : r->end;
+        r->nt = 0;
+        if (memchr(q, '\0', (size_t)(e - q)))
+            return fail(r, "a NUL byte: this is not a text file");
+        while (q < e) {
+            const char *b;
+            while (q < e && is_blank(*q)) q++;
+            if (q == e || *q == '#') break;
+            b = q;
+            while (q < e && !is_blank(*q) && *q != '#') q++;
+            if (r->nt == MAXTOK) return fail(r, "more than %d items on one line", MAXTOK);
+            r->t[r->nt].s = b;
+            r->t[r->nt].n = (size_t)(q - b);
+            r->nt++;
+        }
+        if (r->nt) return 1;
+    }
+    return 0;
+}
+
+static int tok_is(const tok *t, const char *w) { return strlen(w) == t->n && !memcmp(t->s, w, t->n); }
+
+/* A finite decimal number (no hex, inf or nan).  0 or -1 (error reported). */
+static int tok_num(reader *r, const tok *t, const char *what, double *v)
+{
+    char buf[NUMLEN], *end;
+    size_t i;
+    if (t->n >= NUMLEN) return fail(r, "%s: '%.20s...' is too long for a number", what, t->s);
+    memcpy(buf, t->s, t->n);
+    buf[t->n] = '\0';
+    for (i = 0; i < t->n; i++)
+        if (!strchr("0123456789+-.eE", buf[i])) break;
+    if (i < t->n || !t->n) {
+        if (!strncmp(buf, "nan", 3) || !strncmp(buf, "NaN", 3) || !strncmp(buf, "-nan", 4))
+            return fail(r, "%s: '%s': NaN is not a number", what, buf);
+        if (strstr(buf, "inf") || strstr(buf, "Inf"))
+            return fail(r, "%s: '%s': infinite values are not allowed", what, buf);
+        return fail(r, "%s: '%s' is not a number", what, buf);
+    }
+    errno = 0;
+    *v = strtod(buf, &end);
+    if (end != buf + t->n) return fail(r, "%s: '%s' is not a number", what, buf);
+    if (errno == ERANGE && fabs(*v) > 1) return fail(r, "%s: '%s' is out of range", what, buf);
+    if (!isfinite(*v) || fabs(*v) > 1e30)
+        return fail(r, "%s: '%s' is out of range (|x| <= 1e30)", what, buf);
+    return 0;
+}
+
+/* Read the whole line as exactly n numbers. */
+static int line_nums(reader *r, int n, const char *what, double *v)
+{
+    if (r->nt != n)
+        return fail(r, "expected %d numbers (%s), found %d item%s", n, what, r->nt,
+                    r->nt == 1 ? "" : "s");
+    for (int i = 0; i < n; i++)
+        if (tok_num(r, &r->t[i], what, &v[i])) return -1;
+    return 0;
+}
+
+static void reader_init(reader *r, const char *text, size_t len, const char *name,
+                        char *err)
+{
+    memset(r, 0, sizeof *r);
+    r->p = text;
+    r->end = text + len;
+    r->name = name;
+    r->err = err;
+    err[0] = '\0';
+}
+
+/* Growable arrays of doubles. */
+typedef struct dvec { double *v; size_t n, cap; } dvec;
+
+static int dvec_push(dvec *a, const double *x, size_t k)
+{
+    if (a->n + k > a->cap) {
+        size_t cap = a->cap ? a->cap * 2 : 256;
+        double *v;
+        while (cap < a->n + k) cap *= 2;
+        v = realloc(a->v, cap * sizeof *v);
+        if (!v) return -1;
+        a->v = v;
+        a->cap = cap;
+    }
+    memcpy(a->v + a->n, x, k * sizeof *x);
+    a->n += k;
+    return 0;
+}
+
+/* ---- triangles ---------------------------------------------------------------- */
+
+static void sub3(const double *a, const double *b, double *c)
+{
+    c[0] = a[0] - b[0]; c[1] = a[1] - b[1]; c[2] = a[2] - b[2];
+}
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void cross3(const double *a, const double *b, double *c)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Why triangle t is unusable, or NULL. */
+static const char *bad_triangle(const double *t)
+{
+    double e1[3], e2[3], e3[3], c[3], l2;
+    for (int i = 0; i < 9; i++)
+        if (!isfinite(t[i])) return "has a non-finite coordinate";
+    sub3(t + 3, t, e1);
+    sub3(t + 6, t, e2);
+    sub3(t + 6, t + 3, e3);
+    cross3(e1, e2, c);
+    l2 = fmax(dot3(e1, e1), fmax(dot3(e2, e2), dot3(e3, e3)));
+    if (l2 == 0) return "is degenerate (its three vertices coincide)";
+    /* twice the area against the longest edge squared: ~ the smallest angle */
+    if (sqrt(dot3(c, c)) <= 1e-12 * l2) return "has zero area (collinear vertices)";
+    return NULL;
+}
+
+int sc_check_triangles(const double *tri, long ntri, const char *name, char *err)
+{
+    for (long i = 0; i < ntri; i++) {
+        const char *why = bad_triangle(tri + 9 * i);
+        if (why) {
+            snprintf(err, SC_ERRMAX, "%s: triangle %ld %s", name, i + 1, why);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int sc_parse_triangles(const char *text, size_t len, const char *name, double **tri,
+                       long *ntri, char *err)
+{
+    reader r;
+    dvec a = {0};
+    double v[9];
+    long first = 0;
+    int k = 0, st;
+
+    reader_init(&r, text, len, name, err);
+    *tri = NULL;
+    *ntri = 0;
+    while ((st = next_line(&r)) > 0) {
+        const char *why;
+        if (k == 0) first = r.line;
+        if (line_nums(&r, 3, "a vertex: x y z", v + 3 * k)) goto bad;
+        if (++k < 3) continue;
+        k = 0;
+        if ((why = bad_triangle(v))) {
+            r.line = first;
+            fail(&r, "triangle %ld (lines %ld-%ld) %s", (long)(a.n / 9) + 1, first,
+                 first + 2, why);
+            goto bad;
+        }
+        if (a.n / 9 >= (size_t)MAXTRI) { fail(&r, "more than %ld triangles", MAXTRI); goto bad; }
+        if (dvec_push(&a, v, 9)) { fail(&r, "out of memory"); goto bad; }
+    }
+    if (st < 0) goto bad;
+    if (k) {
+        fail(&r, "the file ends inside triangle %ld (%d of its 3 vertex lines; "
+             "each triangle is three lines x y z)", (long)(a.n / 9) + 1, k);
+        goto bad;
+    }
+    if (!a.n) { fail(&r, "no triangles (each triangle is three lines x y z)"); goto bad; }
+    *tri = a.v;
+    *ntri = (long)(a.n / 9);
+    return 0;
+bad:
+    free(a.v);
+    return -1;
+}
+
+int sc_parse_media(const char *text, size_t len, const char *name, long ntri,
+                   double **media, char *err)
+{
+    reader r;
+    double *m = NULL;
+    long n = 0;
+    int st;
+
+    reader_init(&r, text, len, name, err);
+    *media = NULL;
+    if (ntri <= 0 || !(m = malloc((size_t)ntri * 2 * sizeof *m))) {
+        if (ntri > 0) fail(&r, "out of memory");
+        else fail(&r, "no triangles to give media to");
+        return -1;
+    }
+    while ((st = next_line(&r)) > 0) {
+        double v[2];
+        if (n == ntri) {
+            fail(&r, "more media lines than the mesh has triangles (%ld)", ntri);
+            goto bad;
+        }
+        if (line_nums(&r, 2, "indices of refraction: n1 n2", v)) goto bad;
+        for (int i = 0; i < 2; i++)
+            if (!(v[i] > 0)) {
+                fail(&r, "index of refraction n%d = %g must be positive", i + 1, v[i]);
+                goto bad;
+            }
+        m[2 * n] = v[0];
+        m[2 * n + 1] = v[1];
+        n++;
+    }
+    if (st < 0) goto bad;
+    if (n != ntri) {
+        fail(&r, "%ld media lines for %ld triangles (one line n1 n2 per triangle)", n,
+             ntri);
+        goto bad;
+    }
+    *media = m;
+    return 0;
+bad:
+    free(m);
+    return -1;
+}
+
+/* An OBJ vertex reference "i", "i/t", "i//n", "i/t/n"; negative counts back. */
+static int obj_index(reader *r, const tok *t, long nv, long *idx)
+{
+    tok head = *t;
+    const char *slash = memchr(t->s, '/', t->n);
+    double v;
+    if (slash) head.n = (size_t)(slash - t->s);
+    if (!head.n) return fail(r, "face: a vertex reference without a number");
+    if (tok_num(r, &head, "face vertex index", &v)) return -1;
+    if (v != floor(v)) return fail(r, "face: vertex index %g is not an integer", v);
+    if (v < 0) v += (double)nv + 1;
+    if (v < 1 || v > (double)nv)
+        return fail(r, "face: vertex %.0f does not exist (%ld vertices so far)",
+                    v < 1 ? v - (double)nv - 1 : v, nv);
+    *idx = (long)v - 1;
+    return 0;
+}
+
+int sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
+                 long *ntri, char *err)
+{
+    static const char *const ignored[] = {"vt", "vn", "vp", "o", "g", "s", "usemtl",
+                                          "mtllib", NULL};
+    reader r;
+    dvec v = {0}, a = {0};
+    int st;
+
+    reader_init(&r, text, len, name, err);
+    *tri = NULL;
+    *ntri = 0;
+    while ((st = next_line(&r)) > 0) {
+        int skip = 0;
+        for (int i = 0; ignored[i]; i++) skip |= tok_is(&r.t[0], ignored[i]);
+        if (skip) continue;
+        if (tok_is(&r.t[0], "v")) {
+            double x[3];
+            if (r.nt != 4 && r.nt != 5) {
+                fail(&r, "v: expected x y z [w], found %d numbers", r.nt - 1);
+                goto bad;
+            }
+            for (int i = 0; i < 3; i++)
+                if (tok_num(&r, &r.t[i + 1], "v", &x[i])) goto bad;
+            if ((long)(v.n / 3) >= 3 * MAXTRI) { fail(&r, "too many vertices"); goto bad; }
+            if (dvec_push(&v, x, 3)) { fail(&r, "out of memory"); goto bad; }
+        } else if (tok_is(&r.t[0], "f")) {
+            long idx[MAXTOK], nv = (long)(v.n / 3);
+            if (r.nt < 4) { fail(&r, "f: a face needs at least 3 vertices"); goto bad; }
+            for (int i = 1; i < r.nt; i++)
+                if (obj_index(&r, &r.t[i], nv, &idx[i - 1])) goto bad;
+            for (int i = 1; i + 1 < r.nt - 1; i++) {   /* fan: 0, i, i+1 */
+                double t[9];
+                const char *why;
+                memcpy(t, v.v + 3 * idx[0], 3 * sizeof *t);
+                memcpy(t + 3, v.v + 3 * idx[i], 3 * sizeof *t);
+                memcpy(t + 6, v.v + 3 * idx[i + 1], 3 * sizeof *t);
+                if ((why = bad_triangle(t))) {
+                    fail(&r, "f: triangle %ld %s", (long)(a.n / 9) + 1, why);
+                    goto bad;
+                }
+                if (a.n / 9 >= (size_t)MAXTRI) { fail(&r, "too many triangles"); goto bad; }
+                if (dvec_push(&a, t, 9)) { fail(&r, "out of memory"); goto bad; }
+            }
+        } else {
+            char w[32];
+            snprintf(w, sizeof w, "%.*s", (int)(r.t[0].n < 24 ? r.t[0].n : 24), r.t[0].s);
+            fail(&r, "'%s': not an OBJ statement this reader knows (v, f; vt, vn, o, g, "
+                 "s, usemtl, mtllib are ignored)", w);
+            goto bad;
+        }
+    }
+    if (st < 0) goto bad;
+    if (!a.n) { fail(&r, "no faces (f lines)"); goto bad; }
+    free(v.v);
+    *tri = a.v;
+    *ntri = (long)(a.n / 9);
+    return 0;
+bad:
+    free(v.v);
+    free(a.v);
+    return -1;
+}
+
+/* ---- scene files -------------------------------------------------------------- */
+
+/* The keys a directive may carry, with their number of values.  ARGS_WORD: one
+ * word (a file name); ARGS_VAR: numbers up to the next key. */
+enum { ARGS_WORD = -1, ARGS_VAR = -2 };
+typedef struct keydef { const char *name; int nargs; } keydef;
+static const keydef keys[] = {
+    {"refract", 2}, {"mirror", 0}, {"absorb", 0}, {"detect", 0}, {"media", ARGS_WORD},
+    {"at", 3}, {"normal", 3}, {"disc", 1}, {"rect", 2}, {"up", 3},
+    {"center", 3}, {"radius", 1}, {"vertex", 3}, {"axis", 3}, {"conic", 1},
+    {"coef", ARGS_VAR}, {"aperture", 1}, {"tessellate", 1}, {"refine", 0},
+    {"file", ARGS_WORD}, {"sphere", 4},
+    {"from", 3}, {"dir", 3}, {"to", 6}, {"angle", 1}, {"rays", 1}, {"rings", 1},
+    {"toward", 3}, {"grid", 1}, {"waist", 1}, {"wavelength", 1}, {"trunc", 1},
+    {"power", 1}, {"medium", 1}, {"pol", 3},
+};
+#define NKEYS (int)(sizeof keys / sizeof keys[0])
+
+/* The values found on one directive line. */
+typedef struct fields {
+    int has[NKEYS];
+    double num[NKEYS][SC_MAXCOEF];
+    int count[NKEYS];
+    tok word[NKEYS];
+} fields;
+
+static int key_index(const tok *t)
+{
+    for (int i = 0; i < NKEYS; i++)
+        if (tok_is(t, keys[i].name)) return i;
+    return -1;
+}
+
+static int has(const fields *f, const char *k)
+{
+    for (int i = 0; i < NKEYS; i++)
+        if (!strcmp(keys[i].name, k)) return f->has[i];
+    return 0;
+}
+static const double *val(const fields *f, const char *k)
+{
+    for (int i = 0; i < NKEYS; i++)
+        if (!strcmp(keys[i].name, k)) return f->num[i];
+    return NULL;
+}
+
+static int word_in(const char *list, const char *w)
+{
+    size_t n = strlen(w);
+    for (const char *p = list; (p = strstr(p, w)); p += n)
+        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) return 1;
+    return 0;
+}
+
+/* Parse the items from t[first] on as key/value groups allowed by `allowed`
+ * (space-separated key names). */
+static int parse_fields(reader *r, int first, const char *dname, const char *allowed,
+                        fields *f)
+{
+    memset(f, 0, sizeof *f);
+    for (int i = first; i < r->nt;) {
+        int k = key_index(&r->t[i]);
+        char w[32], what[64];
+        snprintf(w, sizeof w, "%.*s", (int)(r->t[i].n < 24 ? r->t[i].n : 24), r->t[i].s);
+        if (k < 0 || !word_in(allowed, keys[k].name))
+            return fail(r, "%s: unexpected '%s' (expected one of: %s)", dname, w, allowed);
+        if (f->has[k]) return fail(r, "%s: '%s' given twice", dname, w);
+        f->has[k] = 1;
+        i++;
+        if (keys[k].nargs == ARGS_WORD) {
+            if (i == r->nt) return fail(r, "%s: '%s' needs a file name", dname, w);
+            f->word[k] = r->t[i++];
+            continue;
+        }
+        snprintf(what, sizeof what, "%s: '%s'", dname, w);
+        if (keys[k].nargs == ARGS_VAR) {
+            while (i < r->nt && key_index(&r->t[i]) < 0) {
+                if (f->count[k] == SC_MAXCOEF)
+                    return fail(r, "%s: more than %d '%s' values", dname, SC_MAXCOEF, w);
+                if (tok_num(r, &r->t[i], what, &f->num[k][f->count[k]++])) return -1;
+                i++;
+            }
+            if (!f->count[k]) return fail(r, "%s: '%s' needs at least one number", dname, w);
+            continue;
+        }
+        for (int j = 0; j < keys[k].nargs; j++, i++) {
+            if (i == r->nt || key_index(&r->t[i]) >= 0)
+                return fail(r, "%s: '%s' needs %d number%s, found %d", dname, w,
+                            keys[k].nargs, keys[k].nargs == 1 ? "" : "s", j);
+            if (tok_num(r, &r->t[i], what, &f->num[k][j])) return -1;
+        }
+        f->count[k] = keys[k].nargs;
+    }
+    return 0;
+}
+
+static char *tok_dup(const tok *t)
+{
+    char *s = malloc(t->n + 1);
+    if (s) {
+        memcpy(s, t->s, t->n);
+        s[t->n] = '\0';
+    }
+    return s;
+}
+
+/* A unit vector from key k; fails on a zero vector. */
+static int unit_vec(reader *r, const fields *f, const char *dname, const char *k,
+                    double *u)
+{
+    const double *v = val(f, k);
+    double m = sqrt(dot3(v, v));
+    if (!(m > 0) || !isfinite(m))
+        return fail(r, "%s: '%s' %g %g %g is a zero-length direction", dname, k, v[0],
+                    v[1], v[2]);
+    for (int i = 0; i < 3; i++) u[i] = v[i] / m;
+    return 0;
+}
+
+static int need(reader *r, const fields *f, const char *dname, const char *list)
+{
+    char k[32];
+    const char *p = list;
+    while (*p) {
+        size_t n = strcspn(p, " ");
+        snprintf(k, sizeof k, "%.*s", (int)n, p);
+        if (!has(f, k)) return fail(r, "%s: '%s' is missing", dname, k);
+        p += n;
+        while (*p == ' ') p++;
+    }
+    return 0;
+}
+
+static int positive(reader *r, const char *dname, const char *what, double v)
+{
+    if (!(v > 0)) return fail(r, "%s: %s = %g must be positive", dname, what, v);
+    return 0;
+}
+
+/* An integer value within [lo, hi]. */
+static int int_val(reader *r, const fields *f, const char *dname, const char *k,
+                   long lo, long hi, long *out)
+{
+    double v = val(f, k)[0];
+    if (v != floor(v) || v < (double)lo || v > (double)hi)
+        return fail(r, "%s: '%s' %g must be an integer from %ld to %ld", dname, k, v, lo,
+                    hi);
+    *out = (long)v;
+    return 0;
+}
+
+/* The kind of a surface: exactly one of refract / mirror / absorb / detect (media:
+ * meshes only). */
+static int surface_kind(reader *r, const fields *f, const char *dname, sc_surface *s)
+{
+    static const char *const kinds[] = {"refract", "mirror", "absorb", "detect", "media"};
+    int n = 0;
+    for (int i = 0; i < 5; i++)
+        if (has(f, kinds[i])) { s->kind = i; n++; }
+    if (n != 1)
+        return fail(r, "%s: give exactly one of refract N1 N2, %smirror, absorb, detect",
+                    dname, s->shape == SC_MESH ? "media FILE, " : "");
+    if (s->kind == SC_REFRACT) {
+        s->n1 = val(f, "refract")[0];
+        s->n2 = val(f, "refract")[1];
+        if (!(s->n1 > 0) || !(s->n2 > 0))
+            return fail(r, "%s: refract %g %g: an index of refraction must be positive",
+                        dname, s->n1, s->n2);
+    }
+    return 0;
+}
+
+/* Some unit vector perpendicular to the unit vector d (or `up` projected). */
+static void perpendicular(const double *d, double *u)
+{
+    double a[3] = {0, 0, 0}, m;
+    int k = fabs(d[0]) < fabs(d[1]) ? (fabs(d[0]) < fabs(d[2]) ? 0 : 2)
+                                    : (fabs(d[1]) < fabs(d[2]) ? 1 : 2);
+    a[k] = 1;
+    m = dot3(a, d);
+    for (int i = 0; i < 3; i++) a[i] -= m * d[i];
+    m = sqrt(dot3(a, a));
+    for (int i = 0; i < 3; i++) u[i] = a[i] / m;
+}
+
+static int up_vector(reader *r, const fields *f, const char *dname, const double *d,
+                     double *u)
+{
+    double m, p;
+    if (!has(f, "up")) { perpendicular(d, u); return 0; }
+    if (unit_vec(r, f, dname, "up", u)) return -1;
+    p = dot3(u, d);
+    for (int i = 0; i < 3; i++) u[i] -= p * d[i];
+    m = sqrt(dot3(u, u));
+    if (m < 1e-9) return fail(r, "%s: 'up' is parallel to the direction", dname);
+    for (int i = 0; i < 3; i++) u[i] /= m;
+    return 0;
+}
+
+/* Does the axial surface exist out to its aperture?  (The conic's square root must
+ * stay real, and the sag must be finite.) */
+static int axial_check(reader *r, const char *dname, const sc_surface *s)
+{
+    double c = s->radius != 0 ? 1 / s->radius : 0, a = s->aperture;
+    double q = 1 - (1 + s->conic) * c * c * a * a;
+    if (q < 0) {
+        if (s->shape == SC_CAP)
+            return fail(r, "%s: aperture %g exceeds the radius %g: no real surface there",
+                        dname, a, fabs(s->radius));
+        return fail(r, "%s: radius %g, conic %g: no real surface at the aperture %g "
+                    "(1 - (1+k) s^2/R^2 = %g < 0; the surface ends at s = %g)", dname,
+                    s->radius, s->conic, a, q, sqrt(1 / ((1 + s->conic) * c * c)));
+    }
+    return 0;
+}
+
+static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
+{
+    static const char *const allowed[] = {
+        [SC_PLANE] = "refract mirror absorb detect at normal disc rect up tessellate refine",
+        [SC_SPHERE] = "refract mirror absorb detect center radius tessellate refine",
+        [SC_CAP] = "refract mirror absorb detect vertex axis radius aperture tessellate refine",
+        [SC_CONIC] = "refract mirror absorb detect vertex axis radius conic aperture "
+                     "tessellate refine",
+        [SC_ASPHERE] = "refract mirror absorb detect vertex axis radius conic coef aperture "
+                       "tessellate refine",
+        [SC_MESH] = "refract mirror absorb detect media file sphere",
+    };
+    static const char *const required[] = {
+        [SC_PLANE] = "at normal", [SC_SPHERE] = "center radius",
+        [SC_CAP] = "vertex radius aperture", [SC_CONIC] = "vertex radius conic aperture",
+        [SC_ASPHERE] = "vertex radius coef aperture", [SC_MESH] = "file",
+    };
+    fields f;
+    sc_surface s;
+    sc_surface *grown;
+
+    memset(&s, 0, sizeof s);
+    s.shape = shape;
+    s.src = sc->name;
+    s.line = r->line;
+    s.axis[2] = 1;
+    if (parse_fields(r, 1, dname, allowed[shape], &f) || need(r, &f, dname, required[shape])
+        || surface_kind(r, &f, dname, &s))
+        return -1;
+    if (has(&f, "tessellate")) {
+        long t;
+        if (int_val(r, &f, dname, "tessellate", 1, 2000, &t)) return -1;
+        s.tessellate = (int)t;
+    }
+    s.refine = has(&f, "refine");
+    if (s.refine && !s.tessellate)
+        return fail(r, "%s: 'refine' applies to a tessellated surface (tessellate N)", dname);
+    switch (shape) {
+    case SC_PLANE:
+        memcpy(s.at, val(&f, "at"), sizeof s.at);
+        if (unit_vec(r, &f, dname, "normal", s.axis)) return -1;
+        if (has(&f, "disc") == has(&f, "rect"))
+            return fail(r, "plane: give its bounds, either disc R or rect W H");
+        if (has(&f, "disc")) {
+            s.aperture = val(&f, "disc")[0];
+            if (positive(r, dname, "the disc radius", s.aperture)) return -1;
+        } else {
+            s.rect[0] = val(&f, "rect")[0];
+            s.rect[1] = val(&f, "rect")[1];
+            if (positive(r, dname, "the width", s.rect[0]) ||
+                positive(r, dname, "the height", s.rect[1]))
+                return -1;
+        }
+        if (up_vector(r, &f, dname, s.axis, s.up)) return -1;
+        break;
+    case SC_SPHERE:
+        memcpy(s.at, val(&f, "center"), sizeof s.at);
+        s.radius = val(&f, "radius")[0];
+        if (positive(r, dname, "the radius", s.radius)) return -1;
+        break;
+    case SC_MESH:
+        s.mesh_file = tok_dup(&f.word[key_index(&(tok){"file", 4})]);
+        if (has(&f, "media"))
+            s.media_file = tok_dup(&f.word[key_index(&(tok){"media", 5})]);
+        if (!s.mesh_file || (has(&f, "media") && !s.media_file)) {
+            free(s.mesh_file);
+            free(s.media_file);
+            return fail(r, "out of memory");
+        }
+        if (has(&f, "sphere")) {
+            memcpy(s.sphere, val(&f, "sphere"), sizeof s.sphere);
+            if (positive(r, dname, "the sphere's radius", s.sphere[3])) goto mesh_bad;
+        }
+        break;
+    default:   /* cap, conic, asphere */
+        memcpy(s.at, val(&f, "vertex"), sizeof s.at);
+        if (has(&f, "axis") && unit_vec(r, &f, dname, "axis", s.axis)) return -1;
+        s.radius = val(&f, "radius")[0];
+        s.aperture = val(&f, "aperture")[0];
+        if (positive(r, dname, "the aperture (semi-diameter)", s.aperture)) return -1;
+        if (has(&f, "conic")) s.conic = val(&f, "conic")[0];
+        if (has(&f, "coef")) {
+            s.ncoef = f.count[key_index(&(tok){"coef", 4})];
+            memcpy(s.coef, val(&f, "coef"), (size_t)s.ncoef * sizeof *s.coef);
+        }
+        if (axial_check(r, dname, &s)) return -1;
+    }
+    if (sc->nsurf == MAXSURF) {
+        fail(r, "more than %d surfaces", MAXSURF);
+        goto mesh_bad;
+    }
+    grown = realloc(sc->surf, (size_t)(sc->nsurf + 1) * sizeof *grown);
+    if (!grown) { fail(r, "out of memory"); goto mesh_bad; }
+    sc->surf = grown;
+    sc->surf[sc->nsurf++] = s;
+    return 0;
+mesh_bad:
+    free(s.mesh_file);
+    free(s.media_file);
+    return -1;
+}
+
+static int read_source(reader *r, sc_scene *sc)
+{
+    static const struct { const char *name, *allowed, *required; } types[] = {
+        [SC_RAY] = {"ray", "from dir power medium pol", "from dir"},
+        [SC_FAN] = {"fan", "from dir angle up to rays power medium pol", "from rays"},
+        [SC_POINT] = {"point", "from toward radius rings power medium pol",
+                      "from toward radius rings"},
+        [SC_CONE] = {"cone", "from dir angle rings power medium pol",
+                     "from dir angle rings"},
+        [SC_COLLIMATED] = {"collimated", "from dir radius grid power medium pol",
+                           "from dir radius grid"},
+        [SC_GAUSSIAN] = {"gaussian", "from dir waist wavelength rings trunc power medium pol",
+                         "from dir waist wavelength rings"},
+    };
+    sc_source s;
+    fields f;
+    char dname[32];
+    long v;
+    int t = -1;
+    sc_source *grown;
+
+    if (r->nt < 2)
+        return fail(r, "source: which kind? (ray, fan, point, cone, collimated, gaussian)");
+    for (int i = 0; i < 6; i++)
+        if (tok_is(&r->t[1], types[i].name)) t = i;
+    if (t < 0)
+        return fail(r, "source: unknown kind '%.*s' (ray, fan, point, cone, collimated, "
+                    "gaussian)", (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
+    snprintf(dname, sizeof dname, "source %s", types[t].name);
+    if (parse_fields(r, 2, dname, types[t].allowed, &f) || need(r, &f, dname, types[t].required))
+        return -1;
+    memset(&s, 0, sizeof s);
+    s.type = t;
+    s.src = sc->name;
+    s.line = r->line;
+    s.power = 1;
+    s.medium = 1;
+    memcpy(s.from, val(&f, "from"), sizeof s.from);
+    if (has(&f, "dir") && unit_vec(r, &f, dname, "dir", s.dir)) return -1;
+    if (has(&f, "power")) {
+        s.power = val(&f, "power")[0];
+        if (positive(r, dname, "power", s.power)) return -1;
+    }
+    if (has(&f, "medium")) {
+        s.medium = val(&f, "medium")[0];
+        if (!(s.medium > 0))
+            return fail(r, "%s: medium %g: an index of refraction must be positive", dname,
+                        s.medium);
+    }
+    if (has(&f, "pol")) {
+        if (unit_vec(r, &f, dname, "pol", s.pol)) return -1;
+        s.polarised = 1;
+    }
+    if (has(&f, "angle")) {
+        s.angle = val(&f, "angle")[0];
+        if (s.angle < 0 || s.angle >= (t == SC_FAN ? 180 : 90))
+            return fail(r, "%s: half angle %g must lie in [0, %d) degrees", dname, s.angle,
+                        t == SC_FAN ? 180 : 90);
+    }
+    if (has(&f, "radius")) {
+        s.radius = val(&f, "radius")[0];
+        if (positive(r, dname, "the radius", s.radius)) return -1;
+    }
+    if (has(&f, "rays")) {
+        if (int_val(r, &f, dname, "rays", 1, 100000000L, &v)) return -1;
+        s.count = v;
+    }
+    if (has(&f, "grid")) {
+        if (int_val(r, &f, dname, "grid", 1, 10000, &v)) return -1;
+        s.count = v;
+    }
+    if (has(&f, "rings")) {
+        if (int_val(r, &f, dname, "rings", 0, t == SC_POINT ? 500 : 5000, &v)) return -1;
+        s.rings = (int)v;
+    }
+    switch (t) {
+    case SC_FAN:
+        if (has(&f, "to") == has(&f, "dir"))
+            return fail(r, "%s: give either dir D angle A [up U], or to P1 P2 (rays toward "
+                        "points on the segment P1-P2, as opticrt)", dname);
+        if (has(&f, "to")) {
+            double a[3], b[3], c[3];
+            if (has(&f, "angle") || has(&f, "up"))
+                return fail(r, "%s: 'angle' and 'up' go with 'dir', not with 'to'", dname);
+            s.has_to = 1;
+            memcpy(s.to, val(&f, "to"), sizeof s.to);
+            sub3(s.to[0], s.from, a);
+            sub3(s.to[1], s.from, b);
+            if (dot3(a, a) == 0 || (s.count > 1 && dot3(b, b) == 0))
+                return fail(r, "%s: a 'to' point is the source point: a zero-direction ray",
+                            dname);
+            cross3(a, b, c);
+            if (s.count > 1 && dot3(c, c) == 0 && dot3(a, b) < 0)
+                return fail(r, "%s: the segment P1-P2 passes through the source point "
+                            "(a zero-direction ray)", dname);
+        } else {
+            if (!has(&f, "angle")) return fail(r, "%s: 'angle' is missing", dname);
+            if (up_vector(r, &f, dname, s.dir, s.up)) return -1;
+        }
+        break;
+    case SC_POINT: {
+        double d[3];
+        memcpy(s.toward, val(&f, "toward"), sizeof s.toward);
+        sub3(s.toward, s.from, d);
+        if (dot3(d, d) == 0)
+            return fail(r, "%s: 'toward' is the source point: a zero-direction ray", dname);
+        break;
+    }
+    case SC_GAUSSIAN:
+        s.waist = val(&f, "waist")[0];
+        s.wavelength = val(&f, "wavelength")[0];
+        if (positive(r, dname, "the waist", s.waist) ||
+            positive(r, dname, "the wavelength", s.wavelength))
+            return -1;
+        if (has(&f, "trunc")) {
+            s.trunc = val(&f, "trunc")[0];
+            if (positive(r, dname, "trunc", s.trunc)) return -1;
+        }
+        if (s.wavelength / (PI * s.waist) > 0.5)
+            return fail(r, "%s: wavelength %g against waist %g: divergence %g rad is beyond "
+                        "the paraxial Gaussian beam", dname, s.wavelength, s.waist,
+                        s.wavelength / (PI * s.waist));
+        break;
+    default:
+        break;
+    }
+    if (sc->nsource == MAXSOURCE) return fail(r, "more than %d sources", MAXSOURCE);
+    grown = realloc(sc->source, (size_t)(sc->nsource + 1) * sizeof *grown);
+    if (!grown) return fail(r, "out of memory");
+    sc->source = grown;
+    sc->source[sc->nsource++] = s;
+    return 0;
+}
+
+/* depth N / cutoff X / threads N / escape L / fresnel on|off / reflections on|off /
+ * output segments|hits|summary FILE */
+static int read_setting(reader *r, sc_scene *sc)
+{
+    double v;
+    char w[32];
+    const tok *d = &r->t[0];
+    if (tok_is(d, "output")) {
+        static const char *const what[] = {"segments", "hits", "summary"};
+        char **slot[] = {&sc->out_segments, &sc->out_hits, &sc->out_summary};
+        if (r->nt != 3)
+            return fail(r, "output: expected 'output segments|hits|summary FILE'");
+        for (int i = 0; i < 3; i++)
+            if (tok_is(&r->t[1], what[i])) {
+                if (*slot[i]) return fail(r, "output %s given twice", what[i]);
+                if (!(*slot[i] = tok_dup(&r->t[2]))) return fail(r, "out of memory");
+                return 0;
+            }
+        return fail(r, "output: '%.*s' is not segments, hits or summary",
+                    (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
+    }
+    if (tok_is(d, "fresnel") || tok_is(d, "reflections")) {
+        int *flag = tok_is(d, "fresnel") ? &sc->fresnel : &sc->reflections;
+        if (r->nt != 2 || !(tok_is(&r->t[1], "on") || tok_is(&r->t[1], "off")))
+            return fail(r, "%.*s: expected on or off", (int)d->n, d->s);
+        *flag = tok_is(&r->t[1], "on");
+        return 0;
+    }
+    if (r->nt != 2) return fail(r, "%.*s: expected one number", (int)d->n, d->s);
+    snprintf(w, sizeof w, "%.*s", (int)(d->n < 24 ? d->n : 24), d->s);
+    if (tok_num(r, &r->t[1], w, &v)) return -1;
+    if (tok_is(d, "depth")) {
+        if (v != floor(v) || v < 1 || v > 1000)
+            return fail(r, "depth %g: must be an integer from 1 to 1000", v);
+        sc->depth = (int)v;
+    } else if (tok_is(d, "cutoff")) {
+        if (!(v >= 0 && v < 1)) return fail(r, "cutoff %g: must lie in [0, 1)", v);
+        sc->cutoff = v;
+    } else if (tok_is(d, "escape")) {
+        if (!(v > 0)) return fail(r, "escape %g: the length must be positive", v);
+        sc->escape = v;
+    } else {
+        if (v != floor(v) || v < 0 || v > 1024)
+            return fail(r, "threads %g: must be an integer from 0 (all cores) to 1024", v);
+        sc->threads = (int)v;
+    }
+    return 0;
+}
+
+static int read_directive(reader *r, sc_scene *sc)
+{
+    static const char *const shapes[] = {[SC_PLANE] = "plane", [SC_SPHERE] = "sphere",
+                                         [SC_CAP] = "cap", [SC_CONIC] = "conic",
+                                         [SC_ASPHERE] = "asphere", [SC_MESH] = "mesh"};
+    static const char *const settings[] = {"depth", "cutoff", "threads", "escape", "fresnel",
+                                           "reflections", "output", NULL};
+    const tok *d = &r->t[0];
+    for (int i = 0; i < 6; i++)
+        if (tok_is(d, shapes[i])) return read_surface(r, sc, shapes[i], i);
+    if (tok_is(d, "source")) return read_source(r, sc);
+    for (int i = 0; settings[i]; i++)
+        if (tok_is(d, settings[i])) return read_setting(r, sc);
+    return fail(r, "unknown directive '%.*s' (plane, sphere, cap, conic, asphere, mesh, "
+                "source, depth, cutoff, threads, escape, fresnel, reflections, output)",
+                (int)(d->n < 24 ? d->n : 24), d->s);
+}
+
+static void scene_defaults(sc_scene *sc)
+{
+    memset(sc, 0, sizeof *sc);
+    sc->depth = 16;
+    sc->cutoff = 1e-6;
+    sc->fresnel = sc->reflections = 1;
+    sc->escape = 1;
+}
+
+int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
+                   char *err)
+{
+    reader r;
+    int st;
+
+    scene_defaults(sc);
+    reader_init(&r, text, len, name, err);
+    if (!(sc->name = malloc(strlen(name) + 1))) return -1;
+    strcpy(sc->name, name);
+    r.name = sc->name;
+    while ((st = next_line(&r)) > 0)
+        if (read_directive(&r, sc)) goto bad;
+    if (st < 0) goto bad;
+    if (!sc->nsurf) { fail(&r, "the scene has no surface"); goto bad; }
+    if (!sc->nsource) { fail(&r, "the scene has no source of rays"); goto bad; }
+    return 0;
+bad:
+    sc_free(sc);
+    return -1;
+}
+
+void sc_free(sc_scene *sc)
+{
+    for (int i = 0; i < sc->nsurf; i++) {
+        free(sc->surf[i].tri);
+        free(sc->surf[i].media);
+        free(sc->surf[i].mesh_file);
+        free(sc->surf[i].media_file);
+    }
+    free(sc->surf);
+    free(sc->source);
+    free(sc->out_segments);
+    free(sc->out_hits);
+    free(sc->out_summary);
+    free(sc->name);
+    free(sc->dir);
+    memset(sc, 0, sizeof *sc);
+}
+
+/* ---- files -------------------------------------------------------------------- */
+
+/* Read a whole file into a malloc'd buffer. */
+static char *slurp(const char *path, size_t *len, char *err)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    size_t cap = 0, n = 0;
+    if (!f) {
+        snprintf(err, SC_ERRMAX, "%s: cannot open: %s", path, strerror(errno));
+        return NULL;
+    }
+    for (;;) {
+        size_t got;
+        if (n == cap) {
+            char *b;
+            cap = cap ? cap * 2 : 65536;
+            if (cap > ((size_t)1 << 32) || !(b = realloc(buf, cap))) {
+                snprintf(err, SC_ERRMAX, "%s: too large or out of memory", path);
+                free(buf);
+                fclose(f);
+                return NULL;
+            }
+            buf = b;
+        }
+        got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0) break;
+    }
+    if (ferror(f)) {
+        snprintf(err, SC_ERRMAX, "%s: read error", path);
+        free(buf);
+        fclose(f);
+        return NULL;
+    }
+    fclose(f);
+    *len = n;
+    return buf;
+}
+
+/* dir/name unless name is absolute. */
+static char *join(const char *dir, const char *name)
+{
+    size_t a = strlen(dir), b = strlen(name);
+    char *p = malloc(a + b + 2);
+    if (!p) return NULL;
+    if (name[0] == '/' || !a) memcpy(p, name, b + 1);
+    else {
+        memcpy(p, dir, a);
+        p[a] = '/';
+        memcpy(p + a + 1, name, b + 1);
+    }
+    return p;
+}
+
+static int ends_with(const char *s, const char *suf)
+{
+    size_t a = strlen(s), b = strlen(suf);
+    return a >= b && !strcasecmp(s + a - b, suf);
+}
+
+/* Prefix err (a file's own message) with the scene line that named the file. */
+static int from_scene(const sc_surface *s, char *err)
+{
+    char tmp[SC_ERRMAX];
+    snprintf(tmp, sizeof tmp, "%s:%ld: %s", s->src, s->line, err);
+    memcpy(err, tmp, SC_ERRMAX);
+    return -1;
+}
+
+static int load_mesh(const sc_scene *sc, sc_surface *s, char *err)
+{
+    char *path = join(sc->dir, s->mesh_file), *text;
+    size_t len;
+    int rc;
+    if (!path) return snprintf(err, SC_ERRMAX, "out of memory"), -1;
+    if (!(text = slurp(path, &len, err))) { free(path); return from_scene(s, err); }
+    rc = ends_with(path, ".obj") ? sc_parse_obj(text, len, path, &s->tri, &s->ntri, err)
+                                 : sc_parse_triangles(text, len, path, &s->tri, &s->ntri, err);
+    free(text);
+    free(path);
+    if (rc) return from_scene(s, err);
+    if (!s->media_file) return 0;
+    if (!(path = join(sc->dir, s->media_file)))
+        return snprintf(err, SC_ERRMAX, "out of memory"), -1;
+    if (!(text = slurp(path, &len, err))) { free(path); return from_scene(s, err); }
+    rc = sc_parse_media(text, len, path, s->ntri, &s->media, err);
+    free(text);
+    free(path);
+    return rc ? from_scene(s, err) : 0;
+}
+
+int sc_load(const char *path, sc_scene *sc, char *err)
+{
+    size_t len;
+    char *text = slurp(path, &len, err), *slash;
+    if (!text) { scene_defaults(sc); return -1; }
+    if (sc_parse_scene(text, len, path, sc, err)) { free(text); return -1; }
+    free(text);
+    if (!(sc->dir = malloc(strlen(path) + 1))) goto oom;
+    strcpy(sc->dir, path);
+    slash = strrchr(sc->dir, '/');
+    if (slash) *slash = '\0';
+    else sc->dir[0] = '\0';
+    for (int i = 0; i < sc->nsurf; i++) {
+        sc_surface *s = &sc->surf[i];
+        if (s->shape == SC_MESH && load_mesh(sc, s, err)) goto bad;
+        if (s->shape != SC_MESH && s->tessellate &&
+            sc_tessellate(s, s->tessellate, &s->tri, &s->ntri, err)) {
+            from_scene(s, err);
+            goto bad;
+        }
+    }
+    return 0;
+oom:
+    snprintf(err, SC_ERRMAX, "%s: out of memory", path);
+bad:
+    sc_free(sc);
+    return -1;
+}
