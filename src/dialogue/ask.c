@@ -10,6 +10,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 #include <readline/readline.h>
 #include <readline/history.h>
@@ -189,11 +190,13 @@ static int end_of_input(lm_io *io, const char *what)
 /* Check a parsed number against the spec; NULL if fine, else the complaint. */
 static const char *violates(const lm_numspec *spec, enum lm_num_status st, double v)
 {
-    if (st == LM_NUM_PLANE) return (spec->flags & LM_ALLOW_PLANE) ? NULL :
+    if (st == LM_NUM_PLANE)
+        return (spec->flags & (LM_ALLOW_PLANE | LM_ALLOW_INF)) ? NULL :
         "'%s': infinity is allowed only for a radius (a plane surface)";
     if (st != LM_NUM_OK) return NULL;
     if ((spec->flags & LM_POSITIVE) && !(v > 0)) return "'%s' must be greater than 0";
     if ((spec->flags & LM_NONNEG) && v < 0) return "'%s' must not be negative";
+    if ((spec->flags & LM_NONZERO) && v == 0) return "'%s' must not be 0";
     if ((spec->flags & LM_AT_LEAST) && v < spec->min)
         return "'%s' lies left of the previous surface (locations must not decrease)";
     return NULL;
@@ -228,7 +231,9 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
             if (complain(io, spec->what, bad, tok)) return LM_FAIL;
             continue;
         }
-        if (st == LM_NUM_PLANE) snprintf(echo, sizeof echo, "plane");
+        if (st == LM_NUM_PLANE && !(spec->flags & LM_ALLOW_PLANE))
+            snprintf(echo, sizeof echo, "%s", *v < 0 ? "-inf" : "inf");
+        else if (st == LM_NUM_PLANE) snprintf(echo, sizeof echo, "plane");
         else lm_format_echo(*v, echo, sizeof echo);
         if ((spec->flags & LM_ALLOW_PLANE) && *v == 0.0) *v = INFINITY;
         lm_say(io, LM_REC, "input: %s\n", echo);
@@ -253,6 +258,55 @@ int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int
         }
         *yes = c == 'y';
         lm_say(io, LM_REC, "input: %c\n", c);
+        return LM_GO;
+    }
+}
+
+int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
+                  const char *const *choices, int *idx)
+{
+    char tok[LM_TOKEN_MAX];
+    if (rec) lm_say(io, LM_REC, "%s", rec);
+    for (;;) {
+        int r, i;
+        if (out) lm_say(io, LM_OUT, "%s", out);
+        r = next_token(io, tok);
+        if (r == -1) return end_of_input(io, what);
+        for (i = 0; r == 0 && choices[i]; i++)
+            if (!strcasecmp(tok, choices[i])) break;
+        if (r != 0 || !choices[i]) {
+            if (complain(io, what, "'%s' is not one of the choices offered",
+                         r == 0 ? tok : "(too long)"))
+                return LM_FAIL;
+            continue;
+        }
+        *idx = i;
+        lm_say(io, LM_REC, "input: %s\n", choices[i]);
+        return LM_GO;
+    }
+}
+
+int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
+                int (*check)(void *ctx, const char *word, char *msg, size_t cap),
+                void *ctx, char *buf, size_t cap)
+{
+    char tok[LM_TOKEN_MAX], msg[256];
+    if (rec) lm_say(io, LM_REC, "%s", rec);
+    for (;;) {
+        int r;
+        if (out) lm_say(io, LM_OUT, "%s", out);
+        r = next_token(io, tok);
+        if (r == -1) return end_of_input(io, what);
+        if (r == 0 && strlen(tok) >= cap) r = -2;
+        msg[0] = '\0';
+        if (r == 0 && check && check(ctx, tok, msg, sizeof msg)) r = -3;
+        if (r != 0) {
+            if (r == -2) snprintf(msg, sizeof msg, "the answer is too long");
+            if (complain(io, what, "%s", msg)) return LM_FAIL;
+            continue;
+        }
+        memcpy(buf, tok, strlen(tok) + 1);
+        lm_say(io, LM_REC, "input: %s\n", tok);
         return LM_GO;
     }
 }

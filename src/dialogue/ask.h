@@ -41,7 +41,10 @@ enum {
     LM_ALLOW_PLANE = 1,     /* inf / plane / 0 accepted (a plane surface): *v = inf */
     LM_POSITIVE = 2,        /* > 0 */
     LM_NONNEG = 4,          /* >= 0 */
-    LM_AT_LEAST = 8         /* >= spec.min */
+    LM_AT_LEAST = 8,        /* >= spec.min */
+    LM_ALLOW_INF = 16,      /* inf / -inf accepted as such (a distance at infinity);
+                               unlike LM_ALLOW_PLANE, 0 stays 0 */
+    LM_NONZERO = 32         /* != 0 */
 };
 typedef struct lm_numspec {
     const char *what;       /* "the radius of the lens surface", for messages */
@@ -55,6 +58,18 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
                   double *v);
 /* The same for a y/n answer; *yes is 1 or 0. */
 int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int *yes);
+/* The same for one word of `choices` (NULL-terminated, any case accepted); *idx is
+ * its index and the record echoes it as written in `choices`. */
+int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
+                  const char *const *choices, int *idx);
+/* The same for one blank-free word (a file name): copied into buf (cap bytes; longer
+ * answers are refused), echoed as "input: WORD".  check (may be NULL) returns 0 to
+ * accept, else writes why into msg: the answer is then handled like a bad number
+ * (terminal: message and ask again; replay: SRC:LINE message, LM_FAIL) and is not
+ * echoed, so a record never holds a rejected answer. */
+int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
+                int (*check)(void *ctx, const char *word, char *msg, size_t cap),
+                void *ctx, char *buf, size_t cap);
 /* After the last question: warn about answers left unread (replay only). */
 void lm_check_leftover(lm_io *io);
 
