@@ -8,5 +8,7 @@ int lm_classic(lm_io *io);
 const char *lm_classic_usage(void);
 const char *lm_classic_usage_more(void);
 const char *lm_classic_example(void);
+int lm_trace(lm_io *io);
+const char *lm_trace_example(void);
 
 #endif

@@ -22,6 +22,8 @@ typedef struct dialogue {
 static const dialogue dialogues[] = {
     {"--classic", "the original lens-entry dialogue (the default)", lm_classic,
      lm_classic_example},
+    {"--trace", "ray tracing: scene files, a lens's real fan, tessellation table", lm_trace,
+     lm_trace_example},
 };
 #define NDIALOGUES (sizeof dialogues / sizeof dialogues[0])
 

@@ -8,6 +8,7 @@
 #ifndef SCENE_H
 #define SCENE_H
 #include <stddef.h>
+#include "trace.h"
 
 enum sc_shape { SC_PLANE, SC_SPHERE, SC_CAP, SC_CONIC, SC_ASPHERE, SC_MESH };
 enum sc_kind { SC_REFRACT, SC_MIRROR, SC_ABSORB, SC_DETECT, SC_MEDIA };
@@ -113,5 +114,56 @@ void sc_point_rays(const sc_source *s, sc_ray *out);
  * (hexapolar rings, vertices on the surface), rectangles into 2 level^2, spheres
  * into 4 level (level - 1) (level >= 2).  Oriented as the surface's normal. */
 int  sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, char *err);
+
+/* ---- running (inside the module: needs the engine) ----------------------------- */
+
+/* What a run did.  Outputs named in the scene are written as FILE.part and renamed
+ * when complete; after a failure they stay .part and err says so. */
+typedef struct sc_result {
+    trace_summary sum;
+    int progress_shown;       /* a progress line was drawn on stderr */
+} sc_result;
+
+/* The error-against-run-time table: a spherical singlet modelled analytically and as
+ * meshes of increasing tessellation, with and without analytic refinement, the same
+ * collimated bundle traced to a detector plane, one row per model. */
+typedef struct sc_tess_spec {
+    double r1, r2, thickness, n, aperture;   /* the lens, first vertex at z = 0 */
+    double z_detector;                       /* detector plane (the paraxial focus) */
+    double beam_radius;                      /* collimated along +z from z = -1 */
+    long grid;                               /* grid x grid rays */
+    int nlevels;
+    const int *levels;                       /* tessellation levels (rings per cap) */
+    int threads;
+} sc_tess_spec;
+
+enum sc_model { SC_MODEL_ANALYTIC, SC_MODEL_MESH, SC_MODEL_MESH_NORMAL, SC_MODEL_MESH_FULL };
+typedef struct sc_tess_row {
+    int model, level;
+    long triangles;
+    double build_ms, trace_ms, rays_per_s;
+    double err_max, err_rms;                 /* detector position error (lens units) */
+    long rays, lost;                         /* rays compared; rays that missed one
+                                                trace but not the other */
+} sc_tess_row;
+
+/* Fill rows[0 .. 1 + 3 nlevels): the analytic model, then per level the mesh
+ * without refinement, with analytic normals, with full re-intersection. */
+int sc_tess_table(const sc_tess_spec *spec, sc_tess_row *rows, char *err);
+
+#define SC_API_ABI 1
+#define SC_API_SYMBOL "lm_scene_api"
+typedef struct scene_api {
+    int abi;
+    int  (*load)(const char *path, sc_scene *sc, char *err);
+    void (*free)(sc_scene *sc);
+    /* Trace the scene, write its outputs; progress on stderr when it is a terminal
+     * and the trace runs over a second.  0 or -1 (err set). */
+    int  (*run)(const sc_scene *sc, sc_result *res, char *err);
+    int  (*tess_table)(const sc_tess_spec *spec, sc_tess_row *rows, char *err);
+    const trace_api *engine;
+} scene_api;
+typedef const scene_api *(*scene_api_fn)(int abi);
+const scene_api *lm_scene_api(int abi);
 
 #endif

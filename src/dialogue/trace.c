@@ -1,0 +1,371 @@
+/* trace.c -- the ray-tracing dialogue (lensmat --trace): trace a scene file and
+ * report what it did; enter a lens surface by surface (as the classic dialogue) and
+ * trace a fan from an object point for real, against the paraxial image; or the
+ * error-against-run-time table of tessellated lenses.  Texts: prompts/trace.txt.
+ * The trace module (Embree) is loaded on the first trace only, through
+ * lm_engine_symbol: the paraxial part of a session never loads it. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "ask.h"
+#include "dialogues.h"
+#include "engine.h"
+#include "../paraxial/paraxial.h"
+#include "../trace/scene.h"
+#include "prompts_trace.h"
+
+#define P(k) trace_prompts[TRACE_##k]
+#define MAXSURF 200
+#define FAN 10          /* rays of a fan: heights (i/FAN) h_max, plus one near the axis */
+#define NEAR_AXIS 1e-6  /* the near-axis ray's height, relative to h_max */
+#define WORD 4096
+
+typedef struct tdlg {
+    lm_io *io;
+    const scene_api *api;      /* NULL until the first trace */
+    sc_scene scene;            /* the scene accepted by the last file question */
+    int have_scene;
+} tdlg;
+
+typedef unsigned long long ull;
+
+/* The module, loaded on first use.  0, or -1 (why printed by lm_engine_symbol). */
+static int need_engine(tdlg *t)
+{
+    scene_api_fn get;
+    if (t->api) return 0;
+    get = (scene_api_fn)lm_engine_symbol("trace", SC_API_SYMBOL);
+    if (get) t->api = get(SC_API_ABI);
+    if (!t->api) {
+        if (get) fprintf(stderr, "lensmat: the trace module's interface does not match\n");
+        return -1;
+    }
+    return 0;
+}
+
+static int ask_num(tdlg *t, const char *q, const char *what, unsigned flags, double min,
+                   double *v)
+{
+    lm_numspec spec = {what, flags, min};
+    return lm_ask_number(t->io, q, q, &spec, v);
+}
+
+/* ---- scene files ------------------------------------------------------------------ */
+
+/* The file question's check: the scene must load (its messages name file and line). */
+static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
+{
+    tdlg *t = ctx;
+    char err[SC_ERRMAX];
+    if (t->have_scene) t->api->free(&t->scene);
+    t->have_scene = 0;
+    if (t->api->load(word, &t->scene, err)) {
+        snprintf(msg, cap, "%s", err);
+        return -1;
+    }
+    t->have_scene = 1;
+    return 0;
+}
+
+static void report_outputs(tdlg *t)
+{
+    const sc_scene *sc = &t->scene;
+    if (sc->out_segments) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_segments, P(WRITTEN_SEGMENTS));
+    if (sc->out_hits) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_hits, P(WRITTEN_HITS));
+    if (sc->out_summary) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_summary, P(WRITTEN_SUMMARY));
+}
+
+static void report_summary(tdlg *t, const trace_summary *s)
+{
+    lm_io *io = t->io;
+    double bal = s->emitted - (s->detected + s->absorbed + s->escaped + s->cutoff);
+    lm_say(io, LM_BOTH, P(RAYS), (ull)s->rays, (ull)s->segments, (ull)s->interactions,
+           (ull)s->tir);
+    lm_say(io, LM_BOTH, P(HITS), (ull)s->hits);
+    lm_say(io, LM_BOTH, P(POWER), s->emitted, s->detected, s->absorbed, s->escaped, s->cutoff);
+    lm_say(io, LM_BOTH, P(BALANCE), lm_clean(io, bal));
+    lm_say(io, LM_BOTH, P(CUTS), (ull)s->cut_depth, (ull)s->cut_power,
+           (ull)s->cut_reflection);
+    if (s->failures) lm_say(io, LM_BOTH, P(WARN_FAILURES), (ull)s->failures);
+    if (s->medium_mismatch) lm_say(io, LM_BOTH, P(WARN_MISMATCH), (ull)s->medium_mismatch);
+    if (fabs(bal) > 1e-9 * (s->emitted > 1 ? s->emitted : 1))
+        lm_say(io, LM_BOTH, P(WARN_BALANCE), bal);
+    lm_say(io, LM_OUT, P(TIMING_OUT), s->build_ms, s->trace_ms,
+           s->trace_ms > 0 ? (double)s->rays / (s->trace_ms / 1e3) : 0.0);
+}
+
+/* Returns LM_GO, LM_QUIT or LM_FAIL (a trace that fails is an error in a replay). */
+static int do_scene(tdlg *t)
+{
+    char name[WORD], err[SC_ERRMAX];
+    sc_result res;
+    const sc_scene *sc = &t->scene;
+    int rc;
+
+    if (need_engine(t)) return LM_FAIL;
+    if ((rc = lm_ask_word(t->io, P(SCENE_FILE), P(SCENE_FILE), P(SCENE_FILE_WHAT),
+                          check_scene, t, name, sizeof name)))
+        return rc;
+    lm_say(t->io, LM_BOTH, P(SCENE_LOADED), sc->name, sc->nsurf, sc->nsource, sc->depth,
+           sc->cutoff);
+    rc = t->api->run(sc, &res, err);
+    if (rc) {
+        lm_say(t->io, LM_REC, P(TRACE_FAILED_OUT), err);
+        fprintf(stderr, "lensmat: %s\n", err);
+        if (!t->io->interactive) return LM_FAIL;
+        return LM_GO;
+    }
+    report_summary(t, &res.sum);
+    report_outputs(t);
+    return LM_GO;
+}
+
+/* ---- a lens entered surface by surface ---------------------------------------------- */
+
+typedef struct lens {
+    px_system sys;
+    trace_lens_surface surf[MAXSURF];
+    trace_lens tl;
+} lens;
+
+static int enter_surface(tdlg *t, lens *l)
+{
+    lm_io *io = t->io;
+    trace_lens_surface *s = &l->surf[l->tl.nsurf];
+    int rc;
+    if ((rc = ask_num(t, P(RADIUS), P(RADIUS_WHAT), LM_ALLOW_PLANE, 0, &s->radius)) ||
+        (rc = ask_num(t, P(LOCATION), P(LOCATION_WHAT), l->tl.nsurf ? LM_AT_LEAST : 0,
+                      l->sys.z_last, &s->z)) ||
+        (rc = ask_num(t, P(INDEX_RIGHT), P(INDEX_RIGHT_WHAT), LM_POSITIVE, 0, &s->n_right)) ||
+        (rc = ask_num(t, P(SEMI), P(SEMI_WHAT), LM_POSITIVE, 0, &s->semi_diameter)))
+        return rc;
+    l->tl.nsurf++;
+    if (isinf(s->radius))
+        lm_say(io, LM_BOTH, P(SURFACE_ECHO_PLANE), l->tl.nsurf, s->z, s->n_right,
+               s->semi_diameter);
+    else
+        lm_say(io, LM_BOTH, P(SURFACE_ECHO), l->tl.nsurf, s->radius, s->z, s->n_right,
+               s->semi_diameter);
+    px_system_translate(&l->sys, s->z);
+    px_system_refract(&l->sys, s->radius, s->n_right);
+    return LM_GO;
+}
+
+/* A fraction in (0, 1], asked as a word so that a bad answer is refused before it is
+ * echoed. */
+static int check_fraction(void *ctx, const char *word, char *msg, size_t cap)
+{
+    double v;
+    (void)ctx;
+    if (lm_parse_number(word, &v) != LM_NUM_OK || !(v > 0 && v <= 1)) {
+        snprintf(msg, cap, "'%s': give a number greater than 0 and at most 1", word);
+        return -1;
+    }
+    return 0;
+}
+
+/* Paraxial image of the object (z_obj = -inf: at infinity).  0, or -1 at infinity. */
+static int paraxial_image(const lens *l, double z_obj, double *z_img)
+{
+    px_image im;
+    px_cardinal k;
+    if (isinf(z_obj)) {
+        px_cardinal_points(&l->sys, 0, &k);
+        *z_img = k.focal2;
+        return 0;
+    }
+    if (px_image_plane(&l->sys, z_obj, &im) == PX_AT_INFINITY) return -1;
+    *z_img = im.z_img;
+    return 0;
+}
+
+static void report_fan(tdlg *t, const double *h, const trace_fan_ray *r, int n, double z_img,
+                       const lens *l)
+{
+    lm_io *io = t->io;
+    lm_say(io, LM_BOTH, P(FAN_HEAD));
+    for (int i = 0; i < n; i++) {
+        const char *why = r[i].status == 1 ? P(FAN_VIGNETTED) : r[i].status == 2 ? P(FAN_TIR)
+                        : P(FAN_PARALLEL);
+        if (r[i].status) lm_say(io, LM_BOTH, P(FAN_MISS), h[i], why);
+        else lm_say(io, LM_BOTH, P(FAN_ROW), h[i], r[i].z_cross, lm_clean(io, r[i].lsa),
+                    lm_clean(io, r[i].y_image));
+    }
+    if (!r[0].status) {
+        double scale = fabs(z_img - l->sys.z_last);
+        lm_say(io, LM_BOTH, P(FAN_AGREE), h[0], fabs(r[0].lsa) / (scale > 0 ? scale : 1));
+    }
+}
+
+static int trace_object(tdlg *t, lens *l)
+{
+    lm_io *io = t->io;
+    double d, z_obj, z_img, frac, h[FAN + 1];
+    trace_fan_ray out[FAN + 1];
+    char word[64], err[SC_ERRMAX];
+    int rc;
+
+    if ((rc = ask_num(t, P(OBJECT), P(OBJECT_WHAT), LM_POSITIVE | LM_ALLOW_INF, 0, &d)) ||
+        (rc = lm_ask_word(io, P(HEIGHT), P(HEIGHT), P(HEIGHT_WHAT), check_fraction, NULL,
+                          word, sizeof word)))
+        return rc;
+    lm_parse_number(word, &frac);
+    z_obj = isinf(d) ? -INFINITY : l->sys.z_first - d;
+    if (isinf(z_obj)) lm_say(io, LM_BOTH, P(OBJECT_ECHO_INF));
+    else lm_say(io, LM_BOTH, P(OBJECT_ECHO), z_obj);
+    if (paraxial_image(l, z_obj, &z_img)) {
+        lm_say(io, LM_BOTH, P(PARAXIAL_INFINITY));
+        return LM_GO;
+    }
+    lm_say(io, LM_BOTH, P(PARAXIAL), lm_clean(io, z_img));
+    h[0] = NEAR_AXIS * frac * l->surf[0].semi_diameter;
+    for (int i = 1; i <= FAN; i++) h[i] = frac * l->surf[0].semi_diameter * i / FAN;
+    if (need_engine(t)) return LM_FAIL;
+    l->tl.surf = l->surf;
+    l->tl.mounts = 1;
+    l->tl.z_detector = NAN;
+    if (t->api->engine->lens_fan(&l->tl, z_obj, 0, z_img, FAN + 1, h, out, err,
+                                 sizeof err)) {
+        lm_say(io, LM_BOTH, P(LENS_FAILED), err);
+        return io->interactive ? LM_GO : LM_FAIL;
+    }
+    report_fan(t, h, out, FAN + 1, z_img, l);
+    return LM_GO;
+}
+
+static int do_lens(tdlg *t)
+{
+    lm_io *io = t->io;
+    lens *l = calloc(1, sizeof *l);
+    int rc, more;
+
+    if (!l) return LM_FAIL;
+    if ((rc = ask_num(t, P(INDEX_LEFT), P(INDEX_LEFT_WHAT), LM_POSITIVE, 0, &l->tl.n_object)))
+        goto out;
+    px_system_init(&l->sys, l->tl.n_object);
+    do {
+        if ((rc = enter_surface(t, l))) goto out;
+        if (l->tl.nsurf == MAXSURF) break;
+        if ((rc = lm_ask_yn(io, P(ANOTHER_SURFACE), P(ANOTHER_SURFACE),
+                            P(ANOTHER_SURFACE_WHAT), &more)))
+            goto out;
+    } while (more);
+    if (px_is_afocal(&l->sys)) {
+        lm_say(io, LM_BOTH, P(AFOCAL));
+        goto out;
+    }
+    do {
+        if ((rc = trace_object(t, l))) goto out;
+        if ((rc = lm_ask_yn(io, P(ANOTHER_OBJECT), P(ANOTHER_OBJECT),
+                            P(ANOTHER_OBJECT_WHAT), &more)))
+            goto out;
+    } while (more);
+out:
+    free(l);
+    return rc;
+}
+
+/* ---- the error-against-run-time table ------------------------------------------------ */
+
+static int check_grid(void *ctx, const char *word, char *msg, size_t cap)
+{
+    double v;
+    (void)ctx;
+    if (lm_parse_number(word, &v) != LM_NUM_OK || v != floor(v) || v < 1 || v > 2000) {
+        snprintf(msg, cap, "'%s': give a whole number from 1 to 2000", word);
+        return -1;
+    }
+    return 0;
+}
+
+static void table_rows(tdlg *t, const sc_tess_row *rows, int n)
+{
+    lm_io *io = t->io;
+    lm_say(io, LM_OUT, "%s", P(T_HEAD_OUT));
+    lm_say(io, LM_REC, "%s", P(T_HEAD_REC));
+    for (int i = 0; i < n; i++) {
+        const sc_tess_row *r = &rows[i];
+        char name[64];
+        const char *fmt = r->model == SC_MODEL_ANALYTIC ? P(T_ANALYTIC)
+                        : r->model == SC_MODEL_MESH ? P(T_MESH)
+                        : r->model == SC_MODEL_MESH_NORMAL ? P(T_MESH_NORMAL) : P(T_MESH_FULL);
+        snprintf(name, sizeof name, fmt, r->level);
+        lm_say(io, LM_OUT, P(T_ROW_OUT), name, r->triangles, r->build_ms, r->trace_ms,
+               r->rays_per_s, r->err_max, r->err_rms, r->lost);
+        lm_say(io, LM_REC, P(T_ROW_REC), name, r->triangles, r->err_max, r->err_rms, r->lost);
+    }
+}
+
+static int tess_table(tdlg *t)
+{
+    static const int levels[] = {4, 8, 16, 32, 64, 128};
+    enum { NL = sizeof levels / sizeof levels[0] };
+    lm_io *io = t->io;
+    sc_tess_spec sp = {0};
+    sc_tess_row rows[1 + 3 * NL];
+    lens l;
+    char word[64], err[SC_ERRMAX];
+    double g;
+    int rc;
+
+    lm_say(io, LM_BOTH, "%s", P(TABLE_INTRO));
+    if ((rc = ask_num(t, P(T_R1), P(T_R1_WHAT), LM_ALLOW_PLANE, 0, &sp.r1)) ||
+        (rc = ask_num(t, P(T_R2), P(T_R2_WHAT), LM_ALLOW_PLANE, 0, &sp.r2)) ||
+        (rc = ask_num(t, P(T_THICK), P(T_THICK_WHAT), LM_POSITIVE, 0, &sp.thickness)) ||
+        (rc = ask_num(t, P(T_INDEX), P(T_INDEX_WHAT), LM_POSITIVE, 0, &sp.n)) ||
+        (rc = ask_num(t, P(T_SEMI), P(T_SEMI_WHAT), LM_POSITIVE, 0, &sp.aperture)) ||
+        (rc = lm_ask_word(io, P(T_GRID), P(T_GRID), P(T_GRID_WHAT), check_grid, NULL, word,
+                          sizeof word)))
+        return rc;
+    lm_parse_number(word, &g);
+    sp.grid = (long)g;
+    /* the paraxial focus, from the paraxial engine */
+    px_system_init(&l.sys, 1);
+    px_system_translate(&l.sys, 0);
+    px_system_refract(&l.sys, sp.r1, sp.n);
+    px_system_translate(&l.sys, sp.thickness);
+    px_system_refract(&l.sys, sp.r2, 1);
+    if (px_is_afocal(&l.sys)) {
+        lm_say(io, LM_BOTH, "%s", P(T_NO_FOCUS));
+        return LM_GO;
+    }
+    paraxial_image(&l, -INFINITY, &sp.z_detector);
+    sp.beam_radius = 0.9 * sp.aperture;
+    sp.levels = levels;
+    sp.nlevels = NL;
+    sp.r1 = isinf(sp.r1) ? 0 : sp.r1;
+    sp.r2 = isinf(sp.r2) ? 0 : sp.r2;
+    lm_say(io, LM_BOTH, P(T_LENS), sp.r1, sp.r2, sp.thickness, sp.n, sp.aperture,
+           sp.z_detector, sp.beam_radius, sp.grid, sp.grid);
+    if (need_engine(t)) return LM_FAIL;
+    if (t->api->tess_table(&sp, rows, err)) {
+        lm_say(io, LM_BOTH, P(T_FAILED), err);
+        return io->interactive ? LM_GO : LM_FAIL;
+    }
+    table_rows(t, rows, 1 + 3 * NL);
+    return LM_GO;
+}
+
+/* ---- the dialogue ------------------------------------------------------------------- */
+
+int lm_trace(lm_io *io)
+{
+    static const char *const modes[] = {"scene", "lens", "table", NULL};
+    tdlg t = {io, NULL, {0}, 0};
+    int rc, mode, more;
+
+    lm_say(io, LM_BOTH, "%s", P(INTRO));
+    do {
+        if ((rc = lm_ask_choice(io, P(MODE), P(MODE), P(MODE_WHAT), modes, &mode))) break;
+        rc = mode == 0 ? do_scene(&t) : mode == 1 ? do_lens(&t) : tess_table(&t);
+        if (rc) break;
+        rc = lm_ask_yn(io, P(ANOTHER), P(ANOTHER), P(ANOTHER_WHAT), &more);
+    } while (!rc && more);
+    if (t.have_scene) t.api->free(&t.scene);
+    if (rc) return rc;
+    lm_check_leftover(io);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    return LM_GO;
+}
+
+const char *lm_trace_example(void) { return P(EXAMPLE); }
