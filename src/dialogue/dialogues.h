@@ -11,4 +11,16 @@ const char *lm_classic_example(void);
 int lm_trace(lm_io *io);
 const char *lm_trace_example(void);
 
+/* The calculation dialogues (lenscalc.c, instrcalc.c, fitcalc.c) and prescription
+ * files (prescription.c); each has its embedded example. */
+int lm_thick(lm_io *io);       const char *lm_thick_example(void);
+int lm_thin(lm_io *io);        const char *lm_thin_example(void);
+int lm_gauss(lm_io *io);       const char *lm_gauss_example(void);
+int lm_pair(lm_io *io);        const char *lm_pair_example(void);
+int lm_magnifier(lm_io *io);   const char *lm_magnifier_example(void);
+int lm_microscope(lm_io *io);  const char *lm_microscope_example(void);
+int lm_telescope(lm_io *io);   const char *lm_telescope_example(void);
+int lm_vision(lm_io *io);      const char *lm_vision_example(void);
+int lm_cornea(lm_io *io);      const char *lm_cornea_example(void);
+
 #endif

@@ -1,0 +1,25 @@
+/* calcio.h -- what the calculation dialogues (thick, thin, gauss, pair, magnifier,
+ * microscope, telescope, fit, vision, cornea) share: the length unit, asking with
+ * the question echoed to stdout and the record, and printing powers in diopters. */
+#ifndef CALCIO_H
+#define CALCIO_H
+#include "ask.h"
+#include "../paraxial/paraxial.h"
+
+typedef struct calc {
+    lm_io *io;
+    px_unit unit;
+    const char *uname;          /* "mm", "cm", "m" */
+} calc;
+
+int  calc_unit(calc *c);                                  /* asks mm, cm or m */
+int  calc_num(calc *c, const char *q, const char *what, unsigned flags, double *v);
+int  calc_yn(calc *c, const char *q, const char *what, int *yes);
+int  calc_choice(calc *c, const char *q, const char *what, const char *const *choices,
+                 int *idx);
+void calc_say(calc *c, const char *fmt, ...);             /* stdout and record */
+void calc_power(calc *c, const char *label, double power); /* power in 1/unit */
+void calc_matrix(calc *c, px_mat m);                      /* and its determinant */
+int  calc_done(calc *c);                                  /* end of a dialogue */
+
+#endif
