@@ -24,6 +24,18 @@ static const dialogue dialogues[] = {
      lm_classic_example},
     {"--trace", "ray tracing: scene files, a lens's real fan, tessellation table", lm_trace,
      lm_trace_example},
+    {"--thick", "thick lens: R1, R2, t, n, any media (sections 8-10, 21)", lm_thick, lm_thick_example},
+    {"--thin", "thin lens equation: f, do, di from the other two (57)", lm_thin, lm_thin_example},
+    {"--gauss", "Gauss's formula, one refracting surface (section 4)", lm_gauss, lm_gauss_example},
+    {"--pair", "two thin lenses t apart (section 56)", lm_pair, lm_pair_example},
+    {"--magnifier", "simple magnifier (sections 31.7-31.8)", lm_magnifier, lm_magnifier_example},
+    {"--microscope", "single-lens and compound microscopes (31.9-31.10, 58)", lm_microscope, lm_microscope_example},
+    {"--telescope", "astronomical, terrestrial, Galileo telescopes (31.11-31.13)", lm_telescope, lm_telescope_example},
+    {"--vision", "spectacle power for a near or far point (41, 57)", lm_vision, lm_vision_example},
+    {"--cornea", "corneal radius <-> power, measuring accuracy (section 37)", lm_cornea, lm_cornea_example},
+    {"--fit", "lens matrix from measurements (lsq), cardinal or nodal points (14, 24, 26)", lm_fit, lm_fit_example},
+    {"--prescription", "run the classic dialogue from a prescription file (-i FILE)", lm_prescription, lm_prescription_example},
+    {"--to-prescription", "write a classic record or answers (-i FILE) as a prescription", lm_to_prescription, lm_to_prescription_example},
 };
 #define NDIALOGUES (sizeof dialogues / sizeof dialogues[0])
 
