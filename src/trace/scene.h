@@ -36,6 +36,7 @@ typedef struct sc_surface {
     double coef[SC_MAXCOEF];
     int ncoef;
     double aperture;      /* disc / semi-diameter; 0 with rect[] set: a rectangle */
+    double hole;          /* plane disc: radius of a central hole (an annulus), or 0 */
     double rect[2];       /* rectangle width (along up x axis) and height (along up) */
     int tessellate;       /* >0: replace the analytic surface by a mesh of that level */
     int refine;           /* mesh: refine hits to the underlying analytic surface */

@@ -8,34 +8,36 @@
 #include <string.h>
 #include "scene.h"
 
+#ifndef PI
 #define PI 3.14159265358979323846
+#endif
 
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static void cross3(const double *a, const double *b, double *c)
+static double g_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void g_cross(const double *a, const double *b, double *c)
 {
     c[0] = a[1] * b[2] - a[2] * b[1];
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
-static int normalize(double *v)
+static int g_unit(double *v)
 {
-    double m = sqrt(dot3(v, v));
+    double m = sqrt(g_dot(v, v));
     if (!(m > 0) || !isfinite(m)) return -1;
     v[0] /= m; v[1] /= m; v[2] /= m;
     return 0;
 }
 
-/* A unit vector perpendicular to unit d: the axis least aligned with d, projected. */
-static void perpendicular(const double *d, double *u)
+/* A unit vector g_perp to unit d: the axis least aligned with d, projected. */
+static void g_perp(const double *d, double *u)
 {
     double m;
     int k = fabs(d[0]) < fabs(d[1]) ? (fabs(d[0]) < fabs(d[2]) ? 0 : 2)
                                     : (fabs(d[1]) < fabs(d[2]) ? 1 : 2);
     u[0] = u[1] = u[2] = 0;
     u[k] = 1;
-    m = dot3(u, d);
+    m = g_dot(u, d);
     for (int i = 0; i < 3; i++) u[i] -= m * d[i];
-    normalize(u);
+    g_unit(u);
 }
 
 long sc_point_count(const sc_source *s) { return 1 + 3L * s->rings * (s->rings + 1); }
@@ -45,9 +47,9 @@ void sc_point_rays(const sc_source *s, sc_ray *out)
     double d[3], u[3], v[3];
     long n = sc_point_count(s), i = 0;
     for (int k = 0; k < 3; k++) d[k] = s->toward[k] - s->from[k];
-    normalize(d);
-    perpendicular(d, u);
-    cross3(d, u, v);
+    g_unit(d);
+    g_perp(d, u);
+    g_cross(d, u, v);
     for (int r = 0; r <= s->rings; r++)
         for (int j = 0; j < (r ? 6 * r : 1); j++, i++) {
             double rho = s->rings ? s->radius * r / s->rings : 0;
@@ -56,7 +58,7 @@ void sc_point_rays(const sc_source *s, sc_ray *out)
             for (int k = 0; k < 3; k++)
                 out[i].d[k] = s->toward[k] - s->from[k] +
                               rho * (cos(phi) * u[k] + sin(phi) * v[k]);
-            normalize(out[i].d);
+            g_unit(out[i].d);
             out[i].power = s->power / (double)n;
         }
 }
@@ -106,8 +108,8 @@ static void axial_point(const sc_surface *f, const double *u, const double *v, d
 static int tess_axial(const sc_surface *f, int level, mesh *m)
 {
     double u[3], v[3], a = f->aperture;
-    perpendicular(f->axis, u);
-    cross3(u, f->axis, v);
+    g_perp(f->axis, u);
+    g_cross(u, f->axis, v);
     for (int k = 1; k <= level; k++) {
         long nin = k == 1 ? 1 : 6L * (k - 1), nout = 6L * k, i = 0, j = 0;
         double rin = a * (k - 1) / level, rout = a * k / level;
@@ -134,7 +136,7 @@ static int tess_rect(const sc_surface *f, int level, mesh *m)
 {
     double v[3], u[3];
     memcpy(v, f->up, sizeof v);
-    cross3(f->axis, v, u);       /* u x v = -axis: normals toward the n1 side */
+    g_cross(f->axis, v, u);       /* u x v = -axis: normals toward the n1 side */
     for (int i = 0; i < level; i++)
         for (int j = 0; j < level; j++) {
             double c[4][3];
@@ -158,8 +160,8 @@ static int put_outward(mesh *m, const double *a, const double *b, const double *
         e2[k] = c[k] - a[k];
         mid[k] = (a[k] + b[k] + c[k]) / 3 - centre[k];
     }
-    cross3(e1, e2, n);
-    return dot3(n, mid) >= 0 ? put(m, a, b, c) : put(m, a, c, b);
+    g_cross(e1, e2, n);
+    return g_dot(n, mid) >= 0 ? put(m, a, b, c) : put(m, a, c, b);
 }
 
 /* Latitude bands x 2 level longitudes; the bands at the poles are fans. */

@@ -168,7 +168,8 @@ static const char *bad_triangle(const double *t)
     sub3(t + 6, t + 3, e3);
     cross3(e1, e2, c);
     l2 = fmax(dot3(e1, e1), fmax(dot3(e2, e2), dot3(e3, e3)));
-    if (l2 == 0) return "is degenerate (its three vertices coincide)";
+    if (l2 == 0) return "is degenerate (its vertices coincide, or its edges are too short "
+                        "to measure)";
     /* twice the area against the longest edge squared: ~ the smallest angle */
     if (sqrt(dot3(c, c)) <= 1e-12 * l2) return "has zero area (collinear vertices)";
     return NULL;
@@ -281,11 +282,11 @@ static int obj_index(reader *r, const tok *t, long nv, long *idx)
     if (slash) head.n = (size_t)(slash - t->s);
     if (!head.n) return fail(r, "face: a vertex reference without a number");
     if (tok_num(r, &head, "face vertex index", &v)) return -1;
+    double given = v;
     if (v != floor(v)) return fail(r, "face: vertex index %g is not an integer", v);
     if (v < 0) v += (double)nv + 1;
     if (v < 1 || v > (double)nv)
-        return fail(r, "face: vertex %.0f does not exist (%ld vertices so far)",
-                    v < 1 ? v - (double)nv - 1 : v, nv);
+        return fail(r, "face: vertex %.0f does not exist (%ld vertices so far)", given, nv);
     *idx = (long)v - 1;
     return 0;
 }
@@ -362,7 +363,7 @@ enum { ARGS_WORD = -1, ARGS_VAR = -2 };
 typedef struct keydef { const char *name; int nargs; } keydef;
 static const keydef keys[] = {
     {"refract", 2}, {"mirror", 0}, {"absorb", 0}, {"detect", 0}, {"media", ARGS_WORD},
-    {"at", 3}, {"normal", 3}, {"disc", 1}, {"rect", 2}, {"up", 3},
+    {"at", 3}, {"normal", 3}, {"disc", 1}, {"hole", 1}, {"rect", 2}, {"up", 3},
     {"center", 3}, {"radius", 1}, {"vertex", 3}, {"axis", 3}, {"conic", 1},
     {"coef", ARGS_VAR}, {"aperture", 1}, {"tessellate", 1}, {"refine", 0},
     {"file", ARGS_WORD}, {"sphere", 4},
@@ -573,7 +574,8 @@ static int axial_check(reader *r, const char *dname, const sc_surface *s)
 static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
 {
     static const char *const allowed[] = {
-        [SC_PLANE] = "refract mirror absorb detect at normal disc rect up tessellate refine",
+        [SC_PLANE] = "refract mirror absorb detect at normal disc hole rect up tessellate "
+                     "refine",
         [SC_SPHERE] = "refract mirror absorb detect center radius tessellate refine",
         [SC_CAP] = "refract mirror absorb detect vertex axis radius aperture tessellate refine",
         [SC_CONIC] = "refract mirror absorb detect vertex axis radius conic aperture "
@@ -616,7 +618,15 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
         if (has(&f, "disc")) {
             s.aperture = val(&f, "disc")[0];
             if (positive(r, dname, "the disc radius", s.aperture)) return -1;
+            if (has(&f, "hole")) {
+                s.hole = val(&f, "hole")[0];
+                if (!(s.hole > 0 && s.hole < s.aperture))
+                    return fail(r, "plane: hole %g must lie between 0 and the disc radius %g",
+                                s.hole, s.aperture);
+                if (s.tessellate) return fail(r, "plane: a disc with a hole cannot be tessellated");
+            }
         } else {
+            if (has(&f, "hole")) return fail(r, "plane: 'hole' goes with 'disc'");
             s.rect[0] = val(&f, "rect")[0];
             s.rect[1] = val(&f, "rect")[1];
             if (positive(r, dname, "the width", s.rect[0]) ||

@@ -49,6 +49,7 @@ static void to_surface(const sc_surface *s, trace_surface *t)
         if (s->aperture > 0) {
             t->aperture = TRACE_AP_DISC;
             t->r_outer = s->aperture;
+            t->r_inner = s->hole;
         } else {
             t->aperture = TRACE_AP_RECT;
             t->width = s->rect[0];

@@ -101,7 +101,8 @@ static int one_model(const trace_api *tr, const sc_tess_spec *sp, int model, int
     det.shape = TRACE_PLANE;
     det.at[2] = sp->z_detector;
     det.axis[2] = 1;
-    det.aperture = TRACE_AP_DISC;   /* r_outer 0: unbounded */
+    det.aperture = TRACE_AP_DISC;
+    det.r_outer = 100 * (sp->aperture + fabs(sp->z_detector));   /* catches every ray */
     if (tr->add_surface(ts, &det, &dm) < 0) goto engine;
     memset(&src, 0, sizeof src);
     src.type = TRACE_SRC_GRID;
