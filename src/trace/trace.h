@@ -163,7 +163,10 @@ typedef struct trace_options {
                               power is cut off (sequential lens work) */
     int threads;           /* 0: all cores */
     double escape_length;  /* length of the segment drawn for an escaping ray (1) */
-    long batch;            /* rays per batch (0: 8192); bounds memory */
+    long batch;            /* rays per batch (0: 8192 with sinks, 65536 without) */
+    int float_hits;        /* 1: take hits as a single-precision tracer computes them
+                              (no double refinement) -- only to measure what double
+                              buys; never for real work (default 0) */
 } trace_options;
 
 /* Records handed to sinks. */

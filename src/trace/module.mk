@@ -1,0 +1,45 @@
+# src/trace/module.mk -- the ray-tracing engine module (Embree 3): build/lib/lensmat-trace.so
+# and its sanitizer twin build/asan/lib/lensmat-trace.so (our code instrumented, Embree
+# not), the engine's own tests (tests/trace/t_*.c, both builds, run by
+# tests/t_60_trace.sh) and benchmark (tests/trace/bench_*.c, scripts/bench_trace.sh).
+# Everything in src/trace/*.c goes into the module; lensmat itself never links Embree.
+
+TRACE_SRC   := $(wildcard src/trace/*.c)
+TRACE_OBJ   := $(patsubst src/%.c,build/obj/%.o,$(TRACE_SRC))
+TRACE_SOBJ  := $(patsubst src/%.c,build/asan/%.o,$(TRACE_SRC))
+TRACE_LIBS  := -lembree3 -lm -pthread
+TRACE_TESTS := $(wildcard tests/trace/t_*.c)
+TRACE_BENCH := $(wildcard tests/trace/bench_*.c)
+TRACE_TBIN  := $(patsubst tests/trace/%.c,build/obj/trace_tests/%,$(TRACE_TESTS)) \
+               $(patsubst tests/trace/%.c,build/asan/trace_tests/%,$(TRACE_TESTS))
+TRACE_BBIN  := $(patsubst tests/trace/%.c,build/obj/trace_tests/%,$(TRACE_BENCH))
+
+# Module objects need -fPIC (the generic rules make position-independent executables).
+build/obj/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -fPIC -pthread -MMD -MP -c $< -o $@
+build/asan/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -fPIC -pthread -MMD -MP -c $< -o $@
+
+build/lib/lensmat-trace.so: $(TRACE_OBJ)
+	@mkdir -p $(@D)
+	$(CC) -shared $(OPT) -o $@ $(TRACE_OBJ) $(TRACE_LIBS)
+build/asan/lib/lensmat-trace.so: $(TRACE_SOBJ)
+	@mkdir -p $(@D)
+	$(CC) -shared $(SAN) -o $@ $(TRACE_SOBJ) $(TRACE_LIBS)
+
+# Engine tests and benches talk to the module through trace.h only (linked to the .so).
+build/obj/trace_tests/%: tests/trace/%.c build/lib/lensmat-trace.so src/trace/trace.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -pthread -Itests -o $@ $< build/lib/lensmat-trace.so \
+	    -Wl,-rpath,$(abspath build/lib) -lembree3 -lm
+build/asan/trace_tests/%: tests/trace/%.c build/asan/lib/lensmat-trace.so src/trace/trace.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -pthread -Itests -o $@ $< build/asan/lib/lensmat-trace.so \
+	    -Wl,-rpath,$(abspath build/asan/lib) -lembree3 -lm
+
+all: build/lib/lensmat-trace.so
+MODULE_TEST_BINS  += build/lib/lensmat-trace.so build/asan/lib/lensmat-trace.so $(TRACE_TBIN)
+MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
+-include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d)

@@ -1,0 +1,946 @@
+/* tr_engine.c -- the trace engine's scene and trace loop on Embree 3, and the
+ * function table the module exports (trace_get_api).  Owns: surfaces (analytic ones
+ * as Embree user geometry, meshes as robust triangle geometry with double copies of
+ * their vertices), the Embree device (created on the first build, never before),
+ * the per-ray recursion with Fresnel s/p bookkeeping, and the batched, thread-count
+ * independent run.  Nothing here prints. */
+#include <embree3/rtcore.h>
+#include <float.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include "tr_int.h"
+
+typedef struct tr_surf {
+    int id, is_mesh;
+    trace_material mat;
+    tr_shape shape;            /* analytic surface, or a mesh's underlying one */
+    int has_under, refine;
+    double *vtx;               /* mesh: nv*3 */
+    uint32_t *idx;             /* mesh: ntri*3 */
+    double *media;             /* mesh: ntri*2 or NULL */
+    long nv, ntri;
+    double eps;                /* mesh: plane distances below this are "here" */
+} tr_surf;
+
+struct trace_scene {
+    char err[512];
+    tr_surf **surf;
+    int nsurf, capsurf;
+    tr_source *src;
+    int nsrc, capsrc;
+    uint64_t nrays;
+    RTCDevice dev;
+    RTCScene scn;
+    int built;
+    double build_ms;
+};
+
+/* The context handed to rtcIntersect1: Embree passes it on to our callbacks. */
+typedef struct tr_ctx {
+    struct RTCIntersectContext ec;   /* must be first */
+    const trace_scene *sc;
+    double o[3], d[3];
+    int last_surf;
+    long last_prim;
+    int float_hits;
+    int best_surf;                   /* nearest analytic hit so far */
+    double best_t, best_n[3];
+} tr_ctx;
+
+typedef struct tr_hitrec {
+    int surf;
+    long prim;
+    double t, n[3];                  /* n: unit normal pointing into the front side */
+} tr_hitrec;
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static int fail(trace_scene *sc, int code, const char *msg)
+{
+    if (sc && msg) {
+        size_t n = strlen(msg);
+        if (n >= sizeof sc->err) n = sizeof sc->err - 1;
+        memmove(sc->err, msg, n);
+        sc->err[n] = '\0';
+    }
+    return code;
+}
+
+int tr_scene_fail(trace_scene *sc, int code, const char *msg)
+{
+    return fail(sc, code, msg);
+}
+
+/* ---------------- scene ---------------- */
+
+static trace_scene *scene_new(void)
+{
+    return calloc(1, sizeof(trace_scene));
+}
+
+static void drop_embree(trace_scene *sc)
+{
+    if (sc->scn) rtcReleaseScene(sc->scn);
+    if (sc->dev) rtcReleaseDevice(sc->dev);
+    sc->scn = NULL;
+    sc->dev = NULL;
+    sc->built = 0;
+}
+
+static void scene_free(trace_scene *sc)
+{
+    if (!sc) return;
+    drop_embree(sc);
+    for (int i = 0; i < sc->nsurf; i++) {
+        free(sc->surf[i]->vtx);
+        free(sc->surf[i]->idx);
+        free(sc->surf[i]->media);
+        free(sc->surf[i]);
+    }
+    free(sc->surf);
+    for (int i = 0; i < sc->nsrc; i++) tr_source_free(&sc->src[i]);
+    free(sc->src);
+    free(sc);
+}
+
+static const char *scene_error(const trace_scene *sc)
+{
+    return sc ? sc->err : "no scene (out of memory)";
+}
+
+static int check_material(trace_scene *sc, const trace_material *m)
+{
+    if (!m) return fail(sc, TRACE_EINVAL, "no material given");
+    if (m->kind < TRACE_REFRACT || m->kind > TRACE_DETECT)
+        return fail(sc, TRACE_EINVAL, "unknown surface kind");
+    if (!(m->n_front > 0 && isfinite(m->n_front) && m->n_back > 0 && isfinite(m->n_back)))
+        return fail(sc, TRACE_EINVAL, "indices of refraction must be positive numbers");
+    return TRACE_OK;
+}
+
+static tr_surf *new_surf(trace_scene *sc)
+{
+    if (sc->nsurf == sc->capsurf) {
+        int cap = sc->capsurf ? 2 * sc->capsurf : 16;
+        tr_surf **p = realloc(sc->surf, (size_t)cap * sizeof *p);
+        if (!p) return NULL;
+        sc->surf = p;
+        sc->capsurf = cap;
+    }
+    tr_surf *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->id = sc->nsurf;
+    return s;
+}
+
+static int add_surface(trace_scene *sc, const trace_surface *s, const trace_material *m)
+{
+    int rc;
+    if (!sc) return TRACE_EINVAL;
+    if (!s) return fail(sc, TRACE_EINVAL, "no surface given");
+    if ((rc = check_material(sc, m))) return rc;
+    tr_surf *f = new_surf(sc);
+    if (!f) return fail(sc, TRACE_ENOMEM, "out of memory");
+    if (tr_shape_init(&f->shape, s, sc->err, sizeof sc->err)) {
+        free(f);
+        return TRACE_EINVAL;
+    }
+    f->mat = *m;
+    sc->surf[sc->nsurf++] = f;
+    drop_embree(sc);
+    return f->id;
+}
+
+/* Distance scale of how far a refined hit may sit off its triangle. */
+static double under_gap(const tr_surf *f)
+{
+    double gap = 0;
+    for (long i = 0; i < f->ntri; i++) {
+        double c[3] = {0, 0, 0}, t, dir[3], o[3];
+        const uint32_t *ix = f->idx + 3 * i;
+        for (int k = 0; k < 3; k++)
+            for (int j = 0; j < 3; j++) c[j] += f->vtx[3 * ix[k] + j] / 3;
+        tr_shape_normal(&f->shape, c, dir);
+        for (int j = 0; j < 3; j++) o[j] = c[j] - dir[j] * f->shape.scale;
+        if (tr_shape_refine(&f->shape, o, dir, f->shape.scale, &t))
+            gap = fmax(gap, fabs(t - f->shape.scale));
+    }
+    return gap;
+}
+
+static int add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m)
+{
+    char msg[256];
+    int rc;
+    if (!sc) return TRACE_EINVAL;
+    if (!mesh || !mesh->vertex || mesh->ntri < 1 || mesh->ntri > 200000000L)
+        return fail(sc, TRACE_EINVAL, "a mesh needs vertices and 1..2e8 triangles");
+    if ((rc = check_material(sc, m))) return rc;
+    long nv = mesh->index ? mesh->nvertex : 3 * mesh->ntri;
+    if (nv < 3 || nv > 600000000L) return fail(sc, TRACE_EINVAL, "bad vertex count");
+    tr_surf *f = new_surf(sc);
+    if (!f) return fail(sc, TRACE_ENOMEM, "out of memory");
+    f->is_mesh = 1;
+    f->mat = *m;
+    f->nv = nv;
+    f->ntri = mesh->ntri;
+    f->vtx = malloc((size_t)nv * 3 * sizeof(double));
+    f->idx = malloc((size_t)f->ntri * 3 * sizeof(uint32_t));
+    if (mesh->media) f->media = malloc((size_t)f->ntri * 2 * sizeof(double));
+    if (!f->vtx || !f->idx || (mesh->media && !f->media)) {
+        rc = fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
+        goto bad;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (long i = 0; i < nv * 3; i++) {
+        double x = mesh->vertex[i];
+        if (!isfinite(x)) {
+            snprintf(msg, sizeof msg, "vertex %ld is not finite", i / 3 + 1);
+            rc = fail(sc, TRACE_EINVAL, msg);
+            goto bad;
+        }
+        f->vtx[i] = x;
+        if (x < lo[i % 3]) lo[i % 3] = x;
+        if (x > hi[i % 3]) hi[i % 3] = x;
+    }
+    for (long i = 0; i < f->ntri * 3; i++) {
+        uint32_t k = mesh->index ? mesh->index[i] : (uint32_t)i;
+        if ((long)k >= nv) {
+            snprintf(msg, sizeof msg, "triangle %ld: vertex index %u out of range",
+                     i / 3 + 1, k);
+            rc = fail(sc, TRACE_EINVAL, msg);
+            goto bad;
+        }
+        f->idx[i] = k;
+    }
+    for (long i = 0; i < f->ntri; i++) {
+        const double *a = f->vtx + 3 * f->idx[3 * i], *b = f->vtx + 3 * f->idx[3 * i + 1],
+                     *c = f->vtx + 3 * f->idx[3 * i + 2];
+        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]}, n[3];
+        v_cross(e1, e2, n);
+        double l2 = fmax(v_dot(e1, e1), v_dot(e2, e2));
+        if (!(v_norm(n) > 1e-12 * l2)) {
+            snprintf(msg, sizeof msg, "triangle %ld is degenerate (zero area)", i + 1);
+            rc = fail(sc, TRACE_EINVAL, msg);
+            goto bad;
+        }
+        if (mesh->media) {
+            double n1 = mesh->media[2 * i], n2 = mesh->media[2 * i + 1];
+            if (!(n1 > 0 && n2 > 0 && isfinite(n1) && isfinite(n2))) {
+                snprintf(msg, sizeof msg, "triangle %ld: indices must be positive "
+                         "numbers", i + 1);
+                rc = fail(sc, TRACE_EINVAL, msg);
+                goto bad;
+            }
+            f->media[2 * i] = n1;
+            f->media[2 * i + 1] = n2;
+        }
+    }
+    double diag[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    f->eps = 1e-9 * v_norm(diag);
+    if (mesh->underlying) {
+        if (tr_shape_init(&f->shape, mesh->underlying, sc->err, sizeof sc->err)) {
+            rc = TRACE_EINVAL;
+            goto bad;
+        }
+        f->has_under = 1;
+        f->refine = mesh->refine;
+        if (f->refine == TRACE_REFINE_FULL) f->eps = fmax(f->eps, 2.5 * under_gap(f));
+    }
+    sc->surf[sc->nsurf++] = f;
+    drop_embree(sc);
+    return f->id;
+bad:
+    free(f->vtx);
+    free(f->idx);
+    free(f->media);
+    free(f);
+    return rc;
+}
+
+static int add_source(trace_scene *sc, const trace_source *s, uint64_t *first)
+{
+    if (!sc) return TRACE_EINVAL;
+    if (!s) return fail(sc, TRACE_EINVAL, "no source given");
+    if (sc->nsrc == sc->capsrc) {
+        int cap = sc->capsrc ? 2 * sc->capsrc : 8;
+        tr_source *p = realloc(sc->src, (size_t)cap * sizeof *p);
+        if (!p) return fail(sc, TRACE_ENOMEM, "out of memory");
+        sc->src = p;
+        sc->capsrc = cap;
+    }
+    tr_source *ts = &sc->src[sc->nsrc];
+    if (tr_source_init(ts, s, sc->err, sizeof sc->err)) {
+        tr_source_free(ts);
+        return TRACE_EINVAL;
+    }
+    ts->first = sc->nrays;
+    if (first) *first = ts->first;
+    sc->nrays += (uint64_t)ts->nrays;
+    sc->nsrc++;
+    return TRACE_OK;
+}
+
+/* ---------------- Embree ---------------- */
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    trace_scene *sc = user;
+    snprintf(sc->err, sizeof sc->err, "Embree error %d: %s", (int)code,
+             str ? str : "(no message)");
+}
+
+static void user_bounds(const struct RTCBoundsFunctionArguments *a)
+{
+    const tr_surf *f = a->geometryUserPtr;
+    struct RTCBounds *b = a->bounds_o;
+    b->lower_x = nextafterf((float)f->shape.lo[0], -INFINITY);
+    b->lower_y = nextafterf((float)f->shape.lo[1], -INFINITY);
+    b->lower_z = nextafterf((float)f->shape.lo[2], -INFINITY);
+    b->upper_x = nextafterf((float)f->shape.hi[0], INFINITY);
+    b->upper_y = nextafterf((float)f->shape.hi[1], INFINITY);
+    b->upper_z = nextafterf((float)f->shape.hi[2], INFINITY);
+}
+
+/* Front-facing unit normal of an analytic surface from tr_shape_hit's. */
+static void front_normal(const tr_shape *g, double n[3])
+{
+    if (g->shape != TRACE_SPHERE) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+}
+
+static void user_intersect(const struct RTCIntersectFunctionNArguments *a)
+{
+    if (a->N != 1 || !a->valid[0]) return;
+    tr_ctx *x = (tr_ctx *)a->context;
+    const tr_surf *f = a->geometryUserPtr;
+    struct RTCRayHit *rh = (struct RTCRayHit *)a->rayhit;
+    double t, n[3];
+    int leaving = x->last_surf == f->id;
+    int ok = x->float_hits ? tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n)
+                           : tr_shape_hit(&f->shape, x->o, x->d, leaving, &t, n);
+    if (!ok || !(t < x->best_t)) return;
+    float tf = (float)t;
+    if (tf > rh->ray.tfar) return;          /* a triangle is clearly nearer */
+    rh->ray.tfar = tf;
+    rh->hit.geomID = a->geomID;
+    rh->hit.primID = 0;
+    rh->hit.u = rh->hit.v = 0;
+    rh->hit.Ng_x = (float)n[0];
+    rh->hit.Ng_y = (float)n[1];
+    rh->hit.Ng_z = (float)n[2];
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    front_normal(&f->shape, n);
+    x->best_surf = f->id;
+    x->best_t = t;
+    v_set(x->best_n, n);
+}
+
+static void user_occluded(const struct RTCOccludedFunctionNArguments *a)
+{
+    (void)a;   /* the engine never asks occlusion queries */
+}
+
+static void tri_normal(const tr_surf *f, long prim, double n[3])
+{
+    const uint32_t *ix = f->idx + 3 * prim;
+    const double *a = f->vtx + 3 * ix[0], *b = f->vtx + 3 * ix[1], *c = f->vtx + 3 * ix[2];
+    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    v_cross(e1, e2, n);
+}
+
+/* Distance along the ray to the triangle's plane, in double. */
+static double tri_plane_t(const tr_surf *f, long prim, const double o[3], const double d[3])
+{
+    double n[3];
+    const double *a = f->vtx + 3 * f->idx[3 * prim];
+    tri_normal(f, prim, n);
+    double den = v_dot(n, d);
+    double q[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
+    return den != 0 ? v_dot(n, q) / den : INFINITY;
+}
+
+/* Leaving a mesh: never its own triangle again, nor another one "here". */
+static void mesh_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    if (a->N != 1 || !a->valid[0]) return;
+    const tr_ctx *x = (const tr_ctx *)a->context;
+    const tr_surf *f = a->geometryUserPtr;
+    if (x->last_surf != f->id) return;
+    long prim = ((const unsigned *)a->hit)[5];    /* RTCHit.primID for N = 1 */
+    if (prim == x->last_prim) { a->valid[0] = 0; return; }
+    if (!x->float_hits && !(tri_plane_t(f, prim, x->o, x->d) > f->eps)) a->valid[0] = 0;
+}
+
+static int attach_mesh(trace_scene *sc, tr_surf *f)
+{
+    RTCGeometry g = rtcNewGeometry(sc->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!g) return -1;
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                       3 * sizeof(float), (size_t)f->nv);
+    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), (size_t)f->ntri);
+    if (!v || !ix) { rtcReleaseGeometry(g); return -1; }
+    for (long i = 0; i < 3 * f->nv; i++) v[i] = (float)f->vtx[i];
+    memcpy(ix, f->idx, (size_t)f->ntri * 3 * sizeof(unsigned));
+    rtcSetGeometryUserData(g, f);
+    rtcSetGeometryIntersectFilterFunction(g, mesh_filter);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc->scn, g, (unsigned)f->id);
+    rtcReleaseGeometry(g);
+    return 0;
+}
+
+static int attach_user(trace_scene *sc, tr_surf *f)
+{
+    RTCGeometry g = rtcNewGeometry(sc->dev, RTC_GEOMETRY_TYPE_USER);
+    if (!g) return -1;
+    rtcSetGeometryUserPrimitiveCount(g, 1);
+    rtcSetGeometryUserData(g, f);
+    rtcSetGeometryBoundsFunction(g, user_bounds, NULL);
+    rtcSetGeometryIntersectFunction(g, user_intersect);
+    rtcSetGeometryOccludedFunction(g, user_occluded);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc->scn, g, (unsigned)f->id);
+    rtcReleaseGeometry(g);
+    return 0;
+}
+
+static int build(trace_scene *sc, double *ms)
+{
+    if (!sc) return TRACE_EINVAL;
+    if (sc->built) { if (ms) *ms = sc->build_ms; return TRACE_OK; }
+    double t0 = now_ms();
+    sc->err[0] = '\0';
+    if (!sc->dev) {
+        sc->dev = rtcNewDevice(NULL);
+        if (!sc->dev) return fail(sc, TRACE_EEMBREE, "cannot create the Embree device");
+        rtcSetDeviceErrorFunction(sc->dev, embree_error, sc);
+    }
+    sc->scn = rtcNewScene(sc->dev);
+    if (!sc->scn) { drop_embree(sc); return fail(sc, TRACE_EEMBREE, "no Embree scene"); }
+    rtcSetSceneFlags(sc->scn, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(sc->scn, RTC_BUILD_QUALITY_MEDIUM);
+    for (int i = 0; i < sc->nsurf; i++) {
+        int rc = sc->surf[i]->is_mesh ? attach_mesh(sc, sc->surf[i])
+                                      : attach_user(sc, sc->surf[i]);
+        if (rc) {
+            drop_embree(sc);
+            return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree geometry failed");
+        }
+    }
+    rtcCommitScene(sc->scn);
+    if (rtcGetDeviceError(sc->dev) != RTC_ERROR_NONE) {
+        drop_embree(sc);
+        return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree build failed");
+    }
+    sc->built = 1;
+    sc->build_ms = now_ms() - t0;
+    if (ms) *ms = sc->build_ms;
+    return TRACE_OK;
+}
+
+/* Nearest hit of the ray (o, d) in double; 0 if none. */
+static int nearest(const trace_scene *sc, int float_hits, const double o[3],
+                   const double d[3], int last_surf, long last_prim, tr_hitrec *h)
+{
+    tr_ctx x;
+    struct RTCRayHit rh;
+    rtcInitIntersectContext(&x.ec);
+    x.sc = sc;
+    v_set(x.o, o);
+    v_set(x.d, d);
+    x.last_surf = last_surf;
+    x.last_prim = last_prim;
+    x.float_hits = float_hits;
+    x.best_surf = -1;
+    x.best_t = INFINITY;
+    rh.ray.org_x = (float)o[0]; rh.ray.org_y = (float)o[1]; rh.ray.org_z = (float)o[2];
+    rh.ray.dir_x = (float)d[0]; rh.ray.dir_y = (float)d[1]; rh.ray.dir_z = (float)d[2];
+    rh.ray.tnear = 0;
+    rh.ray.tfar = INFINITY;
+    rh.ray.time = 0;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(sc->scn, &x.ec, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    const tr_surf *f = sc->surf[rh.hit.geomID];
+    if (!f->is_mesh) {
+        h->surf = f->id;
+        h->prim = -1;
+        h->t = x.best_t;
+        v_set(h->n, x.best_n);
+        return 1;
+    }
+    long prim = rh.hit.primID;
+    double t = float_hits ? (double)rh.ray.tfar : tri_plane_t(f, prim, o, d), n[3];
+    if (!(t > 0 && isfinite(t))) t = rh.ray.tfar;
+    tri_normal(f, prim, n);
+    v_unit(n);
+    if (f->has_under && f->refine != TRACE_REFINE_NONE && !float_hits) {
+        double tt, p[3], an[3];
+        if (f->refine == TRACE_REFINE_FULL && tr_shape_refine(&f->shape, o, d, t, &tt) &&
+            tt > 0)
+            t = tt;
+        for (int i = 0; i < 3; i++) p[i] = o[i] + t * d[i];
+        tr_shape_normal(&f->shape, p, an);
+        if (v_dot(an, n) < 0) { an[0] = -an[0]; an[1] = -an[1]; an[2] = -an[2]; }
+        v_set(n, an);
+    }
+    if (x.best_surf >= 0 && x.best_t < t) {      /* an analytic surface is nearer */
+        h->surf = x.best_surf;
+        h->prim = -1;
+        h->t = x.best_t;
+        v_set(h->n, x.best_n);
+        return 1;
+    }
+    h->surf = f->id;
+    h->prim = prim;
+    h->t = t;
+    v_set(h->n, n);
+    return 1;
+}
+
+/* ---------------- the trace ---------------- */
+
+typedef struct tr_tally {
+    double emitted, detected, absorbed, escaped, cutoff;
+    uint32_t segments, interactions, tir, hits, cut_depth, cut_power, cut_reflection,
+             mismatch, failures;
+    int max_depth;
+} tr_tally;
+
+typedef struct tr_wray {
+    double o[3], d[3];
+    double power, n, len, opl;
+    tr_pol pol;
+    int depth, last_surf;
+    long last_prim;
+    uint32_t hist;
+} tr_wray;
+
+typedef struct tr_buf {
+    void *p;
+    size_t n, cap, size;
+} tr_buf;
+
+static int buf_push(tr_buf *b, const void *rec)
+{
+    if (b->n == b->cap) {
+        size_t cap = b->cap ? 2 * b->cap : 1024;
+        void *p = realloc(b->p, cap * b->size);
+        if (!p) return -1;
+        b->p = p;
+        b->cap = cap;
+    }
+    memcpy((char *)b->p + b->n * b->size, rec, b->size);
+    b->n++;
+    return 0;
+}
+
+typedef struct tr_worker {
+    const trace_scene *sc;
+    const trace_options *o;
+    uint64_t first, count;       /* global ray numbers */
+    tr_tally *tally;             /* count entries */
+    int want_seg, want_hit;
+    tr_buf seg, hit;
+    tr_wray *stack;
+    int nomem;
+} tr_worker;
+
+static void emit_segment(tr_worker *w, const tr_wray *r, uint64_t ray, const double p1[3],
+                         int end, int surf)
+{
+    if (!w->want_seg) return;
+    trace_segment s;
+    memset(&s, 0, sizeof s);            /* padding too: records compare bytewise */
+    s.ray = ray;
+    s.depth = r->depth;
+    s.end = end;
+    s.surface = surf;
+    v_set(s.p0, r->o);
+    v_set(s.p1, p1);
+    s.power = r->pol.jss + r->pol.jpp;
+    if (buf_push(&w->seg, &s)) w->nomem = 1;
+}
+
+static void emit_hit(tr_worker *w, const tr_wray *r, uint64_t ray, const tr_hitrec *h,
+                     const double p[3])
+{
+    if (!w->want_hit) return;
+    trace_hit x;
+    memset(&x, 0, sizeof x);
+    x.ray = ray;
+    x.depth = r->depth;
+    x.history = r->hist;
+    x.surface = h->surf;
+    x.prim = h->prim;
+    v_set(x.pos, p);
+    v_set(x.dir, r->d);
+    v_set(x.normal, h->n);
+    v_set(x.s_dir, r->pol.e);
+    x.power_s = r->pol.jss;
+    x.power_p = r->pol.jpp;
+    x.length = r->len;
+    x.opl = r->opl;
+    if (buf_push(&w->hit, &x)) w->nomem = 1;
+}
+
+/* s unit vector of the plane of incidence (d x n), or the ray's own e at normal
+ * incidence. */
+static void s_vector(const tr_wray *r, const double n[3], double s[3])
+{
+    v_cross(r->d, n, s);
+    if (v_norm(s) < 1e-12 || v_unit(s)) v_set(s, r->pol.e);
+}
+
+/* Push a child if it carries enough power; else count it as cut off. */
+static int push(tr_worker *w, tr_tally *ty, int *sp, const tr_wray *c, double p0)
+{
+    double p = c->pol.jss + c->pol.jpp;
+    if (p <= 0) return 0;
+    if (p < w->o->cutoff * p0) {
+        ty->cutoff += p;
+        ty->cut_power++;
+        return 0;
+    }
+    w->stack[(*sp)++] = *c;
+    return 0;
+}
+
+static void interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hitrec *h,
+                     const tr_surf *f, double p0)
+{
+    double n1 = f->mat.n_front, n2 = f->mat.n_back, s[3], m[3];
+    if (f->media && h->prim >= 0) { n1 = f->media[2 * h->prim]; n2 = f->media[2 * h->prim + 1]; }
+    double dn = v_dot(r->d, h->n);
+    if (dn > 0) { double x = n1; n1 = n2; n2 = x; }     /* arriving from the back */
+    /* m: unit normal pointing back into the incident medium */
+    for (int i = 0; i < 3; i++) m[i] = dn > 0 ? -h->n[i] : h->n[i];
+    double ci = fmin(1.0, fabs(dn));
+    if (f->mat.kind == TRACE_REFRACT && fabs(r->n - n1) > 1e-9 * n1) ty->mismatch++;
+    ty->interactions++;
+    s_vector(r, h->n, s);
+    tr_pol_rotate(&r->pol, r->d, s);
+
+    tr_wray refl = *r, refr = *r;
+    int depth = r->depth + 1;
+    refl.depth = refr.depth = depth;
+    refl.last_surf = refr.last_surf = h->surf;
+    refl.last_prim = refr.last_prim = h->prim;
+    if (r->depth < 32) refl.hist |= 1u << r->depth;
+    for (int i = 0; i < 3; i++) refl.d[i] = r->d[i] + 2 * ci * m[i];
+    v_unit(refl.d);
+    refl.n = n1;
+
+    if (f->mat.kind == TRACE_MIRROR) {          /* rs = -1, rp = +1 */
+        refl.pol.jre = -refl.pol.jre;
+        refl.pol.jim = -refl.pol.jim;
+        push(w, ty, sp, &refl, p0);
+        return;
+    }
+    trace_fresnel_coef fc;
+    tr_fresnel(n1, n2, ci, &fc);
+    if (fc.tir) {
+        double ph = fc.rs_phase - fc.rp_phase, re = refl.pol.jre, im = refl.pol.jim;
+        refl.pol.jre = cos(ph) * re - sin(ph) * im;
+        refl.pol.jim = sin(ph) * re + cos(ph) * im;
+        ty->tir++;
+        push(w, ty, sp, &refl, p0);
+        return;
+    }
+    double eta = n1 / n2, k = eta * ci - fc.cos_t;
+    for (int i = 0; i < 3; i++) refr.d[i] = eta * r->d[i] + k * m[i];
+    v_unit(refr.d);
+    refr.n = n2;
+    if (w->o->fresnel) {
+        double a = sqrt(fc.Ts * fc.Tp);
+        refr.pol.jss = fc.Ts * r->pol.jss;
+        refr.pol.jpp = fc.Tp * r->pol.jpp;
+        refr.pol.jre = a * r->pol.jre;
+        refr.pol.jim = a * r->pol.jim;
+        double rsp = fc.rs * fc.rp * cos(fc.rs_phase - fc.rp_phase);
+        refl.pol.jss = fc.Rs * r->pol.jss;
+        refl.pol.jpp = fc.Rp * r->pol.jpp;
+        refl.pol.jre = rsp * r->pol.jre;
+        refl.pol.jim = rsp * r->pol.jim;
+        /* reflected first on the stack: the refracted ray is traced first */
+        if (w->o->reflections) push(w, ty, sp, &refl, p0);
+        else {
+            double p = refl.pol.jss + refl.pol.jpp;
+            if (p > 0) { ty->cutoff += p; ty->cut_reflection++; }
+        }
+    }
+    push(w, ty, sp, &refr, p0);
+}
+
+static void trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty)
+{
+    const trace_scene *sc = w->sc;
+    const trace_options *o = w->o;
+    int sp = 0;
+    tr_wray *r0w = &w->stack[sp++];
+    memset(ty, 0, sizeof *ty);
+    v_set(r0w->o, r0->o);
+    v_set(r0w->d, r0->d);
+    r0w->power = r0->power;
+    r0w->n = r0->n;
+    r0w->len = r0w->opl = 0;
+    r0w->pol = r0->pol;
+    r0w->depth = 0;
+    r0w->last_surf = -1;
+    r0w->last_prim = -1;
+    r0w->hist = 0;
+    double p0 = r0->pol.jss + r0->pol.jpp;
+    ty->emitted = p0;
+    while (sp > 0) {
+        tr_wray r = w->stack[--sp];
+        double p = r.pol.jss + r.pol.jpp, q[3];
+        tr_hitrec h;
+        if (r.depth > ty->max_depth) ty->max_depth = r.depth;
+        if (r.depth >= o->max_depth) { ty->cutoff += p; ty->cut_depth++; continue; }
+        if (!nearest(sc, o->float_hits, r.o, r.d, r.last_surf, r.last_prim, &h)) {
+            for (int i = 0; i < 3; i++) q[i] = r.o[i] + o->escape_length * r.d[i];
+            ty->segments++;
+            ty->escaped += p;
+            emit_segment(w, &r, ray, q, TRACE_END_ESCAPE, -1);
+            continue;
+        }
+        for (int i = 0; i < 3; i++) q[i] = r.o[i] + h.t * r.d[i];
+        if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]) && isfinite(h.n[0]))) {
+            ty->failures++;
+            ty->cutoff += p;
+            continue;
+        }
+        const tr_surf *f = sc->surf[h.surf];
+        ty->segments++;
+        r.len += h.t;
+        r.opl += r.n * h.t;
+        switch (f->mat.kind) {
+        case TRACE_ABSORB:
+            ty->absorbed += p;
+            emit_segment(w, &r, ray, q, TRACE_END_ABSORB, h.surf);
+            break;
+        case TRACE_DETECT: {
+            double s[3];
+            s_vector(&r, h.n, s);
+            tr_pol_rotate(&r.pol, r.d, s);
+            ty->detected += p;
+            ty->hits++;
+            emit_segment(w, &r, ray, q, TRACE_END_DETECT, h.surf);
+            emit_hit(w, &r, ray, &h, q);
+            break;
+        }
+        default:
+            emit_segment(w, &r, ray, q, TRACE_END_NONE, h.surf);
+            v_set(r.o, q);
+            interact(w, ty, &sp, &r, &h, f, p0);
+        }
+    }
+}
+
+static void *work(void *arg)
+{
+    tr_worker *w = arg;
+    const trace_scene *sc = w->sc;
+    int k = 0;
+    for (uint64_t i = 0; i < w->count; i++) {
+        uint64_t g = w->first + i;
+        tr_ray0 r;
+        while (k + 1 < sc->nsrc && sc->src[k + 1].first <= g) k++;
+        while (sc->src[k].first + (uint64_t)sc->src[k].nrays <= g) k++;
+        tr_source_ray(&sc->src[k], (long)(g - sc->src[k].first), &r);
+        trace_one(w, &r, g, &w->tally[i]);
+    }
+    return NULL;
+}
+
+static void options_default(trace_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->max_depth = 16;
+    o->cutoff = 1e-6;
+    o->fresnel = 1;
+    o->reflections = 1;
+    o->threads = 0;
+    o->escape_length = 1;
+    o->batch = 0;
+    o->float_hits = 0;
+}
+
+static void add_tally(trace_summary *s, const tr_tally *t)
+{
+    s->rays++;
+    s->segments += t->segments;
+    s->interactions += t->interactions;
+    s->tir += t->tir;
+    s->hits += t->hits;
+    s->cut_depth += t->cut_depth;
+    s->cut_power += t->cut_power;
+    s->cut_reflection += t->cut_reflection;
+    s->medium_mismatch += t->mismatch;
+    s->failures += t->failures;
+    if (t->max_depth > s->max_depth_seen) s->max_depth_seen = t->max_depth;
+    s->emitted += t->emitted;
+    s->detected += t->detected;
+    s->absorbed += t->absorbed;
+    s->escaped += t->escaped;
+    s->cutoff += t->cutoff;
+}
+
+static int deliver(const tr_worker *w, const trace_sink *k)
+{
+    for (size_t i = 0; k->segment && i < w->seg.n; i++)
+        if (k->segment(k->ctx, (const trace_segment *)w->seg.p + i)) return TRACE_ECANCEL;
+    for (size_t i = 0; k->hit && i < w->hit.n; i++)
+        if (k->hit(k->ctx, (const trace_hit *)w->hit.p + i)) return TRACE_ECANCEL;
+    return TRACE_OK;
+}
+
+static int check_options(trace_scene *sc, const trace_options *o)
+{
+    if (o->max_depth < 1 || o->max_depth > 10000)
+        return fail(sc, TRACE_EINVAL, "depth limit must be 1..10000");
+    if (!(o->cutoff >= 0 && o->cutoff < 1))
+        return fail(sc, TRACE_EINVAL, "intensity cutoff must be in [0, 1)");
+    if (o->threads < 0 || o->threads > 1024)
+        return fail(sc, TRACE_EINVAL, "thread count must be 0..1024");
+    if (!(o->escape_length >= 0 && isfinite(o->escape_length)))
+        return fail(sc, TRACE_EINVAL, "escape length must be a non-negative number");
+    if (o->batch < 0) return fail(sc, TRACE_EINVAL, "batch must be >= 0");
+    return TRACE_OK;
+}
+
+static int run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
+               trace_summary *sum)
+{
+    trace_options o;
+    trace_summary s;
+    trace_sink none = {0};
+    int rc;
+    if (!sc) return TRACE_EINVAL;
+    if (oin) o = *oin; else options_default(&o);
+    if (!sink) sink = &none;
+    memset(&s, 0, sizeof s);
+    if (sum) memset(sum, 0, sizeof *sum);
+    if ((rc = check_options(sc, &o))) return rc;
+    if ((rc = build(sc, &s.build_ms))) return rc;
+    int nthr = o.threads ? o.threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (nthr < 1) nthr = 1;
+    int want_seg = sink->segment != NULL, want_hit = sink->hit != NULL;
+    long batch = o.batch ? o.batch : (want_seg || want_hit) ? 8192 : 65536;
+    tr_worker *w = calloc((size_t)nthr, sizeof *w);
+    tr_tally *tally = malloc((size_t)batch * sizeof *tally);
+    pthread_t *tid = calloc((size_t)nthr, sizeof *tid);
+    char *started = calloc((size_t)nthr, 1);
+    rc = (w && tally && tid && started) ? TRACE_OK : fail(sc, TRACE_ENOMEM, "out of memory");
+    for (int i = 0; rc == TRACE_OK && i < nthr; i++) {
+        w[i].sc = sc;
+        w[i].o = &o;
+        w[i].want_seg = want_seg;
+        w[i].want_hit = want_hit;
+        w[i].seg.size = sizeof(trace_segment);
+        w[i].hit.size = sizeof(trace_hit);
+        w[i].stack = malloc((size_t)(o.max_depth + 4) * sizeof(tr_wray));
+        if (!w[i].stack) rc = fail(sc, TRACE_ENOMEM, "out of memory");
+    }
+    double t0 = now_ms();
+    for (uint64_t b0 = 0; rc == TRACE_OK && b0 < sc->nrays; b0 += (uint64_t)batch) {
+        uint64_t nb = sc->nrays - b0 < (uint64_t)batch ? sc->nrays - b0 : (uint64_t)batch;
+        uint64_t chunk = (nb + (uint64_t)nthr - 1) / (uint64_t)nthr;
+        for (int i = 0; i < nthr; i++) {
+            uint64_t a = (uint64_t)i * chunk;
+            w[i].first = b0 + (a < nb ? a : nb);
+            w[i].count = a < nb ? (nb - a < chunk ? nb - a : chunk) : 0;
+            w[i].tally = tally + (a < nb ? a : nb);
+            w[i].seg.n = w[i].hit.n = 0;
+        }
+        for (int i = 1; i < nthr; i++) {
+            started[i] = 0;
+            if (w[i].count == 0) continue;
+            if (pthread_create(&tid[i], NULL, work, &w[i]) == 0) started[i] = 1;
+            else work(&w[i]);            /* no thread: the same work, here */
+        }
+        work(&w[0]);
+        for (int i = 1; i < nthr; i++)
+            if (started[i]) pthread_join(tid[i], NULL);
+        for (int i = 0; i < nthr && rc == TRACE_OK; i++) {
+            if (w[i].nomem) rc = fail(sc, TRACE_ENOMEM, "out of memory for trace output");
+            else rc = deliver(&w[i], sink);
+            if (rc == TRACE_ECANCEL) fail(sc, rc, "the trace was cancelled");
+        }
+        for (uint64_t i = 0; i < nb; i++) add_tally(&s, &tally[i]);
+        if (rc == TRACE_OK && sink->progress &&
+            sink->progress(sink->ctx, b0 + nb, sc->nrays))
+            rc = fail(sc, TRACE_ECANCEL, "the trace was cancelled");
+    }
+    s.trace_ms = now_ms() - t0;
+    for (int i = 0; w && i < nthr; i++) {
+        free(w[i].stack);
+        free(w[i].seg.p);
+        free(w[i].hit.p);
+    }
+    free(w);
+    free(tally);
+    free(tid);
+    free(started);
+    if (sum) *sum = s;
+    return rc;
+}
+
+/* ---------------- the table ---------------- */
+
+static const char *version(void)
+{
+    return "lensmat trace engine (ABI " "1" "), Embree " RTC_VERSION_STRING;
+}
+
+static int refract(const double d[3], const double nrm[3], double n1, double n2,
+                   double out[3])
+{
+    return tr_refract(d, nrm, n1, n2, out);
+}
+
+static void fresnel(double n1, double n2, double cos_i, trace_fresnel_coef *out)
+{
+    tr_fresnel(n1, n2, cos_i, out);
+}
+
+static const trace_api api = {
+    TRACE_ABI,
+    version,
+    scene_new,
+    scene_free,
+    scene_error,
+    add_surface,
+    add_mesh,
+    add_source,
+    options_default,
+    build,
+    run,
+    refract,
+    fresnel,
+    tr_add_lens,
+    tr_lens_fan,
+};
+
+const trace_api *trace_get_api(int abi)
+{
+    return abi == TRACE_ABI ? &api : NULL;
+}

@@ -1,0 +1,111 @@
+/* tr_int.h -- private to the trace engine's own files (tr_*.c); callers use trace.h.
+ * Analytic surfaces in double (tr_geom.c), optics (tr_optics.c), sources
+ * (tr_source.c), the scene and the trace loop on Embree (tr_engine.c), sequential
+ * lenses (tr_lens.c). */
+#ifndef TR_INT_H
+#define TR_INT_H
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include "trace.h"
+
+#define TR_PI 3.14159265358979323846
+
+/* ---- small vector helpers ---- */
+static inline double v_dot(const double a[3], const double b[3])
+{ return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline void v_cross(const double a[3], const double b[3], double c[3])
+{
+    double x = a[1] * b[2] - a[2] * b[1];
+    double y = a[2] * b[0] - a[0] * b[2];
+    double z = a[0] * b[1] - a[1] * b[0];
+    c[0] = x; c[1] = y; c[2] = z;
+}
+static inline double v_norm(const double a[3]) { return sqrt(v_dot(a, a)); }
+static inline int v_unit(double a[3])
+{
+    double l = v_norm(a);
+    if (!(l > 0) || !isfinite(l)) return -1;
+    a[0] /= l; a[1] /= l; a[2] /= l;
+    return 0;
+}
+static inline void v_set(double d[3], const double s[3]) { d[0] = s[0]; d[1] = s[1]; d[2] = s[2]; }
+
+/* ---- analytic surfaces (tr_geom.c) ---- */
+typedef struct tr_shape {
+    int shape;                 /* enum trace_shape */
+    double at[3];              /* vertex / point / centre */
+    double u[3], v[3], w[3];   /* local frame, w = axis (unit) */
+    double radius, c, k;       /* c = 1/radius (0: flat) */
+    double asph[TRACE_MAXASPH];
+    int nasph;
+    int aperture;
+    double r_outer2, r_inner2; /* squared; r_outer2 = 0: unbounded (sphere limit) */
+    double hw, hh;             /* rectangle half width (along u), half height (v) */
+    double scale;              /* size, for tolerances */
+    double lo[3], hi[3];       /* world bounds */
+} tr_shape;
+
+/* Validates and prepares; 0, or -1 with a message in err. */
+int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap);
+/* Nearest intersection with t > 0 of the ray o + t d (d unit).  `leaving`: the
+ * origin lies on this surface (the root at t = 0 is excluded exactly).  Returns 1
+ * with *t and the unit normal n (pointing to the back side), 0 for none. */
+int tr_shape_hit(const tr_shape *g, const double o[3], const double d[3], int leaving,
+                 double *t, double n[3]);
+/* The same computed in single precision (to compare with a float-only tracer). */
+int tr_shape_hit_float(const tr_shape *g, const double o[3], const double d[3],
+                       int leaving, double *t, double n[3]);
+/* Unit normal (toward back) at a point near the surface. */
+void tr_shape_normal(const tr_shape *g, const double p[3], double n[3]);
+/* Newton on the implicit function from t0: 1 with *t, or 0. */
+int tr_shape_refine(const tr_shape *g, const double o[3], const double d[3], double t0,
+                    double *t);
+
+/* ---- optics (tr_optics.c) ---- */
+/* Coherency state of a ray in the basis (e, d x e). */
+typedef struct tr_pol {
+    double e[3];
+    double jss, jpp, jre, jim;   /* <Es Es*>, <Ep Ep*>, <Es Ep*> */
+} tr_pol;
+
+void tr_fresnel(double n1, double n2, double cos_i, trace_fresnel_coef *f);
+int tr_refract(const double d[3], const double nrm[3], double n1, double n2,
+               double out[3]);
+/* Rotate the state of a ray with direction d into the s/p basis given by unit s. */
+void tr_pol_rotate(tr_pol *p, const double d[3], const double s[3]);
+
+/* ---- sources (tr_source.c) ---- */
+typedef struct tr_source {
+    trace_source s;            /* copy; s.ray points to own copy */
+    trace_ray *rays;
+    double u[3], v[3];         /* frame about dir */
+    long nrays;
+    long *row_first;           /* GRID: first kept ray of each row (count+1) */
+    int *row_i0;               /* GRID: first kept column of each row */
+    double wsum;               /* GAUSSIAN: sum of weights */
+    uint64_t first;            /* global number of its first ray */
+} tr_source;
+
+typedef struct tr_ray0 {
+    double o[3], d[3];
+    double power, n;
+    tr_pol pol;
+} tr_ray0;
+
+int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap);
+void tr_source_free(tr_source *ts);
+void tr_source_ray(const tr_source *ts, long i, tr_ray0 *r);
+
+/* ---- sequential lenses (tr_lens.c), through the public table ---- */
+int tr_add_lens(trace_scene *sc, const trace_lens *lens);
+int tr_lens_fan(const trace_lens *lens, double z_obj, double y_obj, double z_paraxial,
+                int nrays, const double *h, trace_fan_ray *out, char *err, size_t cap);
+
+/* Set the scene's message; returns code. */
+int tr_scene_fail(trace_scene *sc, int code, const char *msg);
+
+void tr_set_err(char *err, size_t cap, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+#endif
