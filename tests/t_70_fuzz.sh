@@ -3,7 +3,7 @@
 fuzz_short() {
     mkdir -p "$WORK/fuzz"
     "$TOP/build/fuzz_answers" -max_total_time="${FUZZ_SHORT_SECONDS:-15}" -timeout=5 \
-        -print_final_stats=1 "$WORK/fuzz" "$TOP/tests/fuzz-corpus" > "$WORK/fuzz.log" 2>&1 ||
+        -print_final_stats=1 -artifact_prefix="$WORK/" "$WORK/fuzz" "$TOP/tests/fuzz-corpus" > "$WORK/fuzz.log" 2>&1 ||
         { tail -30 "$WORK/fuzz.log"; return 1; }
 }
 if [ -x "$TOP/build/fuzz_answers" ]; then
