@@ -83,6 +83,7 @@ static void test_relay_det(void)
     CHECK(fabs(px_det(s.m) - 1) < 1e-12, "1000-surface relay |det-1| = %.3g < 1e-12",
           fabs(px_det(s.m) - 1));
     CHECK(!px_is_afocal(&s) || fabs(s.m.c) < 1e-12, "relay afocal decision consistent");
+    px_system_free(&s);
 }
 
 /* Random chain: entries grow without bound; the determinant can only be judged
@@ -107,6 +108,7 @@ static void test_random_chain_det(void)
     CHECK(scale > 1e20, "random chain entries grow (|AD|+|BC| = %.3g)", scale);
     CHECK(rel < 1e4 * DBL_EPSILON, "random chain |det-1|/(|AD|+|BC|) = %.3g at rounding level",
           rel);
+    px_system_free(&s);
 }
 
 int main(void)

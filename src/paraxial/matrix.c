@@ -1,6 +1,7 @@
 /* matrix.c -- 2x2 ray-transfer matrices.  The products follow the original listing's
  * order of operations exactly (c_ij = (0 + a_i1*b_1j) + a_i2*b_2j), so the classic
- * dialogue prints the same round-off as the original; build with -ffp-contract=off. */
+ * dialogue prints the same round-off as the original; build with -ffp-contract=off.
+ * px_mul_fma and px_det_accurate are the careful versions (explicit fma). */
 #include <math.h>
 #include "paraxial.h"
 
@@ -29,6 +30,23 @@ px_mat px_mul(px_mat l, px_mat r)
     m.b = (0.0 + l.a * r.b) + l.b * r.d;
     m.c = (0.0 + l.c * r.a) + l.d * r.c;
     m.d = (0.0 + l.c * r.b) + l.d * r.d;
+    return m;
+}
+
+/* a*b + c*d with one rounding of the exact product sum (fma recovers a*b's error). */
+static double dot2(double a, double b, double c, double d)
+{
+    double p = a * b, e = fma(a, b, -p);
+    return fma(c, d, p) + e;
+}
+
+px_mat px_mul_fma(px_mat l, px_mat r)
+{
+    px_mat m;
+    m.a = dot2(l.a, r.a, l.b, r.c);
+    m.b = dot2(l.a, r.b, l.b, r.d);
+    m.c = dot2(l.c, r.a, l.d, r.c);
+    m.d = dot2(l.c, r.b, l.d, r.d);
     return m;
 }
 

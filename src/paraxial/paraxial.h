@@ -1,8 +1,19 @@
-/* paraxial.h -- public face of the paraxial engine (ABCD matrices, cardinal points,
- * object/image planes).  Rays are (y, n*theta); every matrix has det 1.  Lengths are
- * in whatever unit the user chose; the engine never prints anything. */
+/* paraxial.h -- public face of the paraxial engine: ray-transfer (ABCD) matrices,
+ * lens systems, cardinal points, object/image planes, and how well each result is
+ * determined by its inputs.  The engine never prints anything.
+ *
+ * Conventions.  Light travels left to right along +z.  A ray at a reference plane is
+ * the column (y, n*theta): height and index times angle.  A radius is positive when
+ * the centre of curvature lies right of the surface; 0 or +-inf is a plane.
+ * Distances inside matrices are reduced (distance / index of the medium crossed), so
+ * every matrix has det 1.  Lengths are in one unit of the user's choice throughout;
+ * powers are in 1/unit (px_diopters, below, converts to diopters). */
 #ifndef PARAXIAL_H
 #define PARAXIAL_H
+
+/* Result codes.  PX_BAD (= 2, with the calculations below): an input outside the
+ * domain (negative thickness, index <= 0, not a number); nothing was changed. */
+enum { PX_OK = 0, PX_AT_INFINITY = 1, PX_NOMEM = 3 };
 
 /* [a b; c d] acting on the column (y, n*theta). */
 typedef struct px_mat { double a, b, c, d; } px_mat;
@@ -11,34 +22,80 @@ px_mat px_identity(void);
 px_mat px_translation(double reduced);            /* [1 t; 0 1], t = distance / n */
 px_mat px_refraction(double n1, double n2, double r); /* r: radius, +-inf = plane */
 px_mat px_mul(px_mat l, px_mat r);                /* l*r, in the listing's order */
+px_mat px_mul_fma(px_mat l, px_mat r);            /* l*r, each entry a*b+c*d to ~1 ulp */
 px_mat px_mul_abs(px_mat l, px_mat r);            /* |l|*|r|: rounding-error scale */
 double px_det(px_mat m);                          /* a*d - c*b, listing's order */
 double px_det_accurate(px_mat m);                 /* a*d - b*c with an fma correction */
 
-/* A lens system built surface by surface, as the classic dialogue enters it.  `abs`
- * is the product of the elementwise absolute values: the size of what was summed into
- * each entry, which scales the rounding error of that entry. */
+/* One elementary step of a system, kept for the condition estimates. */
+typedef struct px_step {
+    double e;        /* translation: reduced thickness t/n; refraction: (n1 - n2)/R */
+    double w;        /* sum of |de/dx|*|x| over the inputs x (positions, radius, indices) */
+    px_mat pre;      /* the system matrix before this step */
+    int refract;     /* 1: refraction (e is entry c), 0: translation (e is entry b) */
+} px_step;
+#define PX_INLINE_STEPS 8
+
+/* A lens system built surface by surface.  `m` is the product in the original
+ * listing's order of operations (the classic dialogue prints it, round-off and all);
+ * hi + lo is the same product in double-double, exact to about 1e-32 relative to the
+ * sizes of the summed terms, which the accurate results use.  A system with more than
+ * PX_INLINE_STEPS steps owns heap memory: px_system_free it, and do not copy it. */
 typedef struct px_system {
-    px_mat m, abs;
+    px_mat m, abs;            /* listing order; product of |matrices| (rounding scale) */
+    px_mat hi, lo;            /* double-double product */
     double z_first, z_last;   /* reference planes 1 and 2 */
     double n_obj, n_img;      /* media left of the first, right of the last surface */
     int nsurf;
+    int err;                  /* 0, or PX_BAD / PX_NOMEM from the last failed step */
+    int nsteps, cap;
+    px_step *heap;            /* all steps once there are more than PX_INLINE_STEPS */
+    px_step inl[PX_INLINE_STEPS];
 } px_system;
 
 void px_system_init(px_system *s, double n_obj);
+void px_system_free(px_system *s);
 /* Adding a surface at z takes two steps, so that a caller can show the system in
  * between (the original does).  px_system_translate moves reference plane 2 to z and
  * returns 1 if that took a translation (z right of it), 0 otherwise (first surface,
- * or a thin lens: same z).  px_system_refract then adds the refraction at a surface
- * of radius r (0 or +-inf: a plane) with index n_right to its right, and returns
- * that surface's refraction matrix. */
+ * or a thin lens: same z), -1 on an error (z left of plane 2 -- a negative
+ * thickness --, z not finite, or no memory; s->err says which; nothing changed).
+ * px_system_refract then adds the refraction at a surface of radius r (0 or +-inf: a
+ * plane) with index n_right to its right, and returns that surface's refraction
+ * matrix (the identity, with s->err = PX_BAD, if n_right is not a positive number). */
 int px_system_translate(px_system *s, double z);
 px_mat px_system_refract(px_system *s, double r, double n_right);
+/* The same by thickness: a gap t >= 0 (PX_BAD if t < 0 or not finite) and a
+ * surface; return PX_OK, PX_BAD or PX_NOMEM. */
+int px_system_gap(px_system *s, double t);
+int px_system_surface(px_system *s, double r, double n_right);
 
-/* Is C zero within the rounding error of its computation? */
+/* How well a function f(A, B, C, D) of the system matrix is determined by the
+ * inputs: sum over every input x of |df/dx|*|x|, for the gradient (ga, gb, gc, gd) of
+ * f.  Perturbing every input by a relative eps moves f by at most about eps times
+ * this (to first order); computed exactly, with the signs of every partial product,
+ * so it does not overflow or overestimate on long chains whose products stay bounded. */
+double px_sensitivity(const px_system *s, double ga, double gb, double gc, double gd);
+
+/* A result, how sensitive it is, and its relative condition number. */
+typedef struct px_value {
+    double v;        /* the value */
+    double sens;     /* sum |dv/dx|*|x| over every input x */
+    double cond;     /* sens/|v| (inf when v = 0 < sens, 0 when both are 0) */
+} px_value;
+/* Above this relative condition number a result has lost at least half of double's
+ * digits to its inputs' rounding: reports say so instead of printing it bare. */
+#define PX_ILL_CONDITIONED 1e8
+int px_ill_conditioned(px_value v);
+/* Are the printed digits of v (printf %g, `digits` significant) all meaningful? */
+int px_digits_meaningful(px_value v, int digits);
+
+/* Is C zero within what the inputs' rounding can produce?  (Scale-aware: compared
+ * with px_sensitivity of C, not with 0 and not with the product of |matrices|.) */
 int px_is_afocal(const px_system *s);
 
-/* The six cardinal points (z coordinates) and focal distances. */
+/* The six cardinal points (z coordinates) and focal distances, in the original
+ * listing's arithmetic (what --original prints). */
 typedef struct px_cardinal {
     double principal1, principal2, nodal1, nodal2, focal1, focal2;
     double focal_dist1, focal_dist2;   /* |principal - focal|, as the original prints */
@@ -48,16 +105,189 @@ typedef struct px_cardinal {
  * 0: nodal planes correct for any media (identical when the media are equal). */
 void px_cardinal_points(const px_system *s, int original, px_cardinal *out);
 
-/* Image of the object plane at z_obj.  Fills the reduced object distance, the
- * reduced image distance d2 (image at z_last + n_img*d2) and the object-to-image
- * matrix.  Returns 0, or PX_AT_INFINITY when the object lies in the first focal
- * plane (C*d1 + D is zero within rounding), in which case d2 is not set. */
-enum { PX_OK = 0, PX_AT_INFINITY = 1 };
+/* Everything first-order about a system, accurately (double-double matrix,
+ * cancellation-free forms), each result with its condition.  With media n_o left and
+ * n_i right and the matrix [A B; C D] between reference planes z1 and z2:
+ *   power P = -C; effective focal length f = -1/C; focal lengths F1 = -n_o/C (F1 to
+ *   H1) and F2 = -n_i/C (H2 to F2); front/back focal distances z1 - zF1 = -n_o D/C
+ *   and zF2 - z2 = -n_i A/C; zH1 = z1 - n_o (1-D)/C, zH2 = z2 + n_i (1-A)/C;
+ *   zN1 = z1 + (n_o D - n_i)/C, zN2 = z2 + (n_o - n_i A)/C (sections 16, 17, 19, 20,
+ *   with the document's nodal formula corrected for n_o != n_i).
+ * Afocal systems (px_is_afocal) set afocal = 1 and only m, det and angular (the
+ * afocal angular magnification D n_o/n_i); the rest is zero.  Returns PX_OK, or the
+ * system's error. */
+typedef struct px_first {
+    int afocal;
+    px_mat m;                      /* the accurate system matrix */
+    double det;                    /* its determinant (Kahan) */
+    px_value power, efl, f_front, f_back, ffd, bfd;
+    px_value z_f1, z_f2, z_h1, z_h2, z_n1, z_n2;
+    px_value angular;
+} px_first;
+int px_first_order(const px_system *s, px_first *out);
+
+/* The image of the object plane at z_obj, accurately: reduced object distance
+ * d1 = (z1 - z_obj)/n_o, reduced image distance d2 = -(A d1 + B)/(C d1 + D) from
+ * plane 2 (image at z2 + n_i d2), lateral magnification 1/(C d1 + D) (not the
+ * equal A + d2 C, which cancels), angular magnification (C d1 + D) n_o/n_i.  When
+ * C d1 + D is zero within its uncertainty the object is in the first focal plane:
+ * returns PX_AT_INFINITY, sets at_infinity and exit_slope = C/n_i (an object point at
+ * height y leaves as a parallel bundle of angle exit_slope*y) and leaves d2, z_img,
+ * lateral zero. */
+typedef struct px_conj {
+    int at_infinity;
+    px_value d1, d2, z_img, lateral, angular;
+    double exit_slope;
+} px_conj;
+int px_conjugate(const px_system *s, double z_obj, px_conj *out);
+
+/* The original's angular magnification against the naked eye at the near point b:
+ * for a virtual image, (s1*m)/s2 with s1 = max(|z_obj - z1|, b) and s2 =
+ * max(|z_img - z2|, b) (eye at plane 2); for an image at infinity, -C b/n_i. */
+double px_nearpoint_angmag(const px_system *s, double nearpoint, double z_obj,
+                           const px_conj *c);
+
+/* Image of the object plane at z_obj in the original listing's arithmetic (what the
+ * classic dialogue prints).  Fills the reduced object distance, the reduced image
+ * distance d2 (image at z_last + n_img*d2) and the object-to-image matrix.  Returns
+ * 0, or PX_AT_INFINITY when the object lies in the first focal plane (the same
+ * decision as px_conjugate), in which case d2 is not set. */
 typedef struct px_image {
     double dz_obj, d2, z_img;
     px_mat obj_t, img_t, obj_to_img;
     double mag;
 } px_image;
 int px_image_plane(const px_system *s, double z_obj, px_image *out);
+
+/* Indices of a few media by name ("air", "water", "silicon", ...; case-insensitive);
+ * 0 if unknown. */
+double px_medium_index(const char *name);
+
+/* ---- calculations ---------------------------------------------------------------
+ * The document's first-order formulas as pure functions (src/paraxial/calc_*.c):
+ * sections 4, 8-10, 14, 21-26, 31.7-31.13, 37, 41, 56-58.  Lengths in the user's
+ * unit; powers in 1/unit (px_diopters converts).  Infinite distances are +-INFINITY.
+ * Functions returning int give PX_OK, PX_AT_INFINITY (a result at infinity), or
+ * PX_BAD (inputs outside the formula's domain; nothing useful is set). */
+enum { PX_BAD = 2 };
+
+typedef enum px_unit { PX_MM = 0, PX_CM = 1, PX_M = 2 } px_unit;
+double px_unit_meters(px_unit u);                   /* 1e-3, 1e-2, 1 */
+double px_diopters(double power, px_unit u);        /* 1/unit -> 1/m */
+double px_power_of_diopters(double dpt, px_unit u); /* 1/m -> 1/unit */
+
+/* Section 4: Gauss's formula n1/z1 + (n2-n1)/R = n2/z2, surface at z = 0.  z1 may be
+ * -inf.  focal_obj/focal_img are +-inf when the surface has no power (plane, n1 = n2). */
+typedef struct px_gauss {
+    double power;                 /* (n2 - n1)/R */
+    double z2, mag;               /* image plane; lateral magnification n1 z2/(n2 z1) */
+    double focal_obj, focal_img;  /* -n1 R/(n2-n1), n2 R/(n2-n1) */
+} px_gauss;
+int px_gauss_surface(double n1, double n2, double r, double z1, px_gauss *out);
+
+/* Sections 8-10, 21, 23: lens of index n, radii r1, r2 (+-inf: plane), thickness t,
+ * media n1 left and n3 right; surface 1 at z = 0, surface 2 at z = t.  Returns PX_OK,
+ * PX_AT_INFINITY (afocal: first.afocal), PX_BAD or PX_NOMEM. */
+typedef struct px_lens {
+    px_system sys;             /* the two surfaces (px_system_free it when done) */
+    px_first first;            /* matrix, power, focal lengths, cardinal points */
+    double maker_power;        /* lens maker's equation (21), any media */
+    double thin_power;         /* the thin-lens limit t -> 0 (section 10) */
+} px_lens;
+int px_thick_lens(double n1, double r1, double t, double n, double r2, double n3,
+                  px_lens *out);
+
+/* Section 57: 1/f = 1/do + 1/di with the section's signs (f > 0 converging, do > 0
+ * real object, di > 0 real image).  `unknown` is the quantity to compute; with
+ * PX_THIN_NONE each is computed from the other two, as the section's script does,
+ * and the magnification is -di'/do' of the computed di', do'. */
+enum { PX_THIN_F = 0, PX_THIN_DO = 1, PX_THIN_DI = 2, PX_THIN_NONE = 3 };
+typedef struct px_thin {
+    double f, d_o, d_i;        /* the completed (or, for NONE, computed) triple */
+    double mag, power;         /* -di/do, 1/f */
+} px_thin;
+int px_thin_equation(int unknown, double f, double d_o, double d_i, px_thin *out);
+
+/* Section 56: thin lenses f1, f2 (in air) t apart; first lens at z = 0. */
+typedef struct px_pair {
+    px_mat m;                  /* lens 1 to lens 2 */
+    int afocal;
+    double power, f;           /* 1/f1 + 1/f2 - t/(f1 f2), its reciprocal */
+    double ffd, bfd;           /* lens 1 - F1, F2 - lens 2 */
+    double z_h1, z_h2;         /* principal planes */
+} px_pair;
+int px_thin_pair(double f1, double f2, double t, px_pair *out);
+
+/* Sections 31.7-31.8: magnifier of focal length f, eye nearpoint b, object at d_o. */
+typedef struct px_magnifier {
+    double d_i, lateral;       /* virtual image distance, lateral magnification */
+    double angular;            /* b/d_o: eye at the lens */
+    double angular_limit;      /* b/f: image at infinity */
+    double best_alpha, best_d_o, best_angular; /* image at the nearpoint */
+} px_magnifier;
+int px_magnify(double f, double nearpoint, double d_o, px_magnifier *out);
+
+/* Section 31.10: objective fo, eyepiece fe, optical tube length T, nearpoint b. */
+typedef struct px_compound {
+    double d_o;                /* object distance that puts the image T past F'o */
+    double m_objective;        /* -T/fo */
+    double m_eyepiece;         /* b/fe */
+    double total;              /* -T b/(fo fe): inverted */
+    double length;             /* lens separation fo + T + fe */
+} px_compound;
+int px_compound_microscope(double fo, double fe, double tube, double nearpoint,
+                           px_compound *out);
+
+/* Sections 31.11-31.13: objective fo, eyepiece fe (< 0: Galileo), focal points
+ * coinciding; erector > 0 puts the focal points that far apart with an erector lens
+ * of focal length erector/4 midway (terrestrial).  Angular magnification = D. */
+typedef struct px_telescope {
+    px_mat m;                  /* objective to eyepiece */
+    int afocal;
+    double length, angular, erector_f;
+} px_telescope;
+int px_telescope_make(double fo, double fe, double erector, px_telescope *out);
+
+/* Section 14: least squares from n measured (object distance x, image distance y,
+ * magnification m), optical distances, 2 <= n <= PX_FIT_MAX.  `fit` fits c0 + c1 x to y (the dialogue
+ * passes GSL's, loaded from the fit module); returns 0 on success. */
+#define PX_FIT_MAX 1000
+typedef int (*px_linfit)(const double *x, const double *y, int n, double *c0,
+                         double *c1, double *sumsq);
+typedef struct px_fit {
+    px_mat m;
+    double det;                /* A D - B C of the fitted matrix */
+    double rss_cd, rss_ab;     /* residual sums of squares of the two fits */
+    double max_condition;      /* max |(A x + B) + y (C x + D)|: imaging condition */
+} px_fit;
+int px_fit_matrix(const double *x, const double *y, const double *mag, int n,
+                  px_linfit fit, px_fit *out);
+
+/* Section 24: from the focal points zf1, zf2 and principal points zh1, zh2 (z), the
+ * reference planes z1, z2 and media n1, n2.  *mismatch: relative disagreement of
+ * the two focal lengths (0 for consistent data). */
+int px_matrix_from_cardinal(double n1, double n2, double z1, double z2, double zf1,
+                            double zf2, double zh1, double zh2, px_mat *out,
+                            double *mismatch);
+/* Section 26: from the nodal points zn1, zn2 and the front and back focal lengths
+ * ffl = z1 - zf1, bfl = zf2 - z2.  Also gives the principal points. */
+int px_matrix_from_nodal(double n1, double n2, double z1, double z2, double zn1,
+                         double zn2, double ffl, double bfl, px_mat *out,
+                         double *zh1, double *zh2, double *mismatch);
+
+/* Sections 41, 57 (Examples 4-5): spectacle power (1/unit) that images an object at
+ * `target` onto the eye's near point (far: object at infinity onto the far point). */
+double px_vision_near(double nearpoint, double target);
+double px_vision_far(double farpoint);
+
+/* Sections 37: cornea as one refracting surface, power (n - 1)/R (1/unit). */
+#define PX_N_CORNEA 1.376
+#define PX_N_KERATOMETRIC 1.3375
+double px_cornea_power(double radius, double n);
+double px_cornea_radius(double power, double n);
+double px_cornea_dradius(double power, double dpower, double n);  /* |dR| */
+/* Section 37's own form: p = 1/s' = (n-1)/(n R), dR = dp/((n/(n-1)) p^2). */
+double px_cornea_doc_radius(double p, double n);
+double px_cornea_doc_dradius(double p, double dp, double n);
 
 #endif
