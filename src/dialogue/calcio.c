@@ -57,6 +57,13 @@ void calc_matrix(calc *c, px_mat m)
     calc_say(c, P(DET), px_det_accurate(m));
 }
 
+int calc_fail(calc *c, const char *msg)
+{
+    lm_say(c->io, LM_BOTH, "%s", msg);
+    fprintf(stderr, "lensmat: %s:%ld: %s", c->io->src, c->io->line, msg);
+    return LM_FAIL;
+}
+
 int calc_done(calc *c)
 {
     lm_check_leftover(c->io);

@@ -20,6 +20,7 @@ int  calc_choice(calc *c, const char *q, const char *what, const char *const *ch
 void calc_say(calc *c, const char *fmt, ...);             /* stdout and record */
 void calc_power(calc *c, const char *label, double power); /* power in 1/unit */
 void calc_matrix(calc *c, px_mat m);                      /* and its determinant */
+int  calc_fail(calc *c, const char *msg);   /* inconsistent answers: say why, LM_FAIL */
 int  calc_done(calc *c);                                  /* end of a dialogue */
 
 #endif

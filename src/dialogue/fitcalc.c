@@ -40,8 +40,7 @@ static int least_squares(calc *c)
     *(void **)&line = lm_engine_symbol("fit", "lm_fit_line");
     if (!line) return LM_FAIL;
     if (px_fit_matrix(d.x, d.y, d.m, d.n, line, &f) != PX_OK) {
-        calc_say(c, FT(BAD));
-        return LM_FAIL;
+        return calc_fail(c, FT(BAD));
     }
     calc_say(c, FT(FITTED), d.n);
     calc_matrix(c, f.m);
@@ -64,7 +63,7 @@ static int ask_frame(calc *c, double *n1, double *n2, double *z1, double *z2)
 
 static int report(calc *c, int rc, px_mat m, double mismatch)
 {
-    if (rc != PX_OK) { calc_say(c, FT(BAD)); return LM_FAIL; }
+    if (rc != PX_OK) return calc_fail(c, FT(BAD));
     calc_say(c, FT(MATRIX));
     calc_matrix(c, m);
     calc_power(c, FT(POWER), -m.c);

@@ -102,8 +102,7 @@ int lm_telescope(lm_io *io)
         return rc;
     if (px_telescope_make(fo, fe, d, &t) == PX_BAD) {
         /* Galileo's eyepiece must be weaker than the objective; erector needs fe > 0 */
-        lm_say(io, LM_BOTH, TS(NOT_AFOCAL), NAN);
-        return LM_FAIL;
+        return calc_fail(c, TS(BAD));
     }
     if (d > 0) calc_say(c, TS(TERR), t.erector_f);
     else calc_say(c, fe > 0 ? TS(ASTRO) : TS(GALILEO));
