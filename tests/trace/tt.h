@@ -8,6 +8,8 @@
 #include <string.h>
 #include "trace/trace.h"
 
+#pragma GCC diagnostic ignored "-Wunused-function"
+
 static const trace_api *tt_api(void)
 {
     const trace_api *tr = trace_get_api(TRACE_ABI);
