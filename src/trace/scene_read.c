@@ -603,7 +603,7 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
         return -1;
     if (has(&f, "tessellate")) {
         long t;
-        if (int_val(r, &f, dname, "tessellate", 1, 2000, &t)) return -1;
+        if (int_val(r, &f, dname, "tessellate", 1, 1000, &t)) return -1;
         s.tessellate = (int)t;
     }
     s.refine = has(&f, "refine");

@@ -1,0 +1,19 @@
+# src/trace/front.mk -- the trace front end's fuzzer: the scene, triangle, media and
+# OBJ readers (src/trace/scene_read.c, scene_geom.c) built alone with libFuzzer (no
+# Embree).  Included by src/trace/module.mk.  `make check` runs it briefly
+# (tests/t_65_trace_front.sh); `make fuzz` long, from the seed corpus tests/fuzz-trace.
+
+build/fuzz_trace_scene: tests/fuzz_trace_scene.c src/trace/scene_read.c \
+                        src/trace/scene_geom.c src/trace/scene.h | $(DEPS)
+	@mkdir -p $(@D)
+	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+	    -o $@ tests/fuzz_trace_scene.c src/trace/scene_read.c src/trace/scene_geom.c -lm
+
+fuzz-trace: build/fuzz_trace_scene
+	@mkdir -p build/fuzz-trace-corpus
+	build/fuzz_trace_scene -max_total_time=$${FUZZ_SECONDS:-600} -timeout=5 \
+	    build/fuzz-trace-corpus tests/fuzz-trace
+
+MODULE_TEST_BINS += build/fuzz_trace_scene
+fuzz: fuzz-trace
+.PHONY: fuzz-trace
