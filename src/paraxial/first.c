@@ -123,7 +123,9 @@ int px_conjugate(const px_system *s, double z_obj, px_conj *out)
     d1 = dd_div_d(dd_two_sum(z1, -z_obj), no);
     d1v = dd_val(d1);
     s_d1 = (fabs(z1) + fabs(z_obj)) / no + fabs(d1v);
-    l = fmax(system_scale(s, s->hi.c + s->lo.c), fabs(z1 - z_obj));
+    /* length scale of the image side: the system's length, and the focal length or
+     * the object distance, whichever is smaller (f alone is huge near afocal) */
+    l = fmax(fabs(z2 - z1), fmin(fabs(z1 - z_obj), system_scale(s, s->hi.c + s->lo.c)));
     out->d1 = length(d1v, s_d1, l);
     c = s->hi.c + s->lo.c;
     den = dd_add(dd_mul(entry(s, 2), d1), entry(s, 3));        /* C d1 + D */
