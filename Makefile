@@ -59,6 +59,9 @@ build/obj/unit_%: tests/unit_%.c $(LIBOBJ)
 	$(CC) $(BASE) $(OPT) -Itests -o $@ $< $(LIBOBJ) $(LIBS)
 build/asan/unit_%: tests/unit_%.c $(SANLIB)
 	$(CC) $(BASE) $(SAN) -Itests -o $@ $< $(SANLIB) $(LIBS)
+# The paraxial engine's benchmark (scripts/bench_paraxial.sh), linked the same way.
+build/obj/bench_paraxial: tests/bench_paraxial.c $(LIBOBJ)
+	$(CC) $(BASE) $(OPT) -o $@ $< $(LIBOBJ) $(LIBS)
 
 # libFuzzer target for the answer reader and number parser (clang from Debian): the
 # core sources (not main.c) compiled with the fuzzer's instrumentation.
@@ -89,6 +92,7 @@ build/bench/%: tests/bench/%.c | $(DEPS)
 	$(CC) $(BASE) -O2 -o $@ $<
 
 bench: lensmat build/original/lensmat build/bench/benchrun build/bench/baseline \
+       build/obj/bench_paraxial \
        $(MODULE_BENCH_BINS)
 	@sh scripts/bench.sh
 
