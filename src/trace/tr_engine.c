@@ -25,6 +25,7 @@ typedef struct tr_surf {
     double *media;             /* mesh: ntri*2 or NULL */
     long nv, ntri;
     double eps;                /* mesh: plane distances below this are "here" */
+    int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
 } tr_surf;
 
 struct trace_scene {
@@ -38,6 +39,7 @@ struct trace_scene {
     RTCScene scn;
     int built;
     double build_ms;
+    int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
 };
 
 /* The context handed to rtcIntersect1: Embree passes it on to our callbacks. */
@@ -79,6 +81,23 @@ static int fail(trace_scene *sc, int code, const char *msg)
 int tr_scene_fail(trace_scene *sc, int code, const char *msg)
 {
     return fail(sc, code, msg);
+}
+
+int tr_scene_nsurf(const trace_scene *sc) { return sc->nsurf; }
+
+const tr_shape *tr_scene_shape(const trace_scene *sc, int id)
+{
+    return id >= 0 && id < sc->nsurf && !sc->surf[id]->is_mesh ? &sc->surf[id]->shape
+                                                                 : NULL;
+}
+
+void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
+{
+    tr_surf *f = sc->surf[id];
+    f->nseq = 0;
+    for (int i = 0; i < n && i < 4; i++)
+        if (cand[i] >= 0) f->seq[f->nseq++] = cand[i];
+    sc->seq_nsurf = sc->nsurf;
 }
 
 /* ---------------- scene ---------------- */
@@ -516,6 +535,37 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
     return 1;
 }
 
+/* A ray refracted forward through a lens surface can only meet the candidates the
+ * lens named (see tr_lens.c): test those in double, else ask Embree. */
+static int find_hit(const trace_scene *sc, const trace_options *o, const double org[3],
+                    const double d[3], int last, long last_prim, uint32_t hist,
+                    tr_hitrec *h)
+{
+    if (o->sequential && !o->float_hits && last >= 0 && hist == 0 && d[2] > 0 &&
+        sc->seq_nsurf == sc->nsurf && sc->surf[last]->nseq) {
+        const tr_surf *f = sc->surf[last];
+        double best = INFINITY, t, n[3], bn[3];
+        int bs = -1;
+        for (int k = 0; k < f->nseq; k++) {
+            const tr_surf *c = sc->surf[f->seq[k]];
+            if (tr_shape_hit(&c->shape, org, d, c->id == last, &t, n) && t < best) {
+                best = t;
+                bs = c->id;
+                v_set(bn, n);
+            }
+        }
+        if (bs >= 0) {
+            front_normal(&sc->surf[bs]->shape, bn);
+            h->surf = bs;
+            h->prim = -1;
+            h->t = best;
+            v_set(h->n, bn);
+            return 1;
+        }
+    }
+    return nearest(sc, o->float_hits, org, d, last, last_prim, h);
+}
+
 /* ---------------- the trace ---------------- */
 
 typedef struct tr_tally {
@@ -607,21 +657,44 @@ static void emit_hit(tr_worker *w, const tr_wray *r, uint64_t ray, const tr_hitr
 static void s_vector(const tr_wray *r, const double n[3], double s[3])
 {
     v_cross(r->d, n, s);
-    if (v_norm(s) < 1e-12 || v_unit(s)) v_set(s, r->pol.e);
+    double l = v_norm(s);
+    if (!(l >= 1e-12)) { v_set(s, r->pol.e); return; }
+    s[0] /= l; s[1] /= l; s[2] /= l;
 }
 
-/* Push a child if it carries enough power; else count it as cut off. */
-static int push(tr_worker *w, tr_tally *ty, int *sp, const tr_wray *c, double p0)
+/* Children are built in place on the stack; keep() then decides whether they stay
+ * (enough power) or are counted as cut off. */
+static tr_wray *child(tr_worker *w, int sp, const tr_wray *r, const tr_hitrec *h)
+{
+    tr_wray *c = &w->stack[sp];
+    *c = *r;
+    c->depth = r->depth + 1;
+    c->last_surf = h->surf;
+    c->last_prim = h->prim;
+    return c;
+}
+
+static void keep(tr_worker *w, tr_tally *ty, int *sp, const tr_wray *c, double p0)
 {
     double p = c->pol.jss + c->pol.jpp;
-    if (p <= 0) return 0;
+    if (p <= 0) return;
     if (p < w->o->cutoff * p0) {
         ty->cutoff += p;
         ty->cut_power++;
-        return 0;
+        return;
     }
-    w->stack[(*sp)++] = *c;
-    return 0;
+    (*sp)++;
+}
+
+static tr_wray *reflected(tr_worker *w, int sp, const tr_wray *r, const tr_hitrec *h,
+                          const double m[3], double ci, double n1)
+{
+    tr_wray *c = child(w, sp, r, h);
+    if (r->depth < 32) c->hist |= 1u << r->depth;
+    for (int i = 0; i < 3; i++) c->d[i] = r->d[i] + 2 * ci * m[i];
+    v_unit(c->d);
+    c->n = n1;
+    return c;
 }
 
 static void interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hitrec *h,
@@ -638,56 +711,57 @@ static void interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_h
     ty->interactions++;
     s_vector(r, h->n, s);
     tr_pol_rotate(&r->pol, r->d, s);
-
-    tr_wray refl = *r, refr = *r;
-    int depth = r->depth + 1;
-    refl.depth = refr.depth = depth;
-    refl.last_surf = refr.last_surf = h->surf;
-    refl.last_prim = refr.last_prim = h->prim;
-    if (r->depth < 32) refl.hist |= 1u << r->depth;
-    for (int i = 0; i < 3; i++) refl.d[i] = r->d[i] + 2 * ci * m[i];
-    v_unit(refl.d);
-    refl.n = n1;
+    tr_wray *c;
 
     if (f->mat.kind == TRACE_MIRROR) {          /* rs = -1, rp = +1 */
-        refl.pol.jre = -refl.pol.jre;
-        refl.pol.jim = -refl.pol.jim;
-        push(w, ty, sp, &refl, p0);
+        c = reflected(w, *sp, r, h, m, ci, n1);
+        c->pol.jre = -c->pol.jre;
+        c->pol.jim = -c->pol.jim;
+        keep(w, ty, sp, c, p0);
         return;
     }
     trace_fresnel_coef fc;
     tr_fresnel(n1, n2, ci, &fc);
     if (fc.tir) {
-        double ph = fc.rs_phase - fc.rp_phase, re = refl.pol.jre, im = refl.pol.jim;
-        refl.pol.jre = cos(ph) * re - sin(ph) * im;
-        refl.pol.jim = sin(ph) * re + cos(ph) * im;
+        double ph = fc.rs_phase - fc.rp_phase, re = r->pol.jre, im = r->pol.jim;
+        c = reflected(w, *sp, r, h, m, ci, n1);
+        if (re != 0 || im != 0) {
+            c->pol.jre = cos(ph) * re - sin(ph) * im;
+            c->pol.jim = sin(ph) * re + cos(ph) * im;
+        }
         ty->tir++;
-        push(w, ty, sp, &refl, p0);
+        keep(w, ty, sp, c, p0);
         return;
     }
-    double eta = n1 / n2, k = eta * ci - fc.cos_t;
-    for (int i = 0; i < 3; i++) refr.d[i] = eta * r->d[i] + k * m[i];
-    v_unit(refr.d);
-    refr.n = n2;
     if (w->o->fresnel) {
-        double a = sqrt(fc.Ts * fc.Tp);
-        refr.pol.jss = fc.Ts * r->pol.jss;
-        refr.pol.jpp = fc.Tp * r->pol.jpp;
-        refr.pol.jre = a * r->pol.jre;
-        refr.pol.jim = a * r->pol.jim;
-        double rsp = fc.rs * fc.rp * cos(fc.rs_phase - fc.rp_phase);
-        refl.pol.jss = fc.Rs * r->pol.jss;
-        refl.pol.jpp = fc.Rp * r->pol.jpp;
-        refl.pol.jre = rsp * r->pol.jre;
-        refl.pol.jim = rsp * r->pol.jim;
-        /* reflected first on the stack: the refracted ray is traced first */
-        if (w->o->reflections) push(w, ty, sp, &refl, p0);
-        else {
-            double p = refl.pol.jss + refl.pol.jpp;
+        /* outside TIR the phases are 0 or pi: rs rp is the product of signed values */
+        double rsp = fc.rs * fc.rp * (fc.rs_phase == fc.rp_phase ? 1.0 : -1.0);
+        if (w->o->reflections) {
+            /* reflected first on the stack: the refracted ray is traced first */
+            c = reflected(w, *sp, r, h, m, ci, n1);
+            c->pol.jss = fc.Rs * r->pol.jss;
+            c->pol.jpp = fc.Rp * r->pol.jpp;
+            c->pol.jre = rsp * r->pol.jre;
+            c->pol.jim = rsp * r->pol.jim;
+            keep(w, ty, sp, c, p0);
+        } else {
+            double p = fc.Rs * r->pol.jss + fc.Rp * r->pol.jpp;
             if (p > 0) { ty->cutoff += p; ty->cut_reflection++; }
         }
     }
-    push(w, ty, sp, &refr, p0);
+    c = child(w, *sp, r, h);
+    double eta = n1 / n2, k = eta * ci - fc.cos_t;
+    for (int i = 0; i < 3; i++) c->d[i] = eta * r->d[i] + k * m[i];
+    v_unit(c->d);
+    c->n = n2;
+    if (w->o->fresnel) {
+        double a = sqrt(fc.Ts * fc.Tp);
+        c->pol.jss = fc.Ts * r->pol.jss;
+        c->pol.jpp = fc.Tp * r->pol.jpp;
+        c->pol.jre = a * r->pol.jre;
+        c->pol.jim = a * r->pol.jim;
+    }
+    keep(w, ty, sp, c, p0);
 }
 
 static void trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty)
@@ -715,7 +789,7 @@ static void trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *t
         tr_hitrec h;
         if (r.depth > ty->max_depth) ty->max_depth = r.depth;
         if (r.depth >= o->max_depth) { ty->cutoff += p; ty->cut_depth++; continue; }
-        if (!nearest(sc, o->float_hits, r.o, r.d, r.last_surf, r.last_prim, &h)) {
+        if (!find_hit(sc, o, r.o, r.d, r.last_surf, r.last_prim, r.hist, &h)) {
             for (int i = 0; i < 3; i++) q[i] = r.o[i] + o->escape_length * r.d[i];
             ty->segments++;
             ty->escaped += p;
@@ -782,6 +856,7 @@ static void options_default(trace_options *o)
     o->escape_length = 1;
     o->batch = 0;
     o->float_hits = 0;
+    o->sequential = 1;
 }
 
 static void add_tally(trace_summary *s, const tr_tally *t)

@@ -33,8 +33,8 @@ static void frame(tr_shape *g, const double up[3])
     v[0] -= k * g->w[0]; v[1] -= k * g->w[1]; v[2] -= k * g->w[2];
     if (!finite3(v) || v_norm(v) < 1e-9 * (v_norm(up) + 1e-300)) {
         /* any vector not parallel to w */
-        double a[3] = {1, 0, 0};
-        if (fabs(g->w[0]) > 0.6) { a[0] = 0; a[1] = 1; }
+        double a[3] = {0, 1, 0};             /* w = z gives the world frame */
+        if (fabs(g->w[1]) > 0.6) { a[0] = 1; a[1] = 0; }
         k = v_dot(a, g->w);
         v[0] = a[0] - k * g->w[0]; v[1] = a[1] - k * g->w[1]; v[2] = a[2] - k * g->w[2];
     }
@@ -71,17 +71,22 @@ static int sag(const tr_shape *g, double s2, double *z, double *dz)
     return 0;
 }
 
+/* Surfaces whose frame is the world's (lenses on the z axis) skip the rotation;
+ * the results are the same bits (products by exact 1 and 0). */
 static void to_local(const tr_shape *g, const double p[3], double l[3])
 {
     double q[3] = {p[0] - g->at[0], p[1] - g->at[1], p[2] - g->at[2]};
+    if (g->aligned) { l[0] = q[0]; l[1] = q[1]; l[2] = q[2]; return; }
     l[0] = v_dot(q, g->u); l[1] = v_dot(q, g->v); l[2] = v_dot(q, g->w);
 }
 static void dir_local(const tr_shape *g, const double d[3], double l[3])
 {
+    if (g->aligned) { l[0] = d[0]; l[1] = d[1]; l[2] = d[2]; return; }
     l[0] = v_dot(d, g->u); l[1] = v_dot(d, g->v); l[2] = v_dot(d, g->w);
 }
 static void to_world_dir(const tr_shape *g, const double l[3], double d[3])
 {
+    if (g->aligned) { d[0] = l[0]; d[1] = l[1]; d[2] = l[2]; return; }
     for (int i = 0; i < 3; i++)
         d[i] = l[0] * g->u[i] + l[1] * g->v[i] + l[2] * g->w[i];
 }
@@ -249,6 +254,9 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
         return -1;
     }
     pad_box(g);
+    g->aligned = g->u[0] == 1 && g->u[1] == 0 && g->u[2] == 0 && g->v[0] == 0 &&
+                 g->v[1] == 1 && g->v[2] == 0 && g->w[0] == 0 && g->w[1] == 0 &&
+                 g->w[2] == 1;
     return 0;
 }
 

@@ -44,6 +44,7 @@ typedef struct tr_shape {
     double hw, hh;             /* rectangle half width (along u), half height (v) */
     double scale;              /* size, for tolerances */
     double lo[3], hi[3];       /* world bounds */
+    int aligned;               /* u, v, w are the world's x, y, z */
 } tr_shape;
 
 /* Validates and prepares; 0, or -1 with a message in err. */
@@ -101,6 +102,12 @@ void tr_source_ray(const tr_source *ts, long i, tr_ray0 *r);
 int tr_add_lens(trace_scene *sc, const trace_lens *lens);
 int tr_lens_fan(const trace_lens *lens, double z_obj, double y_obj, double z_paraxial,
                 int nrays, const double *h, trace_fan_ray *out, char *err, size_t cap);
+
+/* Lens hints (tr_engine.c): after refraction at surface id a forward ray can only
+ * meet cand[0..n-1] (-1 entries skipped); valid until another surface is added. */
+void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n);
+int tr_scene_nsurf(const trace_scene *sc);
+const tr_shape *tr_scene_shape(const trace_scene *sc, int id);
 
 /* Set the scene's message; returns code. */
 int tr_scene_fail(trace_scene *sc, int code, const char *msg);

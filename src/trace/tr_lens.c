@@ -57,6 +57,39 @@ static double sphere_sag(double r, double s)
     return c * s * s / (1 + sqrt(fmax(0.0, 1 - c * c * s * s)));
 }
 
+/* z range of surface i with its mount */
+static void zrange(const trace_scene *sc, int lens, int mount, double *lo, double *hi)
+{
+    const tr_shape *a = tr_scene_shape(sc, lens);
+    *lo = a->lo[2];
+    *hi = a->hi[2];
+    if (mount >= 0) {
+        const tr_shape *b = tr_scene_shape(sc, mount);
+        *lo = fmin(*lo, b->lo[2]);
+        *hi = fmax(*hi, b->hi[2]);
+    }
+}
+
+/* When every surface (with its mount) lies in its own z slab, in order, a ray leaving
+ * surface i forward can only meet surface i or its mount, or surface i+1 or its mount
+ * (or the detector after the last): tell the engine so. */
+static void set_hints(trace_scene *sc, int n, const int *lid, const int *mid, int det)
+{
+    double lo, hi, plo, phi;
+    zrange(sc, lid[0], mid[0], &plo, &phi);
+    for (int i = 1; i < n; i++) {
+        zrange(sc, lid[i], mid[i], &lo, &hi);
+        if (!(lo > phi)) return;
+        phi = hi;
+    }
+    if (det >= 0 && !(tr_scene_shape(sc, det)->lo[2] > phi)) return;
+    for (int i = 0; i < n; i++) {
+        int c[4] = {lid[i], mid[i], i + 1 < n ? lid[i + 1] : det, i + 1 < n ? mid[i + 1] : -1};
+        if (i + 1 == n && det < 0) continue;
+        tr_scene_set_seq(sc, lid[i], c, 4);
+    }
+}
+
 int tr_add_lens(trace_scene *sc, const trace_lens *l)
 {
     const trace_api *tr = trace_get_api(TRACE_ABI);
@@ -65,6 +98,10 @@ int tr_add_lens(trace_scene *sc, const trace_lens *l)
     if (!sc) return TRACE_EINVAL;
     if (check_lens(l, err, sizeof err)) return tr_scene_fail(sc, TRACE_EINVAL, err);
     double L = lens_scale(l);
+    int alone = tr_scene_nsurf(sc) == 0, det = -1;
+    int *lid = malloc((size_t)l->nsurf * 2 * sizeof(int)), *mid;
+    if (!lid) return tr_scene_fail(sc, TRACE_ENOMEM, "out of memory");
+    mid = lid + l->nsurf;
     for (int i = 0; i < l->nsurf; i++) {
         const trace_lens_surface *ls = &l->surf[i];
         trace_surface s;
@@ -77,8 +114,10 @@ int tr_add_lens(trace_scene *sc, const trace_lens *l)
         s.radius = isfinite(ls->radius) ? ls->radius : 0;
         s.aperture = TRACE_AP_DISC;
         s.r_outer = ls->semi_diameter > 0 ? ls->semi_diameter : s.radius == 0 ? 10 * L : 0;
-        if ((id = tr->add_surface(sc, &s, &m)) < 0) return id;
+        if ((id = tr->add_surface(sc, &s, &m)) < 0) { free(lid); return id; }
         if (first < 0) first = id;
+        lid[i] = id;
+        mid[i] = -1;
         if (l->mounts && ls->semi_diameter > 0) {
             trace_surface a;
             trace_material ma = {TRACE_ABSORB, m.n_front, m.n_back};
@@ -89,7 +128,8 @@ int tr_add_lens(trace_scene *sc, const trace_lens *l)
             a.aperture = TRACE_AP_DISC;
             a.r_inner = ls->semi_diameter;
             a.r_outer = fmax(4 * ls->semi_diameter, 10 * L);
-            if ((id = tr->add_surface(sc, &a, &ma)) < 0) return id;
+            if ((id = tr->add_surface(sc, &a, &ma)) < 0) { free(lid); return id; }
+            mid[i] = id;
         }
     }
     if (isfinite(l->z_detector)) {
@@ -102,8 +142,11 @@ int tr_add_lens(trace_scene *sc, const trace_lens *l)
         d.axis[2] = 1;
         d.aperture = TRACE_AP_DISC;
         d.r_outer = 100 * L + fabs(l->z_detector - l->surf[0].z);
-        if ((id = tr->add_surface(sc, &d, &md)) < 0) return id;
+        if ((id = tr->add_surface(sc, &d, &md)) < 0) { free(lid); return id; }
+        det = id;
     }
+    if (alone) set_hints(sc, l->nsurf, lid, mid, det);
+    free(lid);
     return first;
 }
 

@@ -80,11 +80,13 @@ int tr_refract(const double d[3], const double nrm[3], double n1, double n2,
 void tr_pol_rotate(tr_pol *p, const double d[3], const double s[3])
 {
     double f[3];
+    if (p->jss == p->jpp && p->jre == 0 && p->jim == 0) {   /* isotropic: J = J */
+        v_set(p->e, s);
+        return;
+    }
     v_cross(d, p->e, f);
+    /* e, f and s are unit and perpendicular to d: c^2 + sn^2 = 1 to rounding */
     double c = v_dot(p->e, s), sn = v_dot(f, s);
-    double l = sqrt(c * c + sn * sn);
-    if (!(l > 0)) { v_set(p->e, s); return; }
-    c /= l; sn /= l;
     if (c == 1.0 && sn == 0.0) { v_set(p->e, s); return; }
     double a = p->jss, b = p->jpp, re = p->jre, im = p->jim;
     double cc = c * c, ss = sn * sn, cs = c * sn;

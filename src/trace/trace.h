@@ -167,6 +167,10 @@ typedef struct trace_options {
     int float_hits;        /* 1: take hits as a single-precision tracer computes them
                               (no double refinement) -- only to measure what double
                               buys; never for real work (default 0) */
+    int sequential;        /* 1: in a scene made by add_lens alone, a ray refracted
+                              forward goes to the next surface without the BVH when
+                              the surfaces' z ranges are disjoint -- the same hits,
+                              bit for bit, faster (default); 0: always ask Embree */
 } trace_options;
 
 /* Records handed to sinks. */
