@@ -82,6 +82,21 @@ else
     fail "trace module not built (build/lib/lensmat-trace.so, build/asan/lib/lensmat-trace.so)"
 fi
 
+# Results must not depend on the thread count: 1 and 2 threads, same bytes.
+threads_same() {
+    for t in 1 2; do
+        mkdir -p "$TW/th$t"
+        sed -e "s/^output hits .*/output hits h.csv/" -e "s/^output summary .*/output summary s.txt/" \
+            "$SCENES/singlet.scene" > "$TW/th$t/a.scene"
+        echo "threads $t" >> "$TW/th$t/a.scene"
+        echo "output segments p.l" >> "$TW/th$t/a.scene"
+        tr_session "$BIN" "$TW/th$t" scene a.scene n || return 1
+    done
+    for f in h.csv s.txt p.l; do cmp "$TW/th1/$f" "$TW/th2/$f" || return 1; done
+    [ "$(wc -l < "$TW/th1/h.csv")" -gt 100 ]
+}
+check "trace: hits, segments and summary identical on 1 and 2 threads" threads_same
+
 # ---- malformed input: clear message with file and line, exit 2, answer not echoed --
 
 # bad_case NAME MESSAGE: scene $TW/bad/NAME.scene (with its files) must be refused
