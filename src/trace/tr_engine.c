@@ -577,7 +577,7 @@ typedef struct tr_tally {
 
 typedef struct tr_wray {
     double o[3], d[3];
-    double power, n, len, opl;
+    double n, len, opl;
     tr_pol pol;
     int depth, last_surf;
     long last_prim;
@@ -659,46 +659,32 @@ static void s_vector(const tr_wray *r, const double n[3], double s[3])
     v_cross(r->d, n, s);
     double l = v_norm(s);
     if (!(l >= 1e-12)) { v_set(s, r->pol.e); return; }
-    s[0] /= l; s[1] /= l; s[2] /= l;
+    l = 1.0 / l;
+    s[0] *= l; s[1] *= l; s[2] *= l;
 }
 
-/* Children are built in place on the stack; keep() then decides whether they stay
- * (enough power) or are counted as cut off. */
-static tr_wray *child(tr_worker *w, int sp, const tr_wray *r, const tr_hitrec *h)
+/* Does a ray of power p go on?  Else it is counted as cut off. */
+static int strong(const tr_worker *w, tr_tally *ty, double p, double p0)
 {
-    tr_wray *c = &w->stack[sp];
-    *c = *r;
-    c->depth = r->depth + 1;
-    c->last_surf = h->surf;
-    c->last_prim = h->prim;
-    return c;
+    if (p <= 0) return 0;
+    if (p < w->o->cutoff * p0) {
+        ty->cutoff += p;
+        ty->cut_power++;
+        return 0;
+    }
+    return 1;
 }
 
 static void keep(tr_worker *w, tr_tally *ty, int *sp, const tr_wray *c, double p0)
 {
-    double p = c->pol.jss + c->pol.jpp;
-    if (p <= 0) return;
-    if (p < w->o->cutoff * p0) {
-        ty->cutoff += p;
-        ty->cut_power++;
-        return;
-    }
-    (*sp)++;
+    if (strong(w, ty, c->pol.jss + c->pol.jpp, p0)) (*sp)++;
 }
 
-static tr_wray *reflected(tr_worker *w, int sp, const tr_wray *r, const tr_hitrec *h,
-                          const double m[3], double ci, double n1)
-{
-    tr_wray *c = child(w, sp, r, h);
-    if (r->depth < 32) c->hist |= 1u << r->depth;
-    for (int i = 0; i < 3; i++) c->d[i] = r->d[i] + 2 * ci * m[i];
-    v_unit(c->d);
-    c->n = n1;
-    return c;
-}
-
-static void interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hitrec *h,
-                     const tr_surf *f, double p0)
+/* The interaction at h: a reflected ray that must wait is pushed on the stack; the
+ * ray that goes on now (refracted, or reflected at a mirror or TIR) replaces *r.
+ * Returns 1 if *r goes on. */
+static int interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hitrec *h,
+                    const tr_surf *f, double p0)
 {
     double n1 = f->mat.n_front, n2 = f->mat.n_back, s[3], m[3];
     if (f->media && h->prim >= 0) { n1 = f->media[2 * h->prim]; n2 = f->media[2 * h->prim + 1]; }
@@ -711,34 +697,43 @@ static void interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_h
     ty->interactions++;
     s_vector(r, h->n, s);
     tr_pol_rotate(&r->pol, r->d, s);
-    tr_wray *c;
+    r->depth++;
+    r->last_surf = h->surf;
+    r->last_prim = h->prim;
 
     if (f->mat.kind == TRACE_MIRROR) {          /* rs = -1, rp = +1 */
-        c = reflected(w, *sp, r, h, m, ci, n1);
-        c->pol.jre = -c->pol.jre;
-        c->pol.jim = -c->pol.jim;
-        keep(w, ty, sp, c, p0);
-        return;
+        if (r->depth <= 32) r->hist |= 1u << (r->depth - 1);
+        for (int i = 0; i < 3; i++) r->d[i] += 2 * ci * m[i];
+        v_unit(r->d);
+        r->pol.jre = -r->pol.jre;
+        r->pol.jim = -r->pol.jim;
+        return strong(w, ty, r->pol.jss + r->pol.jpp, p0);
     }
     trace_fresnel_coef fc;
     tr_fresnel(n1, n2, ci, &fc);
     if (fc.tir) {
         double ph = fc.rs_phase - fc.rp_phase, re = r->pol.jre, im = r->pol.jim;
-        c = reflected(w, *sp, r, h, m, ci, n1);
+        if (r->depth <= 32) r->hist |= 1u << (r->depth - 1);
+        for (int i = 0; i < 3; i++) r->d[i] += 2 * ci * m[i];
+        v_unit(r->d);
         if (re != 0 || im != 0) {
-            c->pol.jre = cos(ph) * re - sin(ph) * im;
-            c->pol.jim = sin(ph) * re + cos(ph) * im;
+            r->pol.jre = cos(ph) * re - sin(ph) * im;
+            r->pol.jim = sin(ph) * re + cos(ph) * im;
         }
         ty->tir++;
-        keep(w, ty, sp, c, p0);
-        return;
+        return strong(w, ty, r->pol.jss + r->pol.jpp, p0);
     }
     if (w->o->fresnel) {
         /* outside TIR the phases are 0 or pi: rs rp is the product of signed values */
         double rsp = fc.rs * fc.rp * (fc.rs_phase == fc.rp_phase ? 1.0 : -1.0);
         if (w->o->reflections) {
-            /* reflected first on the stack: the refracted ray is traced first */
-            c = reflected(w, *sp, r, h, m, ci, n1);
+            /* the reflected ray waits on the stack; the refracted one goes first */
+            tr_wray *c = &w->stack[*sp];
+            *c = *r;
+            if (r->depth <= 32) c->hist |= 1u << (r->depth - 1);
+            for (int i = 0; i < 3; i++) c->d[i] = r->d[i] + 2 * ci * m[i];
+            v_unit(c->d);
+            c->n = n1;
             c->pol.jss = fc.Rs * r->pol.jss;
             c->pol.jpp = fc.Rp * r->pol.jpp;
             c->pol.jre = rsp * r->pol.jre;
@@ -749,42 +744,44 @@ static void interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_h
             if (p > 0) { ty->cutoff += p; ty->cut_reflection++; }
         }
     }
-    c = child(w, *sp, r, h);
     double eta = n1 / n2, k = eta * ci - fc.cos_t;
-    for (int i = 0; i < 3; i++) c->d[i] = eta * r->d[i] + k * m[i];
-    v_unit(c->d);
-    c->n = n2;
+    for (int i = 0; i < 3; i++) r->d[i] = eta * r->d[i] + k * m[i];
+    v_unit(r->d);
+    r->n = n2;
     if (w->o->fresnel) {
         double a = sqrt(fc.Ts * fc.Tp);
-        c->pol.jss = fc.Ts * r->pol.jss;
-        c->pol.jpp = fc.Tp * r->pol.jpp;
-        c->pol.jre = a * r->pol.jre;
-        c->pol.jim = a * r->pol.jim;
+        r->pol.jss *= fc.Ts;
+        r->pol.jpp *= fc.Tp;
+        r->pol.jre *= a;
+        r->pol.jim *= a;
     }
-    keep(w, ty, sp, c, p0);
+    return strong(w, ty, r->pol.jss + r->pol.jpp, p0);
 }
 
 static void trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty)
 {
     const trace_scene *sc = w->sc;
     const trace_options *o = w->o;
-    int sp = 0;
-    tr_wray *r0w = &w->stack[sp++];
+    int sp = 0, live = 1;
+    tr_wray r;
     memset(ty, 0, sizeof *ty);
-    v_set(r0w->o, r0->o);
-    v_set(r0w->d, r0->d);
-    r0w->power = r0->power;
-    r0w->n = r0->n;
-    r0w->len = r0w->opl = 0;
-    r0w->pol = r0->pol;
-    r0w->depth = 0;
-    r0w->last_surf = -1;
-    r0w->last_prim = -1;
-    r0w->hist = 0;
+    v_set(r.o, r0->o);
+    v_set(r.d, r0->d);
+    r.n = r0->n;
+    r.len = r.opl = 0;
+    r.pol = r0->pol;
+    r.depth = 0;
+    r.last_surf = -1;
+    r.last_prim = -1;
+    r.hist = 0;
     double p0 = r0->pol.jss + r0->pol.jpp;
     ty->emitted = p0;
-    while (sp > 0) {
-        tr_wray r = w->stack[--sp];
+    for (;;) {
+        if (!live) {
+            if (sp == 0) break;
+            r = w->stack[--sp];
+        }
+        live = 0;
         double p = r.pol.jss + r.pol.jpp, q[3];
         tr_hitrec h;
         if (r.depth > ty->max_depth) ty->max_depth = r.depth;
@@ -824,7 +821,7 @@ static void trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *t
         default:
             emit_segment(w, &r, ray, q, TRACE_END_NONE, h.surf);
             v_set(r.o, q);
-            interact(w, ty, &sp, &r, &h, f, p0);
+            live = interact(w, ty, &sp, &r, &h, f, p0);
         }
     }
 }

@@ -314,8 +314,8 @@ static void axial_normal_local(const tr_shape *g, const double p[3], double nl[3
         nl[1] = -2 * p[1] * dz;
         nl[2] = 1.0;
     }
-    double l = sqrt(nl[0] * nl[0] + nl[1] * nl[1] + nl[2] * nl[2]);
-    nl[0] /= l; nl[1] /= l; nl[2] /= l;
+    double l = 1.0 / sqrt(nl[0] * nl[0] + nl[1] * nl[1] + nl[2] * nl[2]);
+    nl[0] *= l; nl[1] *= l; nl[2] *= l;
 }
 
 /* On the vertex branch of the conic and inside the aperture? */

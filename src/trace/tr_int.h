@@ -26,7 +26,8 @@ static inline int v_unit(double a[3])
 {
     double l = v_norm(a);
     if (!(l > 0) || !isfinite(l)) return -1;
-    a[0] /= l; a[1] /= l; a[2] /= l;
+    double r = 1.0 / l;
+    a[0] *= r; a[1] *= r; a[2] *= r;
     return 0;
 }
 static inline void v_set(double d[3], const double s[3]) { d[0] = s[0]; d[1] = s[1]; d[2] = s[2]; }

@@ -42,17 +42,19 @@ void tr_fresnel(double n1, double n2, double ci, trace_fresnel_coef *f)
         f->Rs = f->Rp = 1; f->Ts = f->Tp = 0;
         return;
     }
-    f->rs = (n1 * ci - n2 * ct) / ds;
-    f->rp = (n2 * ci - n1 * ct) / dp;
-    f->ts = 2 * n1 * ci / ds;
-    f->tp = 2 * n1 * ci / dp;
+    double is = 1.0 / ds, ip = 1.0 / dp;
+    f->rs = (n1 * ci - n2 * ct) * is;
+    f->rp = (n2 * ci - n1 * ct) * ip;
+    f->ts = 2 * n1 * ci * is;
+    f->tp = 2 * n1 * ci * ip;
     if (f->rs < 0) { f->rs = -f->rs; f->rs_phase = TR_PI; }
     if (f->rp < 0) { f->rp = -f->rp; f->rp_phase = TR_PI; }
     f->Rs = f->rs * f->rs;
     f->Rp = f->rp * f->rp;
     /* T = (n2 cos_t / n1 cos_i) t^2, without dividing by cos_i */
-    f->Ts = 4 * n1 * n2 * ci * ct / (ds * ds);
-    f->Tp = 4 * n1 * n2 * ci * ct / (dp * dp);
+    double q = 4 * n1 * n2 * ci * ct;
+    f->Ts = q * is * is;
+    f->Tp = q * ip * ip;
 }
 
 int tr_refract(const double d[3], const double nrm[3], double n1, double n2,
