@@ -40,6 +40,8 @@ struct trace_scene {
     int built;
     double build_ms;
     int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
+    int entry[4], nentry;      /* lens: what a forward ray from left of it meets first */
+    double entry_z;            /* ... if it starts at z < entry_z */
 };
 
 /* The context handed to rtcIntersect1: Embree passes it on to our callbacks. */
@@ -89,6 +91,14 @@ const tr_shape *tr_scene_shape(const trace_scene *sc, int id)
 {
     return id >= 0 && id < sc->nsurf && !sc->surf[id]->is_mesh ? &sc->surf[id]->shape
                                                                  : NULL;
+}
+
+void tr_scene_set_entry(trace_scene *sc, const int *cand, int n, double z)
+{
+    sc->nentry = 0;
+    for (int i = 0; i < n && i < 4; i++)
+        if (cand[i] >= 0) sc->entry[sc->nentry++] = cand[i];
+    sc->entry_z = z;
 }
 
 void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
@@ -541,13 +551,15 @@ static int find_hit(const trace_scene *sc, const trace_options *o, const double 
                     const double d[3], int last, long last_prim, uint32_t hist,
                     tr_hitrec *h)
 {
-    if (o->sequential && !o->float_hits && last >= 0 && hist == 0 && d[2] > 0 &&
-        sc->seq_nsurf == sc->nsurf && sc->surf[last]->nseq) {
-        const tr_surf *f = sc->surf[last];
+    if (o->sequential && !o->float_hits && hist == 0 && d[2] > 0 &&
+        sc->seq_nsurf == sc->nsurf &&
+        (last >= 0 ? sc->surf[last]->nseq > 0 : sc->nentry > 0 && org[2] < sc->entry_z)) {
+        const int *cand = last >= 0 ? sc->surf[last]->seq : sc->entry;
+        int nc = last >= 0 ? sc->surf[last]->nseq : sc->nentry;
         double best = INFINITY, t, n[3], bn[3];
         int bs = -1;
-        for (int k = 0; k < f->nseq; k++) {
-            const tr_surf *c = sc->surf[f->seq[k]];
+        for (int k = 0; k < nc; k++) {
+            const tr_surf *c = sc->surf[cand[k]];
             if (tr_shape_hit(&c->shape, org, d, c->id == last, &t, n) && t < best) {
                 best = t;
                 bs = c->id;

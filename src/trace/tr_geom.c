@@ -370,7 +370,11 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
         else tmin = 1e-9 * g->scale;
     }
     double disc = B * B - A * C;
-    if (disc < 0) {
+    if (leaving && !g->nasph) {
+        /* roots 0 and -2B/A (what the general branch gives, sqrt(B^2) being |B|) */
+        if (A == 0) return 0;
+        r[nr++] = -2 * B / A;
+    } else if (disc < 0) {
         if (!g->nasph) return 0;
         r[nr++] = ld[2] != 0 ? -lo[2] / ld[2] : 0;     /* start from the vertex plane */
     } else {

@@ -108,6 +108,8 @@ int tr_lens_fan(const trace_lens *lens, double z_obj, double y_obj, double z_par
  * meet cand[0..n-1] (-1 entries skipped); valid until another surface is added. */
 void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n);
 int tr_scene_nsurf(const trace_scene *sc);
+/* ... and a forward ray starting at z < z meets cand[] first (or misses them). */
+void tr_scene_set_entry(trace_scene *sc, const int *cand, int n, double z);
 const tr_shape *tr_scene_shape(const trace_scene *sc, int id);
 
 /* Set the scene's message; returns code. */

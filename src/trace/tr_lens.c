@@ -77,12 +77,15 @@ static void set_hints(trace_scene *sc, int n, const int *lid, const int *mid, in
 {
     double lo, hi, plo, phi;
     zrange(sc, lid[0], mid[0], &plo, &phi);
+    double first_lo = plo;
     for (int i = 1; i < n; i++) {
         zrange(sc, lid[i], mid[i], &lo, &hi);
         if (!(lo > phi)) return;
         phi = hi;
     }
     if (det >= 0 && !(tr_scene_shape(sc, det)->lo[2] > phi)) return;
+    int e[2] = {lid[0], mid[0]};
+    tr_scene_set_entry(sc, e, 2, first_lo);
     for (int i = 0; i < n; i++) {
         int c[4] = {lid[i], mid[i], i + 1 < n ? lid[i + 1] : det, i + 1 < n ? mid[i + 1] : -1};
         if (i + 1 == n && det < 0) continue;
