@@ -48,3 +48,13 @@ check "classic default: cardinal points of a nearly afocal telescope flagged" \
            [ \$(grep -c '  (ill-conditioned: relative condition' d.rec) -eq 8 ] &&
            '$BIN' --original o.rec < detuned.in > /dev/null &&
            ! grep -q 'ill-conditioned' o.rec"
+
+# detuned by 5e-13 (a few ulps of 110): still focal, but no digit of the principal
+# planes survives: "undetermined" instead of a number, in default mode only
+printf '25\n1\n100\n0\n1.5\ny\n-100\n0\n1\ny\n10\n110.0000000000005\n1.5\ny\n-10\n110.0000000000005\n1\nn\n-1000\nn\n' \
+    > "$WORK/hopeless.in"
+check "classic default: results with no digit left print 'undetermined'" \
+    sh -c "cd '$WORK' && '$BIN' h.rec < hopeless.in > /dev/null &&
+           grep -q '^Principal plane 1, z= undetermined (relative condition' h.rec &&
+           '$BIN' --original ho.rec < hopeless.in > /dev/null &&
+           grep -Eq '^Principal plane 1, z= -?[0-9.e+]+ $' ho.rec"

@@ -488,8 +488,47 @@ static void test_sensitivity_bound(void)
           "... and the sensitivity is not a gross overestimate");
 }
 
+/* The original's magnifier figure: f = 3, near point 25. */
+static void test_nearpoint_angmag(void)
+{
+    px_system s;
+    px_conj c;
+    px_system_init(&s, 1);
+    px_system_surface(&s, 3, 1.5);
+    px_system_surface(&s, -3, 1);
+    px_conjugate(&s, -2, &c);    /* virtual image at -6, m = 3: both inside 25 */
+    CHECK(fabs(px_nearpoint_angmag(&s, 25, -2, &c) - 3) < 1e-14, "magnifier, image inside "
+          "the near point: s1 m/s2 = 25*3/25 = 3");
+    px_conjugate(&s, -2.9, &c);  /* virtual image at -87, m = 30 */
+    CHECK(fabs(px_nearpoint_angmag(&s, 25, -2.9, &c) - 25 * 30 / 87.0) < 1e-12,
+          "magnifier, image beyond the near point: 25*30/87");
+    CHECK(px_conjugate(&s, -3, &c) == PX_AT_INFINITY &&
+              fabs(px_nearpoint_angmag(&s, 25, -3, &c) - 25 / 3.0) < 1e-14,
+          "object in the focal plane: b/f = 8.333");
+    px_system_free(&s);
+}
+
+/* px_mul_fma against px_mul on a 10 000-matrix relay product: the fma product keeps
+ * |det - 1| at least as small. */
+static void test_mul_fma(void)
+{
+    px_mat p = px_identity(), q = px_identity(), t = px_translation(2 * 37.3),
+           l = px_refraction(1, 1.5, 37.3), l2 = px_refraction(1.5, 1, -37.3);
+    px_mat cell = px_mul(px_mul(t, l2), l);
+    for (int i = 0; i < 5000; i++) {
+        p = px_mul_fma(cell, p);
+        q = px_mul(cell, q);
+    }
+    CHECK(fabs(px_det_accurate(p) - 1) < 1e-12 &&
+              fabs(px_det_accurate(p) - 1) <= fabs(px_det_accurate(q) - 1) + 1e-15,
+          "fma product of 5000 relay cells: |det - 1| = %.3g (plain %.3g)",
+          fabs(px_det_accurate(p) - 1), fabs(px_det_accurate(q) - 1));
+}
+
 int main(void)
 {
+    test_nearpoint_angmag();
+    test_mul_fma();
     size_t n = sizeof cases / sizeof *cases;
     for (size_t i = 0; i < n; i++) run_case(&cases[i]);
     CHECK(n >= 30, "%zu extreme prescriptions in the table", n);

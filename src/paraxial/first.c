@@ -42,7 +42,7 @@ int px_ill_conditioned(px_value v) { return v.cond > PX_ILL_CONDITIONED; }
 
 int px_digits_meaningful(px_value v, int digits)
 {
-    return DBL_EPSILON * v.cond <= 0.5 * pow(10, 1 - digits);
+    return DBL_EPSILON * v.cond <= pow(10, -digits);
 }
 
 static dd entry(const px_system *s, int i)

@@ -87,7 +87,8 @@ typedef struct px_value {
  * digits to its inputs' rounding: reports say so instead of printing it bare. */
 #define PX_ILL_CONDITIONED 1e8
 int px_ill_conditioned(px_value v);
-/* Are the printed digits of v (printf %g, `digits` significant) all meaningful? */
+/* Does v keep `digits` significant digits: relative error bound DBL_EPSILON * cond
+ * at most 10^-digits? */
 int px_digits_meaningful(px_value v, int digits);
 
 /* Is C zero within what the inputs' rounding can produce?  (Scale-aware: compared
