@@ -199,6 +199,18 @@ check "lens fan: spherical aberration is negative and grows with height" sh -c "
          /^Near the axis/ { on = 0; prev = 0 } END { exit bad }' '$TW/lens/e.rec' &&
     grep -q '^  10\.8  .*-3\.74' '$TW/lens/e.rec'"
 
+# A lens of 11 surfaces under ASan (the paraxial system keeps long lenses on the heap):
+# traced, and nothing leaks.
+long_lens() {
+    d=$TW/long; rm -rf "$d"; mkdir -p "$d"
+    { printf 'lens\n1\n'; i=1
+      while [ $i -le 10 ]; do printf '100\n%d\n1.5\n10\ny\n' $((2 * i)); i=$((i + 1)); done
+      printf -- '-100\n22\n1\n10\nn\ninf\n0.5\nn\nn\n'; } > "$d/in"
+    (cd "$d" && "$ASAN" --trace -i in r.rec > out 2> err) || { cat "$d/err"; return 1; }
+    [ ! -s "$d/err" ] && grep -q 'meets the paraxial image' "$d/r.rec"
+}
+check "lens fan asan: 11 surfaces, no leak" long_lens
+
 # ---- the tessellation table: errors shrink with tessellation, refinement is exact ----
 tess_table() {
     d=$TW/tess; rm -rf "$d"

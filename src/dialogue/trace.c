@@ -261,6 +261,7 @@ static int do_lens(tdlg *t)
             goto out;
     } while (more);
 out:
+    px_system_free(&l->sys);   /* zeroed by calloc if never initialised */
     free(l);
     return rc;
 }
@@ -326,10 +327,12 @@ static int tess_table(tdlg *t)
     px_system_translate(&l.sys, sp.thickness);
     px_system_refract(&l.sys, sp.r2, 1);
     if (px_is_afocal(&l.sys)) {
+        px_system_free(&l.sys);
         lm_say(io, LM_BOTH, "%s", P(T_NO_FOCUS));
         return LM_GO;
     }
     paraxial_image(&l, -INFINITY, &sp.z_detector);
+    px_system_free(&l.sys);
     sp.beam_radius = 0.9 * sp.aperture;
     sp.levels = levels;
     sp.nlevels = NL;
