@@ -3,7 +3,7 @@
 # AddressSanitizer and UBSan; `make bench` prints BENCH lines; `make fuzz` fuzzes long.
 # Engines that need big libraries (Embree, OpenCV, libgpiod) are built as modules
 # under build/lib/ that lensmat loads only when a dialogue first uses them; each
-# brings its own src/ENGINE/module.mk.
+# brings its own src/ENGINE/*.mk.
 
 CC      ?= cc
 CLANG   ?= clang
@@ -82,7 +82,7 @@ TEST_BINS := lensmat build/asan/lensmat build/fuzz_answers build/original/lensma
              $(patsubst tests/%.c,build/obj/%,$(UNIT)) \
              $(patsubst tests/%.c,build/asan/%,$(UNIT))
 
--include $(wildcard src/*/module.mk)
+-include $(wildcard src/*/*.mk)
 
 check: $(TEST_BINS) $(MODULE_TEST_BINS)
 	@sh tests/run.sh
