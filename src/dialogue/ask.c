@@ -162,7 +162,7 @@ static int next_token(lm_io *io, char *tok)
  * (LM_GO).  Replay: FILE:LINE message and LM_FAIL. */
 static int complain(lm_io *io, const char *what, const char *fmt, const char *tok)
 {
-    char msg[512];
+    char msg[1200];
     snprintf(msg, sizeof msg, fmt, tok);
     if (io->interactive) {
         fprintf(stderr, "lensmat: %s: %s; please answer again.\n", what, msg);
@@ -290,7 +290,7 @@ int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
                 int (*check)(void *ctx, const char *word, char *msg, size_t cap),
                 void *ctx, char *buf, size_t cap)
 {
-    char tok[LM_TOKEN_MAX], msg[256];
+    char tok[LM_TOKEN_MAX], msg[1024];
     if (rec) lm_say(io, LM_REC, "%s", rec);
     for (;;) {
         int r;
