@@ -110,7 +110,9 @@ int lm_telescope(lm_io *io)
     calc_power(c, TS(EYEPIECE), 1 / fe);
     calc_say(c, TS(LENGTH), CL(t.length));
     calc_say(c, TS(MATRIX));
-    calc_matrix(c, t.m);
+    /* C is zero within its rounding (that is what afocal means): print it as 0, not
+     * as the 1e-17 of round-off the product leaves */
+    calc_matrix(c, t.afocal ? (px_mat){t.m.a, t.m.b, 0.0, t.m.d} : t.m);
     if (t.afocal) calc_say(c, TS(AFOCAL), CL(t.angular), CL(fo / fe));
     else calc_say(c, TS(NOT_AFOCAL), t.m.c);
     return calc_done(c);
