@@ -9,6 +9,11 @@
 #include <stdint.h>
 #include "trace.h"
 
+/* Everything declared below stays inside the module (only trace_get_api, declared in
+ * trace.h above, is exported): calls between the engine's files then go direct, not
+ * through the PLT, and may be inlined. */
+#pragma GCC visibility push(hidden)
+
 #define TR_PI 3.14159265358979323846
 
 /* ---- small vector helpers ---- */
@@ -118,4 +123,5 @@ int tr_scene_fail(trace_scene *sc, int code, const char *msg);
 void tr_set_err(char *err, size_t cap, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+#pragma GCC visibility pop
 #endif
