@@ -546,35 +546,67 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
 }
 
 /* A ray refracted forward through a lens surface can only meet the candidates the
- * lens named (see tr_lens.c): test those in double, else ask Embree. */
+ * lens named (see tr_lens.c).  Does that hold for this ray?  Then cand[0..*nc-1]. */
+static inline int seq_cands(const trace_scene *sc, const trace_options *o,
+                            const double org[3], const double d[3], int last,
+                            uint32_t hist, const int **cand, int *nc)
+{
+    if (!(o->sequential && !o->float_hits && hist == 0 && d[2] > 0 &&
+          sc->seq_nsurf == sc->nsurf))
+        return 0;
+    if (last >= 0) {
+        *cand = sc->surf[last]->seq;
+        *nc = sc->surf[last]->nseq;
+    } else {
+        if (!(sc->nentry > 0 && org[2] < sc->entry_z)) return 0;
+        *cand = sc->entry;
+        *nc = sc->nentry;
+    }
+    return *nc > 0;
+}
+
+/* The nearest of the candidates in double (the first one at a tie), its normal
+ * computed once; 0 if none is hit. */
+static inline int seq_hit(const trace_scene *sc, const int *cand, int nc, int last,
+                          const double org[3], const double d[3], tr_hitrec *h)
+{
+    double best = INFINITY, t, p[3] = {0, 0, 0}, bp[3] = {0, 0, 0};
+    int bs = -1, ok;
+    for (int k = 0; k < nc; k++) {
+        const tr_shape *g = &sc->surf[cand[k]]->shape;
+        int leaving = cand[k] == last;
+        switch (g->fast) {
+        case TR_FAST_CONIC: ok = tr_conic_hit(g, org, d, leaving, &t, p); break;
+        case TR_FAST_PLANE: ok = tr_plane_hit(g, org, d, leaving, &t); break;
+        default: ok = tr_shape_hit_t(g, org, d, leaving, &t, p);
+        }
+        if (ok && t < best) {
+            best = t;
+            bs = cand[k];
+            v_set(bp, p);
+        }
+    }
+    if (bs < 0) return 0;
+    const tr_shape *g = &sc->surf[bs]->shape;
+    if (g->fast == TR_FAST_CONIC) tr_conic_normal_local(g, bp, h->n);  /* world frame */
+    else tr_shape_hit_normal(g, bp, h->n);
+    front_normal(g, h->n);
+    h->surf = bs;
+    h->prim = -1;
+    h->t = best;
+    return 1;
+}
+
+/* The lens shortcut (the same hits, bit for bit), else Embree. */
 static int find_hit(const trace_scene *sc, const trace_options *o, const double org[3],
                     const double d[3], int last, long last_prim, uint32_t hist,
                     tr_hitrec *h)
 {
-    if (o->sequential && !o->float_hits && hist == 0 && d[2] > 0 &&
-        sc->seq_nsurf == sc->nsurf &&
-        (last >= 0 ? sc->surf[last]->nseq > 0 : sc->nentry > 0 && org[2] < sc->entry_z)) {
-        const int *cand = last >= 0 ? sc->surf[last]->seq : sc->entry;
-        int nc = last >= 0 ? sc->surf[last]->nseq : sc->nentry;
-        double best = INFINITY, t, n[3], bn[3];
-        int bs = -1;
-        for (int k = 0; k < nc; k++) {
-            const tr_surf *c = sc->surf[cand[k]];
-            if (tr_shape_hit(&c->shape, org, d, c->id == last, &t, n) && t < best) {
-                best = t;
-                bs = c->id;
-                v_set(bn, n);
-            }
-        }
-        if (bs >= 0) {
-            front_normal(&sc->surf[bs]->shape, bn);
-            h->surf = bs;
-            h->prim = -1;
-            h->t = best;
-            v_set(h->n, bn);
-            return 1;
-        }
-    }
+    const int *cand;
+    int nc;
+    if (seq_cands(sc, o, org, d, last, hist, &cand, &nc) &&
+        seq_hit(sc, cand, nc, last, org, d, h))
+        return 1;
     return nearest(sc, o->float_hits, org, d, last, last_prim, h);
 }
 
@@ -601,19 +633,58 @@ typedef struct tr_buf {
     size_t n, cap, size;
 } tr_buf;
 
-static int buf_push(tr_buf *b, const void *rec)
+/* Room for one more record at the end of b (NULL: out of memory). */
+static void *buf_slot(tr_buf *b)
 {
     if (b->n == b->cap) {
         size_t cap = b->cap ? 2 * b->cap : 1024;
+        void *p = realloc(b->p, cap * b->size);
+        if (!p) return NULL;
+        b->p = p;
+        b->cap = cap;
+    }
+    return (char *)b->p + b->n++ * b->size;
+}
+
+/* Append all of a's records to b and empty a. */
+static int buf_move(tr_buf *b, tr_buf *a)
+{
+    if (a->n == 0) return 0;
+    if (b->n + a->n > b->cap) {
+        size_t cap = b->cap ? b->cap : 1024;
+        while (cap < b->n + a->n) cap *= 2;
         void *p = realloc(b->p, cap * b->size);
         if (!p) return -1;
         b->p = p;
         b->cap = cap;
     }
-    memcpy((char *)b->p + b->n * b->size, rec, b->size);
-    b->n++;
+    memcpy((char *)b->p + b->n * b->size, a->p, a->n * a->size);
+    b->n += a->n;
+    a->n = 0;
     return 0;
 }
+
+/* Where a ray's records go: the worker's buffers, or a lane's until its turn. */
+typedef struct tr_out {
+    tr_buf seg, hit;
+} tr_out;
+
+/* Rays traced side by side on the lens shortcut: their dependent chains of square
+ * roots and divisions overlap in the processor (one ray alone waits on them). */
+#define TR_LANES 4
+
+typedef struct tr_lane {
+    tr_wray r;
+    tr_hitrec h;
+    tr_tally *ty;
+    uint64_t ray;
+    double p0;
+    int sp, live;
+    int state;                   /* LANE_RUN, LANE_DONE, LANE_SLOW */
+    tr_wray *stack;
+    tr_out out;
+} tr_lane;
+enum { LANE_RUN, LANE_DONE, LANE_SLOW };
 
 typedef struct tr_worker {
     const trace_scene *sc;
@@ -621,47 +692,48 @@ typedef struct tr_worker {
     uint64_t first, count;       /* global ray numbers */
     tr_tally *tally;             /* count entries */
     int want_seg, want_hit;
-    tr_buf seg, hit;
+    tr_out out;
     tr_wray *stack;
+    tr_lane lane[TR_LANES];
     int nomem;
 } tr_worker;
 
-static void emit_segment(tr_worker *w, const tr_wray *r, uint64_t ray, const double p1[3],
-                         int end, int surf)
+static void emit_segment(tr_worker *w, tr_out *out, const tr_wray *r, uint64_t ray,
+                         const double p1[3], int end, int surf)
 {
     if (!w->want_seg) return;
-    trace_segment s;
-    memset(&s, 0, sizeof s);            /* padding too: records compare bytewise */
-    s.ray = ray;
-    s.depth = r->depth;
-    s.end = end;
-    s.surface = surf;
-    v_set(s.p0, r->o);
-    v_set(s.p1, p1);
-    s.power = r->pol.jss + r->pol.jpp;
-    if (buf_push(&w->seg, &s)) w->nomem = 1;
+    trace_segment *s = buf_slot(&out->seg);
+    if (!s) { w->nomem = 1; return; }
+    memset(s, 0, sizeof *s);            /* padding too: records compare bytewise */
+    s->ray = ray;
+    s->depth = r->depth;
+    s->end = end;
+    s->surface = surf;
+    v_set(s->p0, r->o);
+    v_set(s->p1, p1);
+    s->power = r->pol.jss + r->pol.jpp;
 }
 
-static void emit_hit(tr_worker *w, const tr_wray *r, uint64_t ray, const tr_hitrec *h,
-                     const double p[3])
+static void emit_hit(tr_worker *w, tr_out *out, const tr_wray *r, uint64_t ray,
+                     const tr_hitrec *h, const double p[3])
 {
     if (!w->want_hit) return;
-    trace_hit x;
-    memset(&x, 0, sizeof x);
-    x.ray = ray;
-    x.depth = r->depth;
-    x.history = r->hist;
-    x.surface = h->surf;
-    x.prim = h->prim;
-    v_set(x.pos, p);
-    v_set(x.dir, r->d);
-    v_set(x.normal, h->n);
-    v_set(x.s_dir, r->pol.e);
-    x.power_s = r->pol.jss;
-    x.power_p = r->pol.jpp;
-    x.length = r->len;
-    x.opl = r->opl;
-    if (buf_push(&w->hit, &x)) w->nomem = 1;
+    trace_hit *x = buf_slot(&out->hit);
+    if (!x) { w->nomem = 1; return; }
+    memset(x, 0, sizeof *x);
+    x->ray = ray;
+    x->depth = r->depth;
+    x->history = r->hist;
+    x->surface = h->surf;
+    x->prim = h->prim;
+    v_set(x->pos, p);
+    v_set(x->dir, r->d);
+    v_set(x->normal, h->n);
+    v_set(x->s_dir, r->pol.e);
+    x->power_s = r->pol.jss;
+    x->power_p = r->pol.jpp;
+    x->length = r->len;
+    x->opl = r->opl;
 }
 
 /* s unit vector of the plane of incidence (d x n), or the ray's own e at normal
@@ -695,8 +767,8 @@ static void keep(tr_worker *w, tr_tally *ty, int *sp, const tr_wray *c, double p
 /* The interaction at h: a reflected ray that must wait is pushed on the stack; the
  * ray that goes on now (refracted, or reflected at a mirror or TIR) replaces *r.
  * Returns 1 if *r goes on. */
-static int interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hitrec *h,
-                    const tr_surf *f, double p0)
+static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray *r,
+                    const tr_hitrec *h, const tr_surf *f, double p0)
 {
     double n1 = f->mat.n_front, n2 = f->mat.n_back, s[3], m[3];
     if (f->media && h->prim >= 0) { n1 = f->media[2 * h->prim]; n2 = f->media[2 * h->prim + 1]; }
@@ -704,7 +776,7 @@ static int interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hi
     if (dn > 0) { double x = n1; n1 = n2; n2 = x; }     /* arriving from the back */
     /* m: unit normal pointing back into the incident medium */
     for (int i = 0; i < 3; i++) m[i] = dn > 0 ? -h->n[i] : h->n[i];
-    double ci = fmin(1.0, fabs(dn));
+    double ci = fabs(dn) < 1.0 ? fabs(dn) : 1.0;   /* fmin(1, |dn|) without the call */
     if (f->mat.kind == TRACE_REFRACT && fabs(r->n - n1) > 1e-9 * n1) ty->mismatch++;
     ty->interactions++;
     s_vector(r, h->n, s);
@@ -740,7 +812,7 @@ static int interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hi
         double rsp = fc.rs * fc.rp * (fc.rs_phase == fc.rp_phase ? 1.0 : -1.0);
         if (w->o->reflections) {
             /* the reflected ray waits on the stack; the refracted one goes first */
-            tr_wray *c = &w->stack[*sp];
+            tr_wray *c = &stack[*sp];
             *c = *r;
             if (r->depth <= 32) c->hist |= 1u << (r->depth - 1);
             for (int i = 0; i < 3; i++) c->d[i] = r->d[i] + 2 * ci * m[i];
@@ -770,71 +842,157 @@ static int interact(tr_worker *w, tr_tally *ty, int *sp, tr_wray *r, const tr_hi
     return strong(w, ty, r->pol.jss + r->pol.jpp, p0);
 }
 
-static void trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty)
+/* A ray's state from its source ray; its tally starts. */
+static void ray_start(tr_wray *r, const tr_ray0 *r0, tr_tally *ty, double *p0)
+{
+    memset(ty, 0, sizeof *ty);
+    v_set(r->o, r0->o);
+    v_set(r->d, r0->d);
+    r->n = r0->n;
+    r->len = r->opl = 0;
+    r->pol = r0->pol;
+    r->depth = 0;
+    r->last_surf = -1;
+    r->last_prim = -1;
+    r->hist = 0;
+    *p0 = r0->pol.jss + r0->pol.jpp;
+    ty->emitted = *p0;
+}
+
+/* One step once the hit h of *r is known: the segment to it and what the surface
+ * does.  Returns 1 if *r goes on. */
+static inline int on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int *sp,
+                         tr_wray *r, const tr_hitrec *h, uint64_t ray, double p0)
+{
+    double p = r->pol.jss + r->pol.jpp, q[3];
+    for (int i = 0; i < 3; i++) q[i] = r->o[i] + h->t * r->d[i];
+    if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]) && isfinite(h->n[0]))) {
+        ty->failures++;
+        ty->cutoff += p;
+        return 0;
+    }
+    const tr_surf *f = w->sc->surf[h->surf];
+    ty->segments++;
+    r->len += h->t;
+    r->opl += r->n * h->t;
+    switch (f->mat.kind) {
+    case TRACE_ABSORB:
+        ty->absorbed += p;
+        emit_segment(w, out, r, ray, q, TRACE_END_ABSORB, h->surf);
+        return 0;
+    case TRACE_DETECT: {
+        double s[3];
+        s_vector(r, h->n, s);
+        tr_pol_rotate(&r->pol, r->d, s);
+        ty->detected += p;
+        ty->hits++;
+        emit_segment(w, out, r, ray, q, TRACE_END_DETECT, h->surf);
+        emit_hit(w, out, r, ray, h, q);
+        return 0;
+    }
+    default:
+        emit_segment(w, out, r, ray, q, TRACE_END_NONE, h->surf);
+        v_set(r->o, q);
+        return interact(w, ty, stack, sp, r, h, f, p0);
+    }
+}
+
+/* The rest of a ray's tree from *r (live: *r itself goes on; else the stack). */
+static void trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int sp,
+                       tr_wray *rp, int live, uint64_t ray, double p0)
 {
     const trace_scene *sc = w->sc;
     const trace_options *o = w->o;
-    int sp = 0, live = 1;
-    tr_wray r;
-    memset(ty, 0, sizeof *ty);
-    v_set(r.o, r0->o);
-    v_set(r.d, r0->d);
-    r.n = r0->n;
-    r.len = r.opl = 0;
-    r.pol = r0->pol;
-    r.depth = 0;
-    r.last_surf = -1;
-    r.last_prim = -1;
-    r.hist = 0;
-    double p0 = r0->pol.jss + r0->pol.jpp;
-    ty->emitted = p0;
+    tr_wray r = *rp;
     for (;;) {
         if (!live) {
             if (sp == 0) break;
-            r = w->stack[--sp];
+            r = stack[--sp];
         }
-        live = 0;
         double p = r.pol.jss + r.pol.jpp, q[3];
         tr_hitrec h;
         if (r.depth > ty->max_depth) ty->max_depth = r.depth;
-        if (r.depth >= o->max_depth) { ty->cutoff += p; ty->cut_depth++; continue; }
+        if (r.depth >= o->max_depth) { ty->cutoff += p; ty->cut_depth++; live = 0; continue; }
         if (!find_hit(sc, o, r.o, r.d, r.last_surf, r.last_prim, r.hist, &h)) {
             for (int i = 0; i < 3; i++) q[i] = r.o[i] + o->escape_length * r.d[i];
             ty->segments++;
             ty->escaped += p;
-            emit_segment(w, &r, ray, q, TRACE_END_ESCAPE, -1);
+            emit_segment(w, out, &r, ray, q, TRACE_END_ESCAPE, -1);
+            live = 0;
             continue;
         }
-        for (int i = 0; i < 3; i++) q[i] = r.o[i] + h.t * r.d[i];
-        if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]) && isfinite(h.n[0]))) {
-            ty->failures++;
-            ty->cutoff += p;
-            continue;
+        live = on_hit(w, out, ty, stack, &sp, &r, &h, ray, p0);
+    }
+}
+
+static void trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty)
+{
+    tr_wray r;
+    double p0;
+    ray_start(&r, r0, ty, &p0);
+    trace_rest(w, &w->out, ty, w->stack, 0, &r, 1, ray, p0);
+}
+
+/* Source ray number g (the source index *k moves forward only). */
+static void source_ray(const trace_scene *sc, int *k, uint64_t g, tr_ray0 *r)
+{
+    while (*k + 1 < sc->nsrc && sc->src[*k + 1].first <= g) (*k)++;
+    while (sc->src[*k].first + (uint64_t)sc->src[*k].nrays <= g) (*k)++;
+    tr_source_ray(&sc->src[*k], (long)(g - sc->src[*k].first), r);
+}
+
+/* Rays i0 .. i0+n-1 of the worker side by side while each stays on the lens
+ * shortcut, step by step; a lane that leaves it (no candidate hit, depth limit, a
+ * ray going back, reflections waiting) is finished alone afterwards by trace_rest.
+ * Every lane computes exactly what trace_one would; its records wait in the lane's
+ * buffers and are passed on in ray order. */
+static void trace_lanes(tr_worker *w, uint64_t i0, int n, int *k)
+{
+    const trace_scene *sc = w->sc;
+    const trace_options *o = w->o;
+    int nrun = n;
+    for (int l = 0; l < n; l++) {
+        tr_lane *L = &w->lane[l];
+        tr_ray0 r0;
+        L->ray = w->first + i0 + (uint64_t)l;
+        L->ty = &w->tally[i0 + (uint64_t)l];
+        source_ray(sc, k, L->ray, &r0);
+        ray_start(&L->r, &r0, L->ty, &L->p0);
+        L->sp = 0;
+        L->live = 1;
+        L->state = LANE_RUN;
+    }
+    while (nrun > 0) {
+        for (int l = 0; l < n; l++) {            /* the hits */
+            tr_lane *L = &w->lane[l];
+            const int *cand;
+            int nc;
+            if (L->state != LANE_RUN) continue;
+            tr_wray *r = &L->r;
+            if (r->depth > L->ty->max_depth) L->ty->max_depth = r->depth;
+            if (r->depth >= o->max_depth ||
+                !seq_cands(sc, o, r->o, r->d, r->last_surf, r->hist, &cand, &nc) ||
+                !seq_hit(sc, cand, nc, r->last_surf, r->o, r->d, &L->h)) {
+                L->state = LANE_SLOW;             /* trace_rest redoes this step */
+                nrun--;
+            }
         }
-        const tr_surf *f = sc->surf[h.surf];
-        ty->segments++;
-        r.len += h.t;
-        r.opl += r.n * h.t;
-        switch (f->mat.kind) {
-        case TRACE_ABSORB:
-            ty->absorbed += p;
-            emit_segment(w, &r, ray, q, TRACE_END_ABSORB, h.surf);
-            break;
-        case TRACE_DETECT: {
-            double s[3];
-            s_vector(&r, h.n, s);
-            tr_pol_rotate(&r.pol, r.d, s);
-            ty->detected += p;
-            ty->hits++;
-            emit_segment(w, &r, ray, q, TRACE_END_DETECT, h.surf);
-            emit_hit(w, &r, ray, &h, q);
-            break;
+        for (int l = 0; l < n; l++) {            /* what the surfaces do */
+            tr_lane *L = &w->lane[l];
+            if (L->state != LANE_RUN) continue;
+            if (!on_hit(w, &L->out, L->ty, L->stack, &L->sp, &L->r, &L->h, L->ray, L->p0)) {
+                L->live = 0;
+                L->state = L->sp ? LANE_SLOW : LANE_DONE;
+                nrun--;
+            }
         }
-        default:
-            emit_segment(w, &r, ray, q, TRACE_END_NONE, h.surf);
-            v_set(r.o, q);
-            live = interact(w, ty, &sp, &r, &h, f, p0);
-        }
+    }
+    for (int l = 0; l < n; l++) {
+        tr_lane *L = &w->lane[l];
+        if (buf_move(&w->out.seg, &L->out.seg) || buf_move(&w->out.hit, &L->out.hit))
+            w->nomem = 1;
+        if (L->state == LANE_SLOW)
+            trace_rest(w, &w->out, L->ty, L->stack, L->sp, &L->r, L->live, L->ray, L->p0);
     }
 }
 
@@ -842,14 +1000,15 @@ static void *work(void *arg)
 {
     tr_worker *w = arg;
     const trace_scene *sc = w->sc;
+    const trace_options *o = w->o;
     int k = 0;
-    for (uint64_t i = 0; i < w->count; i++) {
-        uint64_t g = w->first + i;
+    uint64_t i = 0;
+    if (o->sequential && !o->float_hits && sc->seq_nsurf == sc->nsurf && sc->nentry > 0)
+        for (; i + TR_LANES <= w->count; i += TR_LANES) trace_lanes(w, i, TR_LANES, &k);
+    for (; i < w->count; i++) {
         tr_ray0 r;
-        while (k + 1 < sc->nsrc && sc->src[k + 1].first <= g) k++;
-        while (sc->src[k].first + (uint64_t)sc->src[k].nrays <= g) k++;
-        tr_source_ray(&sc->src[k], (long)(g - sc->src[k].first), &r);
-        trace_one(w, &r, g, &w->tally[i]);
+        source_ray(sc, &k, w->first + i, &r);
+        trace_one(w, &r, w->first + i, &w->tally[i]);
     }
     return NULL;
 }
@@ -890,10 +1049,11 @@ static void add_tally(trace_summary *s, const tr_tally *t)
 
 static int deliver(const tr_worker *w, const trace_sink *k)
 {
-    for (size_t i = 0; k->segment && i < w->seg.n; i++)
-        if (k->segment(k->ctx, (const trace_segment *)w->seg.p + i)) return TRACE_ECANCEL;
-    for (size_t i = 0; k->hit && i < w->hit.n; i++)
-        if (k->hit(k->ctx, (const trace_hit *)w->hit.p + i)) return TRACE_ECANCEL;
+    for (size_t i = 0; k->segment && i < w->out.seg.n; i++)
+        if (k->segment(k->ctx, (const trace_segment *)w->out.seg.p + i))
+            return TRACE_ECANCEL;
+    for (size_t i = 0; k->hit && i < w->out.hit.n; i++)
+        if (k->hit(k->ctx, (const trace_hit *)w->out.hit.p + i)) return TRACE_ECANCEL;
     return TRACE_OK;
 }
 
@@ -939,10 +1099,17 @@ static int run(trace_scene *sc, const trace_options *oin, const trace_sink *sink
         w[i].o = &o;
         w[i].want_seg = want_seg;
         w[i].want_hit = want_hit;
-        w[i].seg.size = sizeof(trace_segment);
-        w[i].hit.size = sizeof(trace_hit);
-        w[i].stack = malloc((size_t)(o.max_depth + 4) * sizeof(tr_wray));
+        w[i].out.seg.size = sizeof(trace_segment);
+        w[i].out.hit.size = sizeof(trace_hit);
+        /* one stack for the worker, one per lane */
+        size_t depth = (size_t)o.max_depth + 4;
+        w[i].stack = malloc((TR_LANES + 1) * depth * sizeof(tr_wray));
         if (!w[i].stack) rc = fail(sc, TRACE_ENOMEM, "out of memory");
+        for (int l = 0; l < TR_LANES; l++) {
+            w[i].lane[l].stack = w[i].stack ? w[i].stack + (size_t)(l + 1) * depth : NULL;
+            w[i].lane[l].out.seg.size = sizeof(trace_segment);
+            w[i].lane[l].out.hit.size = sizeof(trace_hit);
+        }
     }
     double t0 = now_ms();
     for (uint64_t b0 = 0; rc == TRACE_OK && b0 < sc->nrays; b0 += (uint64_t)batch) {
@@ -953,7 +1120,7 @@ static int run(trace_scene *sc, const trace_options *oin, const trace_sink *sink
             w[i].first = b0 + (a < nb ? a : nb);
             w[i].count = a < nb ? (nb - a < chunk ? nb - a : chunk) : 0;
             w[i].tally = tally + (a < nb ? a : nb);
-            w[i].seg.n = w[i].hit.n = 0;
+            w[i].out.seg.n = w[i].out.hit.n = 0;
         }
         for (int i = 1; i < nthr; i++) {
             started[i] = 0;
@@ -977,8 +1144,12 @@ static int run(trace_scene *sc, const trace_options *oin, const trace_sink *sink
     s.trace_ms = now_ms() - t0;
     for (int i = 0; w && i < nthr; i++) {
         free(w[i].stack);
-        free(w[i].seg.p);
-        free(w[i].hit.p);
+        free(w[i].out.seg.p);
+        free(w[i].out.hit.p);
+        for (int l = 0; l < TR_LANES; l++) {
+            free(w[i].lane[l].out.seg.p);
+            free(w[i].lane[l].out.hit.p);
+        }
     }
     free(w);
     free(tally);

@@ -147,14 +147,6 @@ static int init_aperture(tr_shape *g, const trace_surface *s, char *err, size_t 
     return 0;
 }
 
-static int in_aperture(const tr_shape *g, double x, double y)
-{
-    if (g->aperture == TRACE_AP_RECT) return fabs(x) <= g->hw && fabs(y) <= g->hh;
-    double s2 = x * x + y * y;
-    if (g->r_outer2 > 0 && s2 > g->r_outer2) return 0;
-    return s2 >= g->r_inner2;
-}
-
 static int init_axial(tr_shape *g, const trace_surface *s, char *err, size_t cap)
 {
     double smax, zlo, zhi, extra = 0;
@@ -257,13 +249,18 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
     g->aligned = g->u[0] == 1 && g->u[1] == 0 && g->u[2] == 0 && g->v[0] == 0 &&
                  g->v[1] == 1 && g->v[2] == 0 && g->w[0] == 0 && g->w[1] == 0 &&
                  g->w[2] == 1;
+    g->k1 = 1.0 + g->k;
+    g->ck1 = g->c * g->k1;
+    g->fast = !g->aligned ? TR_FAST_NONE :
+              s->shape == TRACE_PLANE ? TR_FAST_PLANE :
+              s->shape == TRACE_AXIAL && g->nasph == 0 ? TR_FAST_CONIC : TR_FAST_NONE;
     return 0;
 }
 
 /* ---- intersection ---- */
 
 static int plane_hit(const tr_shape *g, const double o[3], const double d[3],
-                     int leaving, double *t, double n[3])
+                     int leaving, double *t)
 {
     double lo[3], ld[3];
     if (leaving) return 0;
@@ -272,14 +269,14 @@ static int plane_hit(const tr_shape *g, const double o[3], const double d[3],
     if (ld[2] == 0) return 0;
     double tt = -lo[2] / ld[2];
     if (!(tt > 0)) return 0;
-    if (!in_aperture(g, lo[0] + tt * ld[0], lo[1] + tt * ld[1])) return 0;
+    if (!tr_in_aperture(g, lo[0] + tt * ld[0], lo[1] + tt * ld[1])) return 0;
     *t = tt;
-    v_set(n, g->w);
     return 1;
 }
 
+/* p: the hit relative to the centre */
 static int sphere_hit(const tr_shape *g, const double o[3], const double d[3],
-                      int leaving, double *t, double n[3])
+                      int leaving, double *t, double p[3])
 {
     double q[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     double A = v_dot(d, d), B = v_dot(q, d), R = g->radius;
@@ -295,8 +292,7 @@ static int sphere_hit(const tr_shape *g, const double o[3], const double d[3],
     if (r[0] > 0) tt = r[0];
     else if (r[1] > 0) tt = r[1];
     if (!(tt > 0)) return 0;
-    for (int i = 0; i < 3; i++) n[i] = (q[i] + tt * d[i]) / R;
-    v_unit(n);
+    for (int i = 0; i < 3; i++) p[i] = q[i] + tt * d[i];
     *t = tt;
     return 1;
 }
@@ -304,28 +300,16 @@ static int sphere_hit(const tr_shape *g, const double o[3], const double d[3],
 static void axial_normal_local(const tr_shape *g, const double p[3], double nl[3])
 {
     if (g->nasph == 0) {
-        nl[0] = -g->c * p[0];
-        nl[1] = -g->c * p[1];
-        nl[2] = 1.0 - g->c * (1.0 + g->k) * p[2];
-    } else {
-        double z, dz;
-        if (sag(g, p[0] * p[0] + p[1] * p[1], &z, &dz)) dz = 0;
-        nl[0] = -2 * p[0] * dz;
-        nl[1] = -2 * p[1] * dz;
-        nl[2] = 1.0;
+        tr_conic_normal_local(g, p, nl);
+        return;
     }
+    double z, dz;
+    if (sag(g, p[0] * p[0] + p[1] * p[1], &z, &dz)) dz = 0;
+    nl[0] = -2 * p[0] * dz;
+    nl[1] = -2 * p[1] * dz;
+    nl[2] = 1.0;
     double l = 1.0 / sqrt(nl[0] * nl[0] + nl[1] * nl[1] + nl[2] * nl[2]);
     nl[0] *= l; nl[1] *= l; nl[2] *= l;
-}
-
-/* On the vertex branch of the conic and inside the aperture? */
-static int axial_ok(const tr_shape *g, const double p[3])
-{
-    if (g->c != 0 && 1.0 - g->c * (1.0 + g->k) * p[2] <= 0) return 0;
-    if (g->r_outer2 == 0 && g->aperture == TRACE_AP_DISC && g->c != 0 &&
-        1.0 - (1.0 + g->k) * g->c * g->c * (p[0] * p[0] + p[1] * p[1]) < 0)
-        return 0;
-    return in_aperture(g, p[0], p[1]);
 }
 
 /* Newton on h(t) = z(t) - sag(s(t)^2) in local coordinates, from t. */
@@ -354,10 +338,11 @@ static int asph_newton(const tr_shape *g, const double lo[3], const double ld[3]
     return 0;
 }
 
+/* p: the hit in local coordinates */
 static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
-                     int leaving, double *t, double n[3])
+                     int leaving, double *t, double p[3])
 {
-    double lo[3], ld[3], p[3], r[2], nl[3];
+    double lo[3], ld[3], r[2];
     double c = g->c, k1 = 1.0 + g->k, tmin = 0;
     int nr = 0;
     to_local(g, o, lo);
@@ -391,23 +376,52 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
         }
         if (!(tt > tmin)) continue;
         for (int j = 0; j < 3; j++) p[j] = lo[j] + tt * ld[j];
-        if (!axial_ok(g, p)) continue;
-        axial_normal_local(g, p, nl);
-        to_world_dir(g, nl, n);
+        if (!tr_axial_ok(g, p)) continue;
         *t = tt;
         return 1;
     }
     return 0;
 }
 
+int tr_shape_hit_t(const tr_shape *g, const double o[3], const double d[3], int leaving,
+                   double *t, double p[3])
+{
+    switch (g->fast) {
+    case TR_FAST_CONIC: return tr_conic_hit(g, o, d, leaving, t, p);
+    case TR_FAST_PLANE: return tr_plane_hit(g, o, d, leaving, t);
+    default: break;
+    }
+    switch (g->shape) {
+    case TRACE_PLANE: return plane_hit(g, o, d, leaving, t);
+    case TRACE_SPHERE: return sphere_hit(g, o, d, leaving, t, p);
+    default: return axial_hit(g, o, d, leaving, t, p);
+    }
+}
+
+void tr_shape_hit_normal(const tr_shape *g, const double p[3], double n[3])
+{
+    double nl[3];
+    switch (g->shape) {
+    case TRACE_PLANE:
+        v_set(n, g->w);
+        break;
+    case TRACE_SPHERE:
+        for (int i = 0; i < 3; i++) n[i] = p[i] / g->radius;
+        v_unit(n);
+        break;
+    default:
+        axial_normal_local(g, p, nl);
+        to_world_dir(g, nl, n);
+    }
+}
+
 int tr_shape_hit(const tr_shape *g, const double o[3], const double d[3], int leaving,
                  double *t, double n[3])
 {
-    switch (g->shape) {
-    case TRACE_PLANE: return plane_hit(g, o, d, leaving, t, n);
-    case TRACE_SPHERE: return sphere_hit(g, o, d, leaving, t, n);
-    default: return axial_hit(g, o, d, leaving, t, n);
-    }
+    double p[3];
+    if (!tr_shape_hit_t(g, o, d, leaving, t, p)) return 0;
+    tr_shape_hit_normal(g, p, n);
+    return 1;
 }
 
 /* Single precision throughout (what a float-only tracer computes). */
@@ -432,7 +446,7 @@ int tr_shape_hit_float(const tr_shape *g, const double o[3], const double d[3],
     if (g->shape == TRACE_PLANE || g->c == 0) {
         if (leaving || ld[2] == 0) return 0;
         tt = -lo[2] / ld[2];
-        if (!(tt > 0) || !in_aperture(g, lo[0] + tt * ld[0], lo[1] + tt * ld[1]))
+        if (!(tt > 0) || !tr_in_aperture(g, lo[0] + tt * ld[0], lo[1] + tt * ld[1]))
             return 0;
         nl[0] = 0; nl[1] = 0; nl[2] = 1;
     } else {
@@ -452,7 +466,7 @@ int tr_shape_hit_float(const tr_shape *g, const double o[3], const double d[3],
             double p[3];
             if (!(r[i] > 0)) continue;
             for (int j = 0; j < 3; j++) p[j] = lo[j] + r[i] * ld[j];
-            if (!axial_ok(g, p)) continue;
+            if (!tr_axial_ok(g, p)) continue;
             tt = r[i];
             nl[0] = -c * (float)p[0]; nl[1] = -c * (float)p[1];
             nl[2] = 1.0f - c * k1 * (float)p[2];

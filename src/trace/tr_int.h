@@ -51,7 +51,88 @@ typedef struct tr_shape {
     double scale;              /* size, for tolerances */
     double lo[3], hi[3];       /* world bounds */
     int aligned;               /* u, v, w are the world's x, y, z */
+    double k1, ck1;            /* 1 + k and c (1 + k), as the formulas compute them */
+    int fast;                  /* TR_FAST_*: an inline case of tr_shape_hit_t */
 } tr_shape;
+
+enum { TR_FAST_NONE, TR_FAST_CONIC, TR_FAST_PLANE };
+
+/* Inside the aperture at local (x, y)? */
+static inline int tr_in_aperture(const tr_shape *g, double x, double y)
+{
+    if (g->aperture == TRACE_AP_RECT) return fabs(x) <= g->hw && fabs(y) <= g->hh;
+    double s2 = x * x + y * y;
+    if (g->r_outer2 > 0 && s2 > g->r_outer2) return 0;
+    return s2 >= g->r_inner2;
+}
+
+/* On the vertex branch of the conic and inside the aperture (local point p)? */
+static inline int tr_axial_ok(const tr_shape *g, const double p[3])
+{
+    if (g->c != 0 && 1.0 - g->ck1 * p[2] <= 0) return 0;
+    if (g->r_outer2 == 0 && g->aperture == TRACE_AP_DISC && g->c != 0 &&
+        1.0 - g->k1 * g->c * g->c * (p[0] * p[0] + p[1] * p[1]) < 0)
+        return 0;
+    return tr_in_aperture(g, p[0], p[1]);
+}
+
+/* The hot cases of tr_shape_hit_t, inline (the trace loop calls them per segment):
+ * TR_FAST_CONIC, an axial conic without aspheric terms whose frame is the world's
+ * (lens surfaces): stable quadratic, and a ray leaving the surface drops the root
+ * t = 0 exactly (roots 0 and -2B/A); p = the hit in local coordinates. */
+static inline int tr_conic_hit(const tr_shape *g, const double o[3], const double d[3],
+                               int leaving, double *t, double p[3])
+{
+    double lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
+    double c = g->c, k1 = g->k1, r[2];
+    int nr = 0;
+    double A = c * (d[0] * d[0] + d[1] * d[1] + k1 * d[2] * d[2]);
+    double B = c * (lo[0] * d[0] + lo[1] * d[1] + k1 * lo[2] * d[2]) - d[2];
+    if (leaving) {
+        if (A == 0) return 0;
+        r[nr++] = -2 * B / A;
+    } else {
+        double C = c * (lo[0] * lo[0] + lo[1] * lo[1] + k1 * lo[2] * lo[2]) - 2 * lo[2];
+        double disc = B * B - A * C;
+        if (disc < 0) return 0;
+        double q = -(B + copysign(sqrt(disc), B));
+        if (A != 0) r[nr++] = q / A;
+        if (q != 0) r[nr++] = C / q;
+        if (nr == 2 && r[0] > r[1]) { double x = r[0]; r[0] = r[1]; r[1] = x; }
+    }
+    for (int i = 0; i < nr; i++) {
+        double tt = r[i];
+        if (!(tt > 0)) continue;
+        for (int j = 0; j < 3; j++) p[j] = lo[j] + tt * d[j];
+        if (!tr_axial_ok(g, p)) continue;
+        *t = tt;
+        return 1;
+    }
+    return 0;
+}
+
+/* Unit normal (toward back) of a conic at local point p. */
+static inline void tr_conic_normal_local(const tr_shape *g, const double p[3], double nl[3])
+{
+    nl[0] = -g->c * p[0];
+    nl[1] = -g->c * p[1];
+    nl[2] = 1.0 - g->ck1 * p[2];
+    double l = 1.0 / sqrt(nl[0] * nl[0] + nl[1] * nl[1] + nl[2] * nl[2]);
+    nl[0] *= l; nl[1] *= l; nl[2] *= l;
+}
+
+/* TR_FAST_PLANE: a plane whose frame is the world's. */
+static inline int tr_plane_hit(const tr_shape *g, const double o[3], const double d[3],
+                               int leaving, double *t)
+{
+    if (leaving || d[2] == 0) return 0;
+    double lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
+    double tt = -lo[2] / d[2];
+    if (!(tt > 0)) return 0;
+    if (!tr_in_aperture(g, lo[0] + tt * d[0], lo[1] + tt * d[1])) return 0;
+    *t = tt;
+    return 1;
+}
 
 /* Validates and prepares; 0, or -1 with a message in err. */
 int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap);
@@ -60,6 +141,11 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap);
  * with *t and the unit normal n (pointing to the back side), 0 for none. */
 int tr_shape_hit(const tr_shape *g, const double o[3], const double d[3], int leaving,
                  double *t, double n[3]);
+/* The same in two steps: the root (*t) and a point p that tr_shape_hit_normal turns
+ * into the normal, so a caller choosing among candidates computes one normal. */
+int tr_shape_hit_t(const tr_shape *g, const double o[3], const double d[3], int leaving,
+                   double *t, double p[3]);
+void tr_shape_hit_normal(const tr_shape *g, const double p[3], double n[3]);
 /* The same computed in single precision (to compare with a float-only tracer). */
 int tr_shape_hit_float(const tr_shape *g, const double o[3], const double d[3],
                        int leaving, double *t, double n[3]);
