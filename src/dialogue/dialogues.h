@@ -26,4 +26,18 @@ int lm_fit(lm_io *io);         const char *lm_fit_example(void);
 int lm_prescription(lm_io *io);    const char *lm_prescription_example(void);
 int lm_to_prescription(lm_io *io); const char *lm_to_prescription_example(void);
 
+/* A lens read from a file (prescription.c): a classic record, its grep'd or plain
+ * answers, or a prescription file.  lm_read_lens: LM_GO, or LM_FAIL with
+ * "FILE[:LINE]: why" in err (nothing printed); free with lm_lens_file_free. */
+typedef struct lm_lens_surface { double radius, z, n_right; } lm_lens_surface; /* plane: inf */
+typedef struct lm_lens_file {
+    double nearpoint, n_object;        /* n_object: index left of the first surface */
+    int nsurf, nobj;
+    lm_lens_surface *surf;
+    double *obj;                       /* the object planes' locations */
+    long leftover_line;                /* > 0: answers after the end, from this line */
+} lm_lens_file;
+int  lm_read_lens(const char *path, lm_lens_file *lf, char *err, size_t cap);
+void lm_lens_file_free(lm_lens_file *lf);
+
 #endif

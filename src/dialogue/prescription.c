@@ -1,20 +1,23 @@
-/* prescription.c -- prescription files: a plain text lens description (nearpoint,
- * object-side index, one surface per line, object planes; format in README
- * "Calculations") as an alternative to typing the classic dialogue's answers, and
- * the converse.  --prescription reads the file, checks every line (FILE:LINE
- * messages), turns it into the classic dialogue's answers and runs lm_classic, so
- * its record is an ordinary classic record (grep input: replays it).
- * --to-prescription reads a classic record or answer file and writes the
- * prescription file.  Texts in prompts/prescription.txt. */
+/* prescription.c -- lens files: prescription files (a plain text lens description:
+ * nearpoint, object-side index, one surface per line, object planes; format in README
+ * "Calculations"), classic records and their answers.  --prescription reads a
+ * prescription, checks every line (FILE:LINE messages), turns it into the classic
+ * dialogue's answers and runs lm_classic, so its record is an ordinary classic record
+ * (grep input: replays it).  --to-prescription reads a classic record or answer file
+ * and writes the prescription file.  lm_read_lens reads any of the three into
+ * surfaces (for --trace's record choice).  Texts in prompts/prescription.txt. */
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "ask.h"
 #include "dialogues.h"
 #include "lex.h"
 #include "prompts_prescription.h"
 
 #define PS(k) prescription_prompts[PRESCRIPTION_##k]
+#define LENS_FILE_MAX (16L << 20)   /* a lens file is small text; /dev/zero is not */
 
 typedef struct text { char *s; size_t len, cap; int err; } text;
 
@@ -31,51 +34,86 @@ static void put(text *t, const char *a, const char *b)
     t->len += (size_t)sprintf(t->s + t->len, "%s%s\n", a, b);
 }
 
-static int bad(const lm_io *io, long line, const char *fmt, const char *arg)
+/* All of `in` as one NUL-terminated string (NUL bytes in it end the text early).
+ * NULL with err set if it is too long or cannot be read. */
+static char *slurp(FILE *in, const char *src, char *err, size_t cap)
 {
-    char msg[512];
-    snprintf(msg, sizeof msg, fmt, arg);
-    fprintf(stderr, PS(BAD_LINE), io->src, line, msg);
-    return LM_FAIL;
+    char *s = NULL, *t;
+    size_t len = 0, room = 0, n;
+    for (;;) {
+        if (len + 65536 + 1 > room) {
+            if (len > (size_t)LENS_FILE_MAX) {
+                snprintf(err, cap, PS(TOO_BIG), src, LENS_FILE_MAX >> 20);
+                free(s);
+                return NULL;
+            }
+            room = 2 * room + 65536 + 1;
+            if (!(t = realloc(s, room))) { snprintf(err, cap, PS(NO_MEMORY), src); free(s); return NULL; }
+            s = t;
+        }
+        n = fread(s + len, 1, room - len - 1, in);
+        len += n;
+        if (n == 0) break;
+    }
+    if (ferror(in)) {
+        snprintf(err, cap, PS(CANNOT_READ), src, strerror(errno));
+        free(s);
+        return NULL;
+    }
+    s[len] = '\0';
+    return s;
 }
 
-/* A number token (plane words only where `plane`); 0 or LM_FAIL. */
-static int number(const lm_io *io, long line, const char *tok, int plane, double *v)
-{
-    enum lm_num_status st = lm_parse_number(tok, v);
-    if (st == LM_NUM_OK || (plane && st == LM_NUM_PLANE)) return 0;
-    return bad(io, line, plane ? PS(BAD_RADIUS) : PS(BAD_NUMBER), tok);
-}
+/* ---- prescription files -> the classic dialogue's answers ------------------------ */
 
 typedef struct rx {
+    const char *src;          /* file name for messages */
+    char *err;                /* "FILE:LINE: why" */
+    size_t errcap;
     text ans;                 /* the classic dialogue's answers */
     int have_near, have_index, nsurf, nobj;
     double z_last;
     char near[LM_TOKEN_MAX], index[LM_TOKEN_MAX];
 } rx;
 
-static int keyword(const lm_io *io, long line, rx *r, const char *key, const char *val)
+static int bad(rx *r, long line, const char *fmt, const char *arg)
+{
+    char msg[512];
+    snprintf(msg, sizeof msg, fmt, arg);
+    snprintf(r->err, r->errcap, PS(BAD_LINE), r->src, line, msg);
+    return LM_FAIL;
+}
+
+/* A number token (plane words only where `plane`); 0 or LM_FAIL. */
+static int number(rx *r, long line, const char *tok, int plane, double *v)
+{
+    enum lm_num_status st = lm_parse_number(tok, v);
+    if (st == LM_NUM_OK || (plane && st == LM_NUM_PLANE)) return 0;
+    return bad(r, line, plane ? PS(BAD_RADIUS) : PS(BAD_NUMBER), tok);
+}
+
+static int keyword(rx *r, long line, const char *key, const char *val)
 {
     double v;
     int near = !strcmp(key, "nearpoint");
-    if (near ? r->have_near : r->have_index) return bad(io, line, PS(TWICE), key);
-    if (number(io, line, val, 0, &v)) return LM_FAIL;
-    if (near && v < 0) return bad(io, line, "%s", PS(NEGATIVE));
-    if (!near && !(v > 0)) return bad(io, line, "%s", PS(NOT_POSITIVE));
+    if (near ? r->have_near : r->have_index) return bad(r, line, PS(TWICE), key);
+    if (number(r, line, val, 0, &v)) return LM_FAIL;
+    if (near && v < 0) return bad(r, line, "%s", PS(NEGATIVE));
+    if (!near && !(v > 0)) return bad(r, line, "%s", PS(NOT_POSITIVE));
     strcpy(near ? r->near : r->index, val);
     *(near ? &r->have_near : &r->have_index) = 1;
     return LM_GO;
 }
 
-static int surface(const lm_io *io, long line, rx *r, char tok[3][LM_TOKEN_MAX])
+static int surface(rx *r, long line, char tok[3][LM_TOKEN_MAX])
 {
     double rad, z, n;
-    if (r->nobj) return bad(io, line, "%s", PS(AFTER_OBJECT));
-    if (number(io, line, tok[0], 1, &rad) || number(io, line, tok[1], 0, &z) ||
-        number(io, line, tok[2], 0, &n))
+    if (r->nobj) return bad(r, line, "%s", PS(AFTER_OBJECT));
+    if (number(r, line, tok[0], 1, &rad) || number(r, line, tok[1], 0, &z) ||
+        number(r, line, tok[2], 0, &n))
         return LM_FAIL;
-    if (r->nsurf && z < r->z_last) return bad(io, line, "%s", PS(DECREASING));
-    if (!(n > 0)) return bad(io, line, "%s", PS(NOT_POSITIVE));
+    if (r->nsurf && z < r->z_last) return bad(r, line, "%s", PS(DECREASING));
+    if (!(n > 0)) return bad(r, line, "%s", PS(NOT_POSITIVE));
     if (r->nsurf) put(&r->ans, "y", "");
     put(&r->ans, tok[0], ""); put(&r->ans, tok[1], ""); put(&r->ans, tok[2], "");
     r->z_last = z;
@@ -83,7 +121,7 @@ static int surface(const lm_io *io, long line, rx *r, char tok[3][LM_TOKEN_MAX])
     return LM_GO;
 }
 
-static int one_line(const lm_io *io, long line, const char *buf, rx *r)
+static int one_line(rx *r, long line, char *buf)
 {
     char tok[4][LM_TOKEN_MAX];
     const char *cur = buf;
@@ -91,45 +129,52 @@ static int one_line(const lm_io *io, long line, const char *buf, rx *r)
     char *hash = strchr(buf, '#');
     if (hash) *hash = '\0';
     while (n < 4 && (len = lm_next_token(&cur, tok[n], LM_TOKEN_MAX)) != 0) {
-        if (len < 0) return bad(io, line, "%s", PS(TOO_LONG));
+        if (len < 0) return bad(r, line, "%s", PS(TOO_LONG));
         n++;
     }
     if (n == 0) return LM_GO;
     if (n == 2 && (!strcmp(tok[0], "nearpoint") || !strcmp(tok[0], "index"))) {
-        if (r->nsurf) return bad(io, line, "%s", "nearpoint and index come before the surfaces");
-        return keyword(io, line, r, tok[0], tok[1]);
+        if (r->nsurf) return bad(r, line, "%s", PS(KEYS_FIRST));
+        return keyword(r, line, tok[0], tok[1]);
     }
     if (n == 2 && !strcmp(tok[0], "object")) {
         double z;
-        if (!r->nsurf) return bad(io, line, "%s", PS(NEED_THREE));
-        if (number(io, line, tok[1], 0, &z)) return LM_FAIL;
+        if (!r->nsurf) return bad(r, line, "%s", PS(NEED_THREE));
+        if (number(r, line, tok[1], 0, &z)) return LM_FAIL;
         put(&r->ans, r->nobj ? "y" : "n", "");
         put(&r->ans, tok[1], "");
         r->nobj++;
         return LM_GO;
     }
-    if (n != 3) return bad(io, line, "%s", PS(NEED_THREE));
-    return surface(io, line, r, tok);
+    if (n != 3) return bad(r, line, "%s", PS(NEED_THREE));
+    return surface(r, line, tok);
 }
 
-static int read_prescription(lm_io *io, rx *r)
+/* The prescription in `s` (modified: lines are cut in place) -> r->ans, the classic
+ * answers.  LM_GO, or LM_FAIL with r->err set. */
+static int read_prescription(rx *r, char *s)
 {
-    char *buf = NULL;
-    size_t cap = 0;
+    text head = {0};
     long line = 0;
     int rc = LM_GO;
-    text head = {0};
-    while (rc == LM_GO && getline(&buf, &cap, io->in) >= 0)
-        rc = one_line(io, ++line, buf, r);
-    free(buf);
+    while (rc == LM_GO && *s) {
+        char *nl = strchr(s, '\n');
+        if (nl) *nl = '\0';
+        rc = one_line(r, ++line, s);
+        s = nl ? nl + 1 : s + strlen(s);
+    }
     if (rc) return rc;
-    if (!r->nsurf) { fprintf(stderr, PS(NO_SURFACE), io->src); return LM_FAIL; }
-    if (!r->nobj) { fprintf(stderr, PS(NO_OBJECT), io->src); return LM_FAIL; }
+    if (!r->nsurf) { snprintf(r->err, r->errcap, PS(NO_SURFACE), r->src); return LM_FAIL; }
+    if (!r->nobj) { snprintf(r->err, r->errcap, PS(NO_OBJECT), r->src); return LM_FAIL; }
     put(&r->ans, "n", "");
     put(&head, r->have_near ? r->near : "25", "");
     put(&head, r->have_index ? r->index : "1", "");
     put(&head, r->ans.s ? r->ans.s : "", "");
-    if (head.err || r->ans.err) { free(head.s); return LM_FAIL; }
+    if (head.err || r->ans.err) {
+        free(head.s);
+        snprintf(r->err, r->errcap, PS(NO_MEMORY), r->src);
+        return LM_FAIL;
+    }
     free(r->ans.s);
     r->ans = head;
     return LM_GO;
@@ -139,10 +184,16 @@ int lm_prescription(lm_io *io)
 {
     rx r;
     FILE *answers;
-    char src[600];
+    char src[600], err[1200], *s;
     int rc;
     memset(&r, 0, sizeof r);
-    if ((rc = read_prescription(io, &r))) { free(r.ans.s); return rc; }
+    r.src = io->src;
+    r.err = err;
+    r.errcap = sizeof err;
+    if (!(s = slurp(io->in, io->src, err, sizeof err))) rc = LM_FAIL;
+    else rc = read_prescription(&r, s);
+    free(s);
+    if (rc) { fprintf(stderr, PS(ERROR), err); free(r.ans.s); return rc; }
     answers = fmemopen(r.ans.s, r.ans.len, "r");
     if (!answers) { free(r.ans.s); return LM_FAIL; }
     snprintf(src, sizeof src, "%s (as classic answers)", io->src);
@@ -158,30 +209,205 @@ int lm_prescription(lm_io *io)
 }
 const char *lm_prescription_example(void) { return PS(EXAMPLE); }
 
-/* ---- the converse: classic answers -> prescription ---- */
+/* ---- the classic dialogue's answers -> a lens ------------------------------------ */
 
-/* Read all of `in`; if some line starts with "input:", blank every other line (a
- * whole record file; line numbers stay those of the file). */
-static char *answers_of(FILE *in, size_t *len)
+/* The answers' tokens, line by line (lines are cut in place), as lm_ask reads them. */
+typedef struct cursor {
+    const char *src;
+    char *next;               /* the next line, or NULL at the end */
+    const char *cur;          /* unread part of the current line */
+    long line;
+    char *err;
+    size_t errcap;
+} cursor;
+
+static int fail_at(cursor *c, const char *what, const char *fmt, const char *tok)
 {
-    text t = {0};
-    char *buf = NULL;
-    size_t cap = 0;
-    int only_input = 0;
-    while (getline(&buf, &cap, in) >= 0) {
-        size_t n = strcspn(buf, "\n");
-        buf[n] = '\0';
-        put(&t, buf, "");
-    }
-    free(buf);
-    if (t.err || !t.s) { free(t.s); return NULL; }
-    only_input = !strncmp(t.s, "input:", 6) || strstr(t.s, "\ninput:") != NULL;
-    if (only_input)
-        for (char *l = t.s; *l; l = strchr(l, '\n') + 1)
-            if (strncmp(l, "input:", 6)) memset(l, ' ', strcspn(l, "\n"));
-    *len = t.len;
-    return t.s;
+    char msg[600];
+    snprintf(msg, sizeof msg, fmt, tok);
+    snprintf(c->err, c->errcap, PS(ANSWER_ERROR), c->src, c->line > 0 ? c->line : 1,
+             what, msg);
+    return LM_FAIL;
 }
+
+/* Move to the next line: 0, or -1 at the end. */
+static int next_line(cursor *c)
+{
+    char *nl;
+    if (!c->next || !*c->next) return -1;
+    if ((nl = strchr(c->next, '\n'))) *nl = '\0';
+    c->cur = lm_line_start(c->next);
+    c->next = nl ? nl + 1 : NULL;
+    c->line++;
+    return 0;
+}
+
+static int token(cursor *c, const char *what, char tok[LM_TOKEN_MAX])
+{
+    for (;;) {
+        int n = lm_next_token(&c->cur, tok, LM_TOKEN_MAX);
+        if (n > 0) return LM_GO;
+        if (n < 0) return fail_at(c, what, "%s", PS(A_TOO_LONG));
+        if (next_line(c)) {
+            snprintf(c->err, c->errcap, PS(END_OF_INPUT), c->src, c->line + 1, what);
+            return LM_FAIL;
+        }
+    }
+}
+
+/* A number answer with the checks lm_ask_number makes for these lm_numspec flags
+ * (LM_ALLOW_PLANE, LM_POSITIVE, LM_NONNEG, LM_AT_LEAST). */
+static int num(cursor *c, const char *what, unsigned flags, double min, double *v)
+{
+    char tok[LM_TOKEN_MAX];
+    enum lm_num_status st;
+    if (token(c, what, tok)) return LM_FAIL;
+    st = lm_parse_number(tok, v);
+    if (st == LM_NUM_PLANE && (flags & LM_ALLOW_PLANE)) { *v = INFINITY; return LM_GO; }
+    if (st != LM_NUM_OK) {
+        char msg[LM_TOKEN_MAX + 100];
+        snprintf(msg, sizeof msg, PS(A_NOT_NUMBER), tok, lm_num_status_text(st));
+        return fail_at(c, what, "%s", msg);
+    }
+    if ((flags & LM_POSITIVE) && !(*v > 0)) return fail_at(c, what, PS(A_POSITIVE), tok);
+    if ((flags & LM_NONNEG) && *v < 0) return fail_at(c, what, PS(A_NONNEG), tok);
+    if ((flags & LM_AT_LEAST) && *v < min) return fail_at(c, what, PS(A_LEFT), tok);
+    if ((flags & LM_ALLOW_PLANE) && *v == 0) *v = INFINITY;
+    return LM_GO;
+}
+
+static int yn(cursor *c, const char *what, int *yes)
+{
+    char tok[LM_TOKEN_MAX];
+    int ch;
+    if (token(c, what, tok)) return LM_FAIL;
+    if (!(ch = lm_parse_yn(tok))) return fail_at(c, what, PS(A_YN), tok);
+    *yes = ch == 'y';
+    return LM_GO;
+}
+
+/* Room for n elements of `size` bytes in a (which has room for n - 1): the room
+ * doubles when n is a power of 2.  NULL if out of memory (a is then still valid). */
+static void *grow(void *a, int n, size_t size)
+{
+    return n & (n - 1) ? a : realloc(a, size * (size_t)n * 2);
+}
+
+static int read_answers(cursor *c, lm_lens_file *lf)
+{
+    double s[3], z, *no;
+    lm_lens_surface *ns;
+    char tok[LM_TOKEN_MAX];
+    int more;
+    if (num(c, PS(W_NEARPOINT), LM_NONNEG, 0, &lf->nearpoint) ||
+        num(c, PS(W_INDEX), LM_POSITIVE, 0, &lf->n_object))
+        return LM_FAIL;
+    do {
+        if (num(c, PS(W_RADIUS), LM_ALLOW_PLANE, 0, &s[0]) ||
+            num(c, PS(W_LOCATION), lf->nsurf ? LM_AT_LEAST : 0,
+                lf->nsurf ? lf->surf[lf->nsurf - 1].z : 0, &s[1]) ||
+            num(c, PS(W_INDEX), LM_POSITIVE, 0, &s[2]) ||
+            yn(c, PS(W_ANOTHER_SURFACE), &more))
+            return LM_FAIL;
+        if (!(ns = grow(lf->surf, lf->nsurf + 1, sizeof *ns))) return fail_at(c, "", "%s", PS(A_MEMORY));
+        lf->surf = ns;
+        ns[lf->nsurf++] = (lm_lens_surface){s[0], s[1], s[2]};
+    } while (more);
+    do {
+        if (num(c, PS(W_OBJECT), 0, 0, &z) || yn(c, PS(W_ANOTHER_OBJECT), &more)) return LM_FAIL;
+        if (!(no = grow(lf->obj, lf->nobj + 1, sizeof *no))) return fail_at(c, "", "%s", PS(A_MEMORY));
+        lf->obj = no;
+        no[lf->nobj++] = z;
+    } while (more);
+    /* answers left over (the classic dialogue warns and ignores them) */
+    do if (lm_next_token(&c->cur, tok, sizeof tok) != 0) { lf->leftover_line = c->line; break; }
+    while (!next_line(c));
+    return LM_GO;
+}
+
+/* Does some line begin with a prescription keyword? (classic answers never do) */
+static int is_prescription(const char *s)
+{
+    static const char *const keys[] = {"nearpoint", "index", "object"};
+    for (const char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL) {
+        size_t n;
+        l += strspn(l, " \t");
+        n = strcspn(l, " \t\r\n#");
+        for (int i = 0; i < 3; i++)
+            if (n == strlen(keys[i]) && !strncmp(l, keys[i], n)) return 1;
+    }
+    return 0;
+}
+
+/* If some line starts with "input:" (a classic record), blank every other line;
+ * line numbers stay those of the file. */
+static void keep_input_lines(char *s)
+{
+    if (strncmp(s, "input:", 6) && !strstr(s, "\ninput:")) return;
+    for (char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL)
+        if (strncmp(l, "input:", 6)) memset(l, ' ', strcspn(l, "\n"));
+}
+
+/* The lens in text s (a prescription, a classic record or its answers; s is cut up).
+ * LM_GO, or LM_FAIL with "FILE:LINE: why" in err. */
+static int lens_of_text(const char *src, char *s, lm_lens_file *lf, char *err, size_t cap)
+{
+    cursor c = {src, s, "", 0, err, cap};
+    char asrc[600];
+    rx r;
+    int rc;
+    memset(lf, 0, sizeof *lf);
+    keep_input_lines(s);
+    if (!is_prescription(s)) {
+        rc = read_answers(&c, lf);
+    } else {
+        memset(&r, 0, sizeof r);
+        r.src = src;
+        r.err = err;
+        r.errcap = cap;
+        rc = read_prescription(&r, s);
+        snprintf(asrc, sizeof asrc, "%s (as classic answers)", src);
+        c.src = asrc;
+        c.next = r.ans.s;
+        if (!rc) rc = read_answers(&c, lf);
+        free(r.ans.s);
+    }
+    if (rc) lm_lens_file_free(lf);
+    return rc;
+}
+
+int lm_read_lens(const char *path, lm_lens_file *lf, char *err, size_t cap)
+{
+    struct stat st;
+    FILE *f;
+    char *s;
+    int rc;
+    memset(lf, 0, sizeof *lf);
+    if (stat(path, &st) || !(f = fopen(path, "r"))) {
+        snprintf(err, cap, PS(CANNOT_OPEN), path, strerror(errno));
+        return LM_FAIL;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        fclose(f);
+        snprintf(err, cap, PS(NOT_REGULAR), path);
+        return LM_FAIL;
+    }
+    s = slurp(f, path, err, cap);
+    fclose(f);
+    if (!s) return LM_FAIL;
+    rc = lens_of_text(path, s, lf, err, cap);
+    free(s);
+    return rc;
+}
+
+void lm_lens_file_free(lm_lens_file *lf)
+{
+    free(lf->surf);
+    free(lf->obj);
+    memset(lf, 0, sizeof *lf);
+}
+
+/* ---- the converse: classic answers -> prescription ---- */
 
 static void number_text(double v, char *buf, size_t cap)
 {
@@ -189,63 +415,40 @@ static void number_text(double v, char *buf, size_t cap)
     else lm_format_echo(v, buf, cap);
 }
 
-static int convert(lm_io *in, lm_io *out)
+static void write_prescription(lm_io *out, const lm_lens_file *lf)
 {
     char a[64], b[64], c[64];
-    double near, n, r, z, zl = 0;
-    int rc, more, first = 1;
-    lm_numspec s_near = {"the eye nearpoint", LM_NONNEG, 0},
-               s_index = {"the index of refraction", LM_POSITIVE, 0},
-               s_r = {"the radius of the lens surface", LM_ALLOW_PLANE, 0},
-               s_z = {"the location of the lens surface", 0, 0},
-               s_obj = {"the location of the object plane", 0, 0};
-    if ((rc = lm_ask_number(in, NULL, NULL, &s_near, &near)) ||
-        (rc = lm_ask_number(in, NULL, NULL, &s_index, &n)))
-        return rc;
     lm_say(out, LM_REC, "%s", PS(HEADER));
-    number_text(near, a, sizeof a);
+    number_text(lf->nearpoint, a, sizeof a);
     lm_say(out, LM_REC, PS(NEARPOINT), a);
-    number_text(n, a, sizeof a);
+    number_text(lf->n_object, a, sizeof a);
     lm_say(out, LM_REC, PS(INDEX), a);
-    do {
-        s_z.flags = first ? 0 : LM_AT_LEAST;
-        s_z.min = zl;
-        if ((rc = lm_ask_number(in, NULL, NULL, &s_r, &r)) ||
-            (rc = lm_ask_number(in, NULL, NULL, &s_z, &z)) ||
-            (rc = lm_ask_number(in, NULL, NULL, &s_index, &n)) ||
-            (rc = lm_ask_yn(in, NULL, NULL, "another lens surface (y or n)", &more)))
-            return rc;
-        number_text(r, a, sizeof a); number_text(z, b, sizeof b); number_text(n, c, sizeof c);
+    for (int i = 0; i < lf->nsurf; i++) {
+        const lm_lens_surface *s = &lf->surf[i];
+        number_text(s->radius, a, sizeof a);
+        number_text(s->z, b, sizeof b);
+        number_text(s->n_right, c, sizeof c);
         lm_say(out, LM_REC, PS(SURFACE), a, b, c);
-        zl = z;
-        first = 0;
-    } while (more);
-    do {
-        if ((rc = lm_ask_number(in, NULL, NULL, &s_obj, &z)) ||
-            (rc = lm_ask_yn(in, NULL, NULL, "another object plane (y or n)", &more)))
-            return rc;
-        number_text(z, a, sizeof a);
+    }
+    for (int i = 0; i < lf->nobj; i++) {
+        number_text(lf->obj[i], a, sizeof a);
         lm_say(out, LM_REC, PS(OBJECT), a);
-    } while (more);
-    lm_check_leftover(in);
-    return LM_GO;
+    }
 }
 
 int lm_to_prescription(lm_io *io)
 {
-    size_t len = 0;
-    char *ans = answers_of(io->in, &len);
-    FILE *mem;
-    lm_io in;
-    int rc;
-    if (!ans) { fprintf(stderr, PS(NO_SURFACE), io->src); return LM_FAIL; }
-    mem = fmemopen(ans, len, "r");
-    if (!mem) { free(ans); return LM_FAIL; }
-    if (lm_io_open(&in, "/dev/null", mem, io->src, 0) < 0) { fclose(mem); free(ans); return LM_FAIL; }
-    rc = convert(&in, io);
-    lm_io_close(&in);
-    fclose(mem);
-    free(ans);
-    return rc;
+    lm_lens_file lf;
+    char err[1200], *s = slurp(io->in, io->src, err, sizeof err);
+    if (!s || lens_of_text(io->src, s, &lf, err, sizeof err)) {
+        free(s);
+        fprintf(stderr, PS(ERROR), err);
+        return LM_FAIL;
+    }
+    free(s);
+    write_prescription(io, &lf);
+    if (lf.leftover_line) fprintf(stderr, PS(LEFTOVER), io->src, lf.leftover_line);
+    lm_lens_file_free(&lf);
+    return LM_GO;
 }
 const char *lm_to_prescription_example(void) { return PS(TO_EXAMPLE); }
