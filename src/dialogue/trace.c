@@ -1,6 +1,7 @@
 /* trace.c -- the ray-tracing dialogue (lensmat --trace): trace a scene file and
- * report what it did; enter a lens surface by surface (as the classic dialogue) and
- * trace a fan from an object point for real, against the paraxial image; or the
+ * report what it did; enter a lens surface by surface (as the classic dialogue), or
+ * read it from a classic record or prescription file (prescription.c), and trace a
+ * fan from an object point for real, against the paraxial image; or the
  * error-against-run-time table of tessellated lenses.  Texts: prompts/trace.txt.
  * The trace module (Embree) is loaded on the first trace only, through
  * lm_engine_symbol: the paraxial part of a session never loads it. */
@@ -120,7 +121,7 @@ static int do_scene(tdlg *t)
     return LM_GO;
 }
 
-/* ---- a lens entered surface by surface ---------------------------------------------- */
+/* ---- a lens: entered surface by surface, or read from a file ----------------------- */
 
 typedef struct lens {
     px_system sys;
@@ -128,26 +129,31 @@ typedef struct lens {
     trace_lens tl;
 } lens;
 
-static int enter_surface(tdlg *t, lens *l)
+/* Append surface s to the lens and its paraxial system, and echo it. */
+static void add_surface(tdlg *t, lens *l, const trace_lens_surface *s)
 {
-    lm_io *io = t->io;
-    trace_lens_surface *s = &l->surf[l->tl.nsurf];
-    int rc;
-    if ((rc = ask_num(t, P(RADIUS), P(RADIUS_WHAT), LM_ALLOW_PLANE, 0, &s->radius)) ||
-        (rc = ask_num(t, P(LOCATION), P(LOCATION_WHAT), l->tl.nsurf ? LM_AT_LEAST : 0,
-                      l->sys.z_last, &s->z)) ||
-        (rc = ask_num(t, P(INDEX_RIGHT), P(INDEX_RIGHT_WHAT), LM_POSITIVE, 0, &s->n_right)) ||
-        (rc = ask_num(t, P(SEMI), P(SEMI_WHAT), LM_POSITIVE, 0, &s->semi_diameter)))
-        return rc;
-    l->tl.nsurf++;
+    l->surf[l->tl.nsurf++] = *s;
     if (isinf(s->radius))
-        lm_say(io, LM_BOTH, P(SURFACE_ECHO_PLANE), l->tl.nsurf, s->z, s->n_right,
+        lm_say(t->io, LM_BOTH, P(SURFACE_ECHO_PLANE), l->tl.nsurf, s->z, s->n_right,
                s->semi_diameter);
     else
-        lm_say(io, LM_BOTH, P(SURFACE_ECHO), l->tl.nsurf, s->radius, s->z, s->n_right,
+        lm_say(t->io, LM_BOTH, P(SURFACE_ECHO), l->tl.nsurf, s->radius, s->z, s->n_right,
                s->semi_diameter);
     px_system_translate(&l->sys, s->z);
     px_system_refract(&l->sys, s->radius, s->n_right);
+}
+
+static int enter_surface(tdlg *t, lens *l)
+{
+    trace_lens_surface s;
+    int rc;
+    if ((rc = ask_num(t, P(RADIUS), P(RADIUS_WHAT), LM_ALLOW_PLANE, 0, &s.radius)) ||
+        (rc = ask_num(t, P(LOCATION), P(LOCATION_WHAT), l->tl.nsurf ? LM_AT_LEAST : 0,
+                      l->sys.z_last, &s.z)) ||
+        (rc = ask_num(t, P(INDEX_RIGHT), P(INDEX_RIGHT_WHAT), LM_POSITIVE, 0, &s.n_right)) ||
+        (rc = ask_num(t, P(SEMI), P(SEMI_WHAT), LM_POSITIVE, 0, &s.semi_diameter)))
+        return rc;
+    add_surface(t, l, &s);
     return LM_GO;
 }
 
@@ -218,6 +224,10 @@ static int trace_object(tdlg *t, lens *l)
         return LM_GO;
     }
     lm_say(io, LM_BOTH, P(PARAXIAL), lm_clean(io, z_img));
+    if (z_img <= l->sys.z_last) {   /* the fan is traced forward to a detector there */
+        lm_say(io, LM_BOTH, P(PARAXIAL_VIRTUAL));
+        return LM_GO;
+    }
     h[0] = NEAR_AXIS * frac * l->surf[0].semi_diameter;
     for (int i = 1; i <= FAN; i++) h[i] = frac * l->surf[0].semi_diameter * i / FAN;
     if (need_engine(t)) return LM_FAIL;
@@ -230,6 +240,23 @@ static int trace_object(tdlg *t, lens *l)
         return io->interactive ? LM_GO : LM_FAIL;
     }
     report_fan(t, h, out, FAN + 1, z_img, l);
+    return LM_GO;
+}
+
+/* The object points of a lens whose surfaces are in: fan, LSA, as many as asked. */
+static int trace_objects(tdlg *t, lens *l)
+{
+    int rc, more;
+    if (px_is_afocal(&l->sys)) {
+        lm_say(t->io, LM_BOTH, P(AFOCAL));
+        return LM_GO;
+    }
+    do {
+        if ((rc = trace_object(t, l))) return rc;
+        if ((rc = lm_ask_yn(t->io, P(ANOTHER_OBJECT), P(ANOTHER_OBJECT),
+                            P(ANOTHER_OBJECT_WHAT), &more)))
+            return rc;
+    } while (more);
     return LM_GO;
 }
 
@@ -250,19 +277,95 @@ static int do_lens(tdlg *t)
                             P(ANOTHER_SURFACE_WHAT), &more)))
             goto out;
     } while (more);
-    if (px_is_afocal(&l->sys)) {
-        lm_say(io, LM_BOTH, P(AFOCAL));
-        goto out;
-    }
-    do {
-        if ((rc = trace_object(t, l))) goto out;
-        if ((rc = lm_ask_yn(io, P(ANOTHER_OBJECT), P(ANOTHER_OBJECT),
-                            P(ANOTHER_OBJECT_WHAT), &more)))
-            goto out;
-    } while (more);
+    rc = trace_objects(t, l);
 out:
     px_system_free(&l->sys);   /* zeroed by calloc if never initialised */
     free(l);
+    return rc;
+}
+
+/* The record question's check: the file must read as a lens (a classic record, its
+ * answers, or a prescription; messages with file and line) of at most MAXSURF
+ * surfaces. */
+static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
+{
+    lm_lens_file *lf = ctx;
+    lm_lens_file_free(lf);
+    if (lm_read_lens(word, lf, msg, cap)) return -1;
+    if (lf->nsurf > MAXSURF) {
+        snprintf(msg, cap, P(RECORD_TOO_MANY), word, lf->nsurf, MAXSURF);
+        lm_lens_file_free(lf);
+        return -1;
+    }
+    return 0;
+}
+
+/* The semi-diameter's check: > 0 and at most *ctx (the smallest |radius|). */
+static int check_semi(void *ctx, const char *word, char *msg, size_t cap)
+{
+    double v, max = *(const double *)ctx;
+    if (lm_parse_number(word, &v) != LM_NUM_OK || !(v > 0)) {
+        snprintf(msg, cap, P(SEMI_ALL_BAD), word);
+        return -1;
+    }
+    if (v > max) {
+        snprintf(msg, cap, P(SEMI_ALL_BIG), word, max);
+        return -1;
+    }
+    return 0;
+}
+
+/* One semi-diameter for every surface of lf: *semi.  The largest a sphere allows
+ * (the smallest |radius|) is said in the question. */
+static int ask_semi_all(tdlg *t, const lm_lens_file *lf, double *semi)
+{
+    double max = INFINITY;
+    char q[512], word[64];
+    int rc;
+    for (int i = 0; i < lf->nsurf; i++)
+        if (isfinite(lf->surf[i].radius)) max = fmin(max, fabs(lf->surf[i].radius));
+    if (isinf(max)) snprintf(q, sizeof q, "%s", P(SEMI_ALL_PLANE));
+    else snprintf(q, sizeof q, P(SEMI_ALL), max);
+    if ((rc = lm_ask_word(t->io, q, q, P(SEMI_ALL_WHAT), check_semi, &max, word,
+                          sizeof word)))
+        return rc;
+    lm_parse_number(word, semi);
+    return LM_GO;
+}
+
+/* A lens read from a classic record, its answers or a prescription file. */
+static int do_record(tdlg *t)
+{
+    lm_io *io = t->io;
+    lm_lens_file lf = {0};
+    lens *l = NULL;
+    char name[WORD];
+    double semi;
+    int rc;
+
+    if ((rc = lm_ask_word(io, P(RECORD_FILE), P(RECORD_FILE), P(RECORD_FILE_WHAT),
+                          check_lens_file, &lf, name, sizeof name)) ||
+        (rc = ask_semi_all(t, &lf, &semi)))
+        goto out;
+    if (!(l = calloc(1, sizeof *l))) { rc = LM_FAIL; goto out; }
+    lm_say(io, LM_BOTH, P(RECORD_LENS), lf.nsurf, lf.n_object);
+    l->tl.n_object = lf.n_object;
+    px_system_init(&l->sys, lf.n_object);
+    for (int i = 0; i < lf.nsurf; i++) {
+        trace_lens_surface s = {lf.surf[i].radius, lf.surf[i].z, lf.surf[i].n_right, semi};
+        add_surface(t, l, &s);
+    }
+    if (lf.nobj) {
+        lm_say(io, LM_BOTH, "%s", P(RECORD_OBJECTS));
+        for (int i = 0; i < lf.nobj; i++)
+            lm_say(io, LM_BOTH, P(RECORD_OBJECT), lm_clean(io, l->sys.z_first - lf.obj[i]));
+        lm_say(io, LM_BOTH, "\n");
+    }
+    rc = trace_objects(t, l);
+out:
+    if (l) px_system_free(&l->sys);
+    free(l);
+    lm_lens_file_free(&lf);
     return rc;
 }
 
@@ -353,14 +456,15 @@ static int tess_table(tdlg *t)
 
 int lm_trace(lm_io *io)
 {
-    static const char *const modes[] = {"scene", "lens", "table", NULL};
+    static const char *const modes[] = {"scene", "lens", "record", "table", NULL};
     tdlg t = {io, NULL, {0}, 0};
     int rc, mode, more;
 
     lm_say(io, LM_BOTH, "%s", P(INTRO));
     do {
         if ((rc = lm_ask_choice(io, P(MODE), P(MODE), P(MODE_WHAT), modes, &mode))) break;
-        rc = mode == 0 ? do_scene(&t) : mode == 1 ? do_lens(&t) : tess_table(&t);
+        rc = mode == 0 ? do_scene(&t) : mode == 1 ? do_lens(&t)
+           : mode == 2 ? do_record(&t) : tess_table(&t);
         if (rc) break;
         rc = lm_ask_yn(io, P(ANOTHER), P(ANOTHER), P(ANOTHER_WHAT), &more);
     } while (!rc && more);
