@@ -565,12 +565,13 @@ static inline int seq_cands(const trace_scene *sc, const trace_options *o,
     return *nc > 0;
 }
 
-/* The nearest of the candidates in double (the first one at a tie), its normal
- * computed once; 0 if none is hit. */
+/* The nearest of the candidates in double (the first one at a tie); 0 if none is
+ * hit.  Its normal waits for seq_normal (from bp). */
 static inline int seq_hit(const trace_scene *sc, const int *cand, int nc, int last,
-                          const double org[3], const double d[3], tr_hitrec *h)
+                          const double org[3], const double d[3], tr_hitrec *h,
+                          double bp[3])
 {
-    double best = INFINITY, t, p[3] = {0, 0, 0}, bp[3] = {0, 0, 0};
+    double best = INFINITY, t, p[3] = {0, 0, 0};
     int bs = -1, ok;
     for (int k = 0; k < nc; k++) {
         const tr_shape *g = &sc->surf[cand[k]]->shape;
@@ -587,14 +588,18 @@ static inline int seq_hit(const trace_scene *sc, const int *cand, int nc, int la
         }
     }
     if (bs < 0) return 0;
-    const tr_shape *g = &sc->surf[bs]->shape;
-    if (g->fast == TR_FAST_CONIC) tr_conic_normal_local(g, bp, h->n);  /* world frame */
-    else tr_shape_hit_normal(g, bp, h->n);
-    front_normal(g, h->n);
     h->surf = bs;
     h->prim = -1;
     h->t = best;
     return 1;
+}
+
+static inline void seq_normal(const trace_scene *sc, tr_hitrec *h, const double bp[3])
+{
+    const tr_shape *g = &sc->surf[h->surf]->shape;
+    if (g->fast == TR_FAST_CONIC) tr_conic_normal_local(g, bp, h->n);  /* world frame */
+    else tr_shape_hit_normal(g, bp, h->n);
+    front_normal(g, h->n);
 }
 
 /* The lens shortcut (the same hits, bit for bit), else Embree. */
@@ -604,9 +609,12 @@ static int find_hit(const trace_scene *sc, const trace_options *o, const double 
 {
     const int *cand;
     int nc;
+    double bp[3] = {0, 0, 0};
     if (seq_cands(sc, o, org, d, last, hist, &cand, &nc) &&
-        seq_hit(sc, cand, nc, last, org, d, h))
+        seq_hit(sc, cand, nc, last, org, d, h, bp)) {
+        seq_normal(sc, h, bp);
         return 1;
+    }
     return nearest(sc, o->float_hits, org, d, last, last_prim, h);
 }
 
@@ -676,6 +684,7 @@ typedef struct tr_out {
 typedef struct tr_lane {
     tr_wray r;
     tr_hitrec h;
+    double hp[3];                /* seq_hit's point, for the normal */
     tr_tally *ty;
     uint64_t ray;
     double p0;
@@ -951,13 +960,19 @@ static void trace_lanes(tr_worker *w, uint64_t i0, int n, int *k)
     const trace_scene *sc = w->sc;
     const trace_options *o = w->o;
     int nrun = n;
+    tr_ray0 r0[TR_LANES];
+    uint64_t g = w->first + i0;
+    source_ray(sc, k, g, &r0[0]);             /* moves *k to the first ray's source */
+    const tr_source *src = &sc->src[*k];
+    if (g + (uint64_t)n <= src->first + (uint64_t)src->nrays)
+        tr_source_rays(src, (long)(g - src->first), n, r0);
+    else
+        for (int l = 1; l < n; l++) source_ray(sc, k, g + (uint64_t)l, &r0[l]);
     for (int l = 0; l < n; l++) {
         tr_lane *L = &w->lane[l];
-        tr_ray0 r0;
-        L->ray = w->first + i0 + (uint64_t)l;
+        L->ray = g + (uint64_t)l;
         L->ty = &w->tally[i0 + (uint64_t)l];
-        source_ray(sc, k, L->ray, &r0);
-        ray_start(&L->r, &r0, L->ty, &L->p0);
+        ray_start(&L->r, &r0[l], L->ty, &L->p0);
         L->sp = 0;
         L->live = 1;
         L->state = LANE_RUN;
@@ -972,11 +987,13 @@ static void trace_lanes(tr_worker *w, uint64_t i0, int n, int *k)
             if (r->depth > L->ty->max_depth) L->ty->max_depth = r->depth;
             if (r->depth >= o->max_depth ||
                 !seq_cands(sc, o, r->o, r->d, r->last_surf, r->hist, &cand, &nc) ||
-                !seq_hit(sc, cand, nc, r->last_surf, r->o, r->d, &L->h)) {
+                !seq_hit(sc, cand, nc, r->last_surf, r->o, r->d, &L->h, L->hp)) {
                 L->state = LANE_SLOW;             /* trace_rest redoes this step */
                 nrun--;
             }
         }
+        for (int l = 0; l < n; l++)              /* their normals */
+            if (w->lane[l].state == LANE_RUN) seq_normal(sc, &w->lane[l].h, w->lane[l].hp);
         for (int l = 0; l < n; l++) {            /* what the surfaces do */
             tr_lane *L = &w->lane[l];
             if (L->state != LANE_RUN) continue;

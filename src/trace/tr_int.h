@@ -165,8 +165,31 @@ typedef struct tr_pol {
 void tr_fresnel(double n1, double n2, double cos_i, trace_fresnel_coef *f);
 int tr_refract(const double d[3], const double nrm[3], double n1, double n2,
                double out[3]);
-/* Rotate the state of a ray with direction d into the s/p basis given by unit s. */
-void tr_pol_rotate(tr_pol *p, const double d[3], const double s[3]);
+/* Rotate the state of a ray with direction d into the s/p basis given by unit s.
+ * New basis: s and d x s.  With f = d x e: s = c e + s f, so the components are
+ * E_s = c E_e + s E_f and E_p = -s E_e + c E_f; J' = R J R^T. */
+static inline void tr_pol_rotate(tr_pol *p, const double d[3], const double s[3])
+{
+    double f[3];
+    if (p->jss == p->jpp && p->jre == 0 && p->jim == 0) {   /* isotropic: J = J */
+        v_set(p->e, s);
+        return;
+    }
+    v_cross(d, p->e, f);
+    /* e, f and s are unit and perpendicular to d: c^2 + sn^2 = 1 to rounding */
+    double c = v_dot(p->e, s), sn = v_dot(f, s);
+    if (c == 1.0 && sn == 0.0) { v_set(p->e, s); return; }
+    double a = p->jss, b = p->jpp, re = p->jre, im = p->jim;
+    double cc = c * c, ss = sn * sn, cs = c * sn;
+    p->jss = cc * a + 2 * cs * re + ss * b;
+    p->jpp = ss * a - 2 * cs * re + cc * b;
+    /* J'_sp = cs (J_pp - J_ss) + c^2 J_sp - s^2 conj(J_sp) */
+    p->jre = cs * (b - a) + (cc - ss) * re;
+    p->jim = (cc + ss) * im;
+    if (p->jss < 0) p->jss = 0;   /* rounding of an exactly polarised state */
+    if (p->jpp < 0) p->jpp = 0;
+    v_set(p->e, s);
+}
 
 /* ---- sources (tr_source.c) ---- */
 typedef struct tr_source {
@@ -189,6 +212,8 @@ typedef struct tr_ray0 {
 int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap);
 void tr_source_free(tr_source *ts);
 void tr_source_ray(const tr_source *ts, long i, tr_ray0 *r);
+/* Rays i .. i+n-1 of the source, the same as n calls (a grid is walked, not searched). */
+void tr_source_rays(const tr_source *ts, long i, long n, tr_ray0 *r);
 
 /* ---- sequential lenses (tr_lens.c), through the public table ---- */
 int tr_add_lens(trace_scene *sc, const trace_lens *lens);

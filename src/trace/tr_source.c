@@ -243,7 +243,19 @@ static void set_pol(const tr_source *ts, tr_ray0 *r)
     else r->pol.jss = r->pol.jpp = 0.5 * r->power;
 }
 
-void tr_source_ray(const tr_source *ts, long i, tr_ray0 *r)
+/* GRID: the last row whose first ray is <= i */
+static long grid_row(const tr_source *ts, long i)
+{
+    long lo = 0, hi = ts->s.count - 1;
+    while (lo < hi) {
+        long mid = (lo + hi + 1) / 2;
+        if (ts->row_first[mid] <= i) lo = mid; else hi = mid - 1;
+    }
+    return lo;
+}
+
+/* Ray i; row: its grid row if known, else -1. */
+static void ray_at(const tr_source *ts, long i, long row, tr_ray0 *r)
 {
     const trace_source *s = &ts->s;
     double each = s->power / (double)ts->nrays;
@@ -277,11 +289,7 @@ void tr_source_ray(const tr_source *ts, long i, tr_ray0 *r)
         break;
     }
     case TRACE_SRC_GRID: {
-        long n = s->count, lo = 0, hi = n - 1;
-        while (lo < hi) {                  /* last row whose first ray <= i */
-            long mid = (lo + hi + 1) / 2;
-            if (ts->row_first[mid] <= i) lo = mid; else hi = mid - 1;
-        }
+        long n = s->count, lo = row >= 0 ? row : grid_row(ts, i);
         double h = 2 * s->radius / (double)n;
         double y = -s->radius + (lo + 0.5) * h;
         double x = -s->radius + ((double)ts->row_i0[lo] + (double)(i - ts->row_first[lo])
@@ -308,4 +316,22 @@ void tr_source_ray(const tr_source *ts, long i, tr_ray0 *r)
     }
     v_unit(r->d);
     set_pol(ts, r);
+}
+
+void tr_source_ray(const tr_source *ts, long i, tr_ray0 *r)
+{
+    ray_at(ts, i, -1, r);
+}
+
+void tr_source_rays(const tr_source *ts, long i, long n, tr_ray0 *r)
+{
+    if (ts->s.type != TRACE_SRC_GRID) {
+        for (long k = 0; k < n; k++) ray_at(ts, i + k, -1, &r[k]);
+        return;
+    }
+    long row = grid_row(ts, i);
+    for (long k = 0; k < n; k++) {
+        while (row + 1 < ts->s.count && ts->row_first[row + 1] <= i + k) row++;
+        ray_at(ts, i + k, row, &r[k]);
+    }
 }
