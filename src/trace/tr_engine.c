@@ -26,6 +26,7 @@ typedef struct tr_surf {
     long nv, ntri;
     double eps;                /* mesh: plane distances below this are "here" */
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
+    const tr_shape *seqg[4];   /* ... and their shapes */
 } tr_surf;
 
 struct trace_scene {
@@ -41,6 +42,7 @@ struct trace_scene {
     double build_ms;
     int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
     int entry[4], nentry;      /* lens: what a forward ray from left of it meets first */
+    const tr_shape *entryg[4];
     double entry_z;            /* ... if it starts at z < entry_z */
 };
 
@@ -97,7 +99,10 @@ void tr_scene_set_entry(trace_scene *sc, const int *cand, int n, double z)
 {
     sc->nentry = 0;
     for (int i = 0; i < n && i < 4; i++)
-        if (cand[i] >= 0) sc->entry[sc->nentry++] = cand[i];
+        if (cand[i] >= 0) {
+            sc->entryg[sc->nentry] = &sc->surf[cand[i]]->shape;
+            sc->entry[sc->nentry++] = cand[i];
+        }
     sc->entry_z = z;
 }
 
@@ -106,7 +111,10 @@ void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
     tr_surf *f = sc->surf[id];
     f->nseq = 0;
     for (int i = 0; i < n && i < 4; i++)
-        if (cand[i] >= 0) f->seq[f->nseq++] = cand[i];
+        if (cand[i] >= 0) {
+            f->seqg[f->nseq] = &sc->surf[cand[i]]->shape;
+            f->seq[f->nseq++] = cand[i];
+        }
     sc->seq_nsurf = sc->nsurf;
 }
 
@@ -549,46 +557,48 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
  * lens named (see tr_lens.c).  Does that hold for this ray?  Then cand[0..*nc-1]. */
 static inline int seq_cands(const trace_scene *sc, const trace_options *o,
                             const double org[3], const double d[3], int last,
-                            uint32_t hist, const int **cand, int *nc)
+                            uint32_t hist, const int **cand,
+                            const tr_shape *const **cg, int *nc)
 {
     if (!(o->sequential && !o->float_hits && hist == 0 && d[2] > 0 &&
           sc->seq_nsurf == sc->nsurf))
         return 0;
     if (last >= 0) {
-        *cand = sc->surf[last]->seq;
-        *nc = sc->surf[last]->nseq;
+        const tr_surf *f = sc->surf[last];
+        *cand = f->seq;
+        *cg = f->seqg;
+        *nc = f->nseq;
     } else {
         if (!(sc->nentry > 0 && org[2] < sc->entry_z)) return 0;
         *cand = sc->entry;
+        *cg = sc->entryg;
         *nc = sc->nentry;
     }
     return *nc > 0;
 }
 
-/* The nearest of the candidates in double (the first one at a tie); 0 if none is
- * hit.  Its normal waits for seq_normal (from bp). */
-static inline int seq_hit(const trace_scene *sc, const int *cand, int nc, int last,
+/* The nearest of the candidates (ids cand, shapes cg) in double (the first one at a
+ * tie); 0 if none is hit.  Its normal waits for seq_normal (from bp). */
+static inline int seq_hit(const int *cand, const tr_shape *const *cg, int nc, int last,
                           const double org[3], const double d[3], tr_hitrec *h,
                           double bp[3])
 {
     double best = INFINITY, t, p[3] = {0, 0, 0};
     int bs = -1, ok;
     for (int k = 0; k < nc; k++) {
-        const tr_shape *g = &sc->surf[cand[k]]->shape;
+        const tr_shape *g = cg[k];
         int leaving = cand[k] == last;
-        switch (g->fast) {
-        case TR_FAST_CONIC: ok = tr_conic_hit(g, org, d, leaving, &t, p); break;
-        case TR_FAST_PLANE: ok = tr_plane_hit(g, org, d, leaving, &t); break;
-        default: ok = tr_shape_hit_t(g, org, d, leaving, &t, p);
-        }
+        if (g->fast == TR_FAST_CONIC) ok = tr_conic_hit(g, org, d, leaving, &t, p);
+        else if (g->fast == TR_FAST_PLANE) ok = tr_plane_hit(g, org, d, leaving, &t);
+        else ok = tr_shape_hit_t(g, org, d, leaving, &t, p);
         if (ok && t < best) {
             best = t;
-            bs = cand[k];
+            bs = k;
             v_set(bp, p);
         }
     }
     if (bs < 0) return 0;
-    h->surf = bs;
+    h->surf = cand[bs];
     h->prim = -1;
     h->t = best;
     return 1;
@@ -608,10 +618,11 @@ static int find_hit(const trace_scene *sc, const trace_options *o, const double 
                     tr_hitrec *h)
 {
     const int *cand;
+    const tr_shape *const *cg;
     int nc;
     double bp[3] = {0, 0, 0};
-    if (seq_cands(sc, o, org, d, last, hist, &cand, &nc) &&
-        seq_hit(sc, cand, nc, last, org, d, h, bp)) {
+    if (seq_cands(sc, o, org, d, last, hist, &cand, &cg, &nc) &&
+        seq_hit(cand, cg, nc, last, org, d, h, bp)) {
         seq_normal(sc, h, bp);
         return 1;
     }
@@ -981,13 +992,14 @@ static void trace_lanes(tr_worker *w, uint64_t i0, int n, int *k)
         for (int l = 0; l < n; l++) {            /* the hits */
             tr_lane *L = &w->lane[l];
             const int *cand;
+            const tr_shape *const *cg;
             int nc;
             if (L->state != LANE_RUN) continue;
             tr_wray *r = &L->r;
             if (r->depth > L->ty->max_depth) L->ty->max_depth = r->depth;
             if (r->depth >= o->max_depth ||
-                !seq_cands(sc, o, r->o, r->d, r->last_surf, r->hist, &cand, &nc) ||
-                !seq_hit(sc, cand, nc, r->last_surf, r->o, r->d, &L->h, L->hp)) {
+                !seq_cands(sc, o, r->o, r->d, r->last_surf, r->hist, &cand, &cg, &nc) ||
+                !seq_hit(cand, cg, nc, r->last_surf, r->o, r->d, &L->h, L->hp)) {
                 L->state = LANE_SLOW;             /* trace_rest redoes this step */
                 nrun--;
             }
