@@ -6,7 +6,8 @@
  *                            triangle cornea (the loop is timed on a subset of the
  *                            segments and scaled; one thread each)
  *   trace_mrays_per_s        triplet workload on all cores
- *   trace_threads_scaling    triplet workload, 2 threads / 1 thread
+ *   trace_threads_scaling    triplet workload, 2 threads / 1 thread (median of five
+ *                            back-to-back pairs)
  *   trace_mem_mb_per_mtri    peak RSS growth per million triangles (child process)
  *   trace_triplet_mrays_per_s, trace_triplet_peak_mb, trace_triplet_rms_spot_um:
  *                            Cooke triplet f/4, Fresnel on, 1e6 rays, one thread
@@ -318,19 +319,24 @@ int main(int argc, char **argv)
     long peak = child_peak_kb(triplet_child, NULL, &f);
     printf("BENCH trace_triplet_peak_mb %.1f MB\n", peak / 1024.0);
 
-    /* all cores and scaling on the same workload (2 runs each, median of 3 for 1/2) */
+    /* all cores and scaling on the same workload.  The speed of this machine drifts
+     * by tens of percent over seconds, so the scaling is the median of five ratios of
+     * back-to-back 1- and 2-thread runs (taken in alternating order), not a ratio of
+     * medians taken seconds apart. */
     long across = quick ? 400 : 800;
-    double r1[3], r2[3], ra;
-    for (int i = 0; i < 3; i++) {
-        r1[i] = triplet(1, across, NULL, NULL);
-        r2[i] = triplet(2, across, NULL, NULL);
+    double ratio2[5], ra;
+    for (int i = 0; i < 5; i++) {
+        double a, b;
+        if (i % 2) { b = triplet(2, across, NULL, NULL); a = triplet(1, across, NULL, NULL); }
+        else { a = triplet(1, across, NULL, NULL); b = triplet(2, across, NULL, NULL); }
+        ratio2[i] = b / a;
     }
+    qsort(ratio2, 5, sizeof *ratio2, cmpd);
     double rall[3];
     for (int i = 0; i < 3; i++) rall[i] = triplet(0, across, NULL, NULL);
     ra = median3(rall[0], rall[1], rall[2]);
     printf("BENCH trace_mrays_per_s %.3f Mrays/s\n", ra / 1e6);
-    printf("BENCH trace_threads_scaling %.2f x\n",
-           median3(r2[0], r2[1], r2[2]) / median3(r1[0], r1[1], r1[2]));
+    printf("BENCH trace_threads_scaling %.2f x\n", ratio2[2]);
 
     /* full trace vs bare Embree on a glass geodesic sphere (80 000 triangles) */
     tmesh ball = {0};

@@ -2,7 +2,8 @@
  * going to 0 meets the paraxial image (computed here, independently) to 1e-9; the
  * aberration grows as h^2; double-precision hits agree with an independent double
  * trace of a Cooke triplet where single-precision hits do not; results are bit for
- * bit the same for 1, 2 and 3 threads. */
+ * bit the same for 1, 2 and 3 threads, and so is the whole stream of sink calls
+ * (segments, hits and progress, interleaved), a cancelled trace included. */
 #include <stdio.h>
 #include "unit.h"
 #include "tt.h"
@@ -146,6 +147,115 @@ static void threads_bitwise(const trace_api *tr)
     for (int k = 0; k < 3; k++) free(r[k].h);
 }
 
+/* Every sink call folded into one hash, in the order the calls come. */
+typedef struct stream {
+    uint64_t hash, calls, hits, progress_last, progress_total;
+    int progress_ok;           /* done goes up, total stays */
+    long cancel_at;            /* cancel at this hit (-1: never) */
+    long after_cancel;         /* calls that came after a cancel */
+    int cancelled;
+} stream;
+
+static void st_mix(stream *st, int kind, const void *p, size_t n)
+{
+    const unsigned char *c = p;
+    if (st->cancelled) st->after_cancel++;
+    st->hash = (st->hash ^ (unsigned)kind) * 1099511628211ULL;
+    for (size_t i = 0; i < n; i++) st->hash = (st->hash ^ c[i]) * 1099511628211ULL;
+    st->calls++;
+}
+static int st_seg(void *ctx, const trace_segment *g)
+{
+    st_mix(ctx, 1, g, sizeof *g);
+    return 0;
+}
+static int st_hit(void *ctx, const trace_hit *h)
+{
+    stream *st = ctx;
+    st_mix(st, 2, h, sizeof *h);
+    if ((long)st->hits++ == st->cancel_at) st->cancelled = 1;
+    return st->cancelled;
+}
+static int st_progress(void *ctx, uint64_t done, uint64_t total)
+{
+    stream *st = ctx;
+    uint64_t v[2] = {done, total};
+    st_mix(st, 3, v, sizeof v);
+    if (done <= st->progress_last || (st->progress_total && total != st->progress_total))
+        st->progress_ok = 0;
+    st->progress_last = done;
+    st->progress_total = total;
+    return 0;
+}
+
+/* The stream of sink calls is the same for 1, 2 and 3 threads, a cancel stops it for
+ * good, and the summary does not depend on the batch size either (no sinks: bigger
+ * batches). */
+static void threads_stream(const trace_api *tr)
+{
+    trace_lens_surface s[TT_NSURF];
+    trace_lens l;
+    tt_triplet(s, &l, 1);
+    l.z_detector = tt_paraxial_image(&l, -INFINITY);
+    trace_scene *sc = tr->scene_new();
+    trace_source src = {0};
+    src.type = TRACE_SRC_GRID;
+    src.dir[2] = 1; src.at[2] = -5; src.radius = TT_EPD / 2; src.count = 90;
+    src.up[1] = 1;
+    tr->add_lens(sc, &l);
+    tr->add_source(sc, &src, NULL);
+    trace_source cone = {0};                 /* a second source: skew rays, ghosts */
+    cone.type = TRACE_SRC_CONE;
+    cone.at[1] = 8; cone.at[2] = -60; cone.dir[1] = -8; cone.dir[2] = 60;
+    cone.half_angle = 0.09; cone.rings = 20;
+    tr->add_source(sc, &cone, NULL);
+    stream st[3], cut[3];
+    trace_summary sum[3], bare;
+    int rc[3], crc[3];
+    for (int k = 0; k < 3; k++) {
+        trace_options o;
+        tr->options_default(&o);
+        o.threads = k + 1;
+        o.cutoff = 1e-4;
+        o.batch = 700;
+        st[k] = (stream){.hash = 14695981039346656037ULL, .progress_ok = 1, .cancel_at = -1};
+        trace_sink sink = {&st[k], st_seg, st_hit, st_progress};
+        rc[k] = tr->run(sc, &o, &sink, &sum[k]);
+        cut[k] = (stream){.hash = 14695981039346656037ULL, .progress_ok = 1,
+                          .cancel_at = 2500};
+        trace_sink sink2 = {&cut[k], st_seg, st_hit, st_progress};
+        crc[k] = tr->run(sc, &o, &sink2, NULL);
+    }
+    trace_options o;
+    tr->options_default(&o);
+    o.threads = 2;
+    o.cutoff = 1e-4;
+    tr->run(sc, &o, NULL, &bare);
+    CHECK(rc[0] == TRACE_OK && st[0].hits > 5000 && st[0].progress_ok &&
+          st[0].progress_last == sum[0].rays,
+          "stream: %llu calls, %llu hits, progress up to %llu of %llu rays",
+          (unsigned long long)st[0].calls, (unsigned long long)st[0].hits,
+          (unsigned long long)st[0].progress_last, (unsigned long long)sum[0].rays);
+    for (int k = 1; k < 3; k++) {
+        CHECK(rc[k] == TRACE_OK && st[k].calls == st[0].calls && st[k].hash == st[0].hash &&
+              st[k].progress_ok,
+              "%d threads: the same %llu sink calls in the same order (hash %016llx)",
+              k + 1, (unsigned long long)st[k].calls, (unsigned long long)st[k].hash);
+        CHECK(crc[k] == TRACE_ECANCEL && cut[k].after_cancel == 0 &&
+              cut[k].calls == cut[0].calls && cut[k].hash == cut[0].hash,
+              "%d threads: cancelled at hit 2500 like 1 thread (%llu calls before, %ld "
+              "after)", k + 1, (unsigned long long)cut[k].calls, cut[k].after_cancel);
+    }
+    CHECK(crc[0] == TRACE_ECANCEL && cut[0].after_cancel == 0 && cut[0].hits == 2501,
+          "1 thread: cancelled at hit 2500, no call after it");
+    int same = !memcmp(&bare.emitted, &sum[0].emitted, 5 * sizeof(double)) &&
+               bare.segments == sum[0].segments && bare.hits == sum[0].hits &&
+               bare.tir == sum[0].tir && bare.max_depth_seen == sum[0].max_depth_seen;
+    CHECK(same, "no sinks, default batches, 2 threads: the summary of 700-ray batches "
+          "bit for bit (cut off %.17g)", bare.cutoff);
+    tr->scene_free(sc);
+}
+
 /* The lens shortcut (no BVH between consecutive surfaces) changes no bit. */
 static void sequential_same(const trace_api *tr)
 {
@@ -195,6 +305,7 @@ int main(void)
     paraxial_limit(tr);
     double_beats_float(tr);
     threads_bitwise(tr);
+    threads_stream(tr);
     sequential_same(tr);
     return unit_failed();
 }
