@@ -27,9 +27,11 @@
  * averaged.  Hits report the powers along the basis of the last interface (s, p).
  *
  * Results are bit-identical for any thread count: rays are numbered in the order the
- * sources were added, each thread traces a contiguous block of every batch, and the
- * sinks are called from the calling thread in ray order (within a ray: depth-first,
- * refracted before reflected). */
+ * sources were added and cut into batches; threads (created once per run) take whole
+ * batches in order, and the sinks are called from the calling thread batch by batch in
+ * batch order (within a batch: its segments, then its hits, each in ray order; within
+ * a ray: depth-first, refracted before reflected).  Powers are summed ray by ray in ray
+ * order, so the summary does not depend on the thread count or the batch size. */
 #ifndef TRACE_H
 #define TRACE_H
 #include <stddef.h>
@@ -163,7 +165,9 @@ typedef struct trace_options {
                               power is cut off (sequential lens work) */
     int threads;           /* 0: all cores */
     double escape_length;  /* length of the segment drawn for an escaping ray (1) */
-    long batch;            /* rays per batch (0: 8192 with sinks, 65536 without) */
+    long batch;            /* rays per batch (0: 8192 with sinks, 65536 without,
+                              halved down to 1024 with several threads until each
+                              has 8 batches) */
     int float_hits;        /* 1: take hits as a single-precision tracer computes them
                               (no double refinement) -- only to measure what double
                               buys; never for real work (default 0) */
