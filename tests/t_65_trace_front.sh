@@ -246,9 +246,11 @@ check "no Embree in lensmat's links or in a paraxial session (LD_DEBUG=libs)" no
 
 # ---- on a terminal: a bad scene file is explained and asked again; progress -------
 tty_trace() {
-    python3 - "$BIN" "$TW/tty" "$TW/bad" "$SCENES" <<'EOF'
-import os, pty, select, sys, time
+    python3 - "$BIN" "$TW/tty" "$TW/bad" "$SCENES" "$TOP/tests" <<'EOF'
+import os, sys
 bin_, d, bad, scenes = sys.argv[1:5]
+sys.path.insert(0, sys.argv[5])
+from ptydrive import drive
 os.makedirs(d, exist_ok=True)
 big = os.path.join(d, "big.scene")
 with open(big, "w") as f:   # a few million rays: over a second on any machine here
@@ -257,28 +259,8 @@ with open(big, "w") as f:   # a few million rays: over a second on any machine h
             "plane detect at 0 0 55 normal 0 0 1 disc 30\nreflections off\n"
             "source collimated from 0 0 -10 dir 0 0 1 radius 10 grid 2200\n")
 def run(keys, timeout=120):
-    pid, fd = pty.fork()
-    if pid == 0:
-        os.chdir(d); os.environ["HOME"] = d; os.environ["TERM"] = "dumb"
-        os.execv(bin_, [bin_, "--trace", "t.rec"])
-    out = b""; deadline = time.time() + timeout
-    for k in keys:
-        while time.time() < deadline:
-            r, _, _ = select.select([fd], [], [], 0.3)
-            if not r: break
-            try: out += os.read(fd, 65536)
-            except OSError: break
-        os.write(fd, k)
-    while time.time() < deadline:
-        r, _, _ = select.select([fd], [], [], 0.3)
-        if r:
-            try: data = os.read(fd, 65536)
-            except OSError: break
-            if not data: break
-            out += data
-        elif os.waitpid(pid, os.WNOHANG)[0]: break
-    _, st = os.waitpid(pid, 0)
-    return out.decode(errors="replace"), os.waitstatus_to_exitcode(st)
+    rc, out = drive([bin_, "--trace", "t.rec"], keys, cwd=d, home=d, timeout=timeout)
+    return out, rc
 fails = []
 out, rc = run([b"scene\n", (bad + "/nodir.scene\n").encode(), (scenes + "/opticrt.scene\n").encode(), b"n\n"])
 if rc != 0: fails.append("re-ask session exit %d" % rc)

@@ -146,34 +146,17 @@ check "trace record replay asan" replay_record "$ASAN"
 
 # ---- on a terminal: a bad file is explained and asked again ---------------------------
 tty_record() {
-    python3 - "$BIN" "$RW/tty" "$RW/doublet.rec" <<'EOF'
-import os, pty, select, shutil, sys, time
+    python3 - "$BIN" "$RW/tty" "$RW/doublet.rec" "$TOP/tests" <<'EOF'
+import os, shutil, sys
 bin_, d, rec = sys.argv[1:4]
+sys.path.insert(0, sys.argv[4])
+from ptydrive import drive
 os.makedirs(d, exist_ok=True)
 shutil.copy(rec, os.path.join(d, "doublet.rec"))
 with open(os.path.join(d, "broken.lens"), "w") as f: f.write("3 0 1.5\n-3 x 1\nobject -2\n")
-pid, fd = pty.fork()
-if pid == 0:
-    os.chdir(d); os.environ["HOME"] = d; os.environ["TERM"] = "dumb"
-    os.execv(bin_, [bin_, "--trace", "t.rec"])
-out = b""; deadline = time.time() + 60
-for k in [b"record\n", b"broken.lens\n", b"doublet.rec\n", b"9\n", b"4\n", b"30\n", b"1\n", b"n\n", b"n\n"]:
-    while time.time() < deadline:
-        r, _, _ = select.select([fd], [], [], 0.3)
-        if not r: break
-        try: out += os.read(fd, 65536)
-        except OSError: break
-    os.write(fd, k)
-while time.time() < deadline:
-    r, _, _ = select.select([fd], [], [], 0.3)
-    if r:
-        try: data = os.read(fd, 65536)
-        except OSError: break
-        if not data: break
-        out += data
-    elif os.waitpid(pid, os.WNOHANG)[0]: break
-_, st = os.waitpid(pid, 0)
-out = out.decode(errors="replace"); rc = os.waitstatus_to_exitcode(st)
+rc, out = drive([bin_, "--trace", "t.rec"],
+                [b"record\n", b"broken.lens\n", b"doublet.rec\n", b"9\n", b"4\n", b"30\n",
+                 b"1\n", b"n\n", b"n\n"], cwd=d, home=d, timeout=60)
 rec = open(os.path.join(d, "t.rec")).read()
 fails = []
 if rc != 0: fails.append("exit %d" % rc)

@@ -5,43 +5,12 @@ keyboard would, and check what a person would see.  MODE:
          then completes and the record holds only the accepted answers
   ctrld  Ctrl-D at a question ends the session cleanly (exit 0), record kept
 Exit 0 when every check holds; prints what failed otherwise."""
-import os, pty, select, sys, time
+import os, sys
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from ptydrive import drive
 
 def run(bin_, args, keys, home, timeout=10):
-    pid, fd = pty.fork()
-    if pid == 0:
-        os.environ["HOME"] = home
-        os.environ["TERM"] = "dumb"
-        os.execv(bin_, [bin_] + args)
-    out = b""
-    deadline = time.time() + timeout
-    for k in keys:
-        # wait until the program has asked (its output goes quiet), then type
-        while time.time() < deadline:
-            r, _, _ = select.select([fd], [], [], 0.15)
-            if not r:
-                break
-            try:
-                out += os.read(fd, 65536)
-            except OSError:
-                break
-        os.write(fd, k)
-    while time.time() < deadline:
-        r, _, _ = select.select([fd], [], [], 0.2)
-        if r:
-            try:
-                data = os.read(fd, 65536)
-            except OSError:
-                break
-            if not data:
-                break
-            out += data
-        else:
-            wpid, st = os.waitpid(pid, os.WNOHANG)
-            if wpid:
-                return os.waitstatus_to_exitcode(st), out.decode(errors="replace")
-    _, st = os.waitpid(pid, 0)
-    return os.waitstatus_to_exitcode(st), out.decode(errors="replace")
+    return drive([bin_] + args, keys, home=home, timeout=timeout, quiet=0.15)
 
 def main():
     bin_, mode, home = sys.argv[1], sys.argv[2], sys.argv[3]
