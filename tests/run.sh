@@ -29,6 +29,14 @@ unit() {
     if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
         fail "$1 exited $rc"; tail -20 "$WORK/unit.out"; fi
 }
+# trace_session BIN DIR ANSWERS...: lensmat --trace in DIR with the answers (one per
+# line) read from DIR/in; stdout in DIR/out, stderr in DIR/err, record DIR/r.rec.
+trace_session() {
+    bin=$1; dir=$2; shift 2
+    mkdir -p "$dir"
+    printf '%s\n' "$@" > "$dir/in"
+    (cd "$dir" && "$bin" --trace -i in r.rec > out 2> err)
+}
 have_shared() { [ -d "$SHARED/reference/lensmat" ] && [ -x "$ORIG" ]; }
 
 for t in "$TOP"/tests/t_*.sh; do

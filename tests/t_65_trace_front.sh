@@ -13,15 +13,6 @@ SCENES=$TOP/scenes
 TW=$WORK/trace
 mkdir -p "$TW"
 
-# tr_session BIN DIR ANSWERS...: run --trace in DIR with the answers (one per line)
-# read from DIR/in; stdout in DIR/out, stderr in DIR/err, record DIR/r.rec.
-tr_session() {
-    bin=$1; dir=$2; shift 2
-    mkdir -p "$dir"
-    printf '%s\n' "$@" > "$dir/in"
-    (cd "$dir" && "$bin" --trace -i in r.rec > out 2> err)
-}
-
 # summary_value FILE KEY
 summary_value() { awk -v k="$2" '$1 == k { print $2 }' "$1"; }
 
@@ -54,7 +45,7 @@ check_outputs() {
 trace_scene_ok() {
     bin=$1; name=$2; dir=$TW/$3
     rm -rf "$dir"
-    tr_session "$bin" "$dir" scene "$SCENES/$name.scene" n || { cat "$dir/err"; return 1; }
+    trace_session "$bin" "$dir" scene "$SCENES/$name.scene" n || { cat "$dir/err"; return 1; }
     grep -q "^Energy balance error: " "$dir/out" && ! grep -q Warning "$dir/out"
 }
 
@@ -90,7 +81,7 @@ threads_same() {
             "$SCENES/singlet.scene" > "$TW/th$t/a.scene"
         echo "threads $t" >> "$TW/th$t/a.scene"
         echo "output segments p.l" >> "$TW/th$t/a.scene"
-        tr_session "$BIN" "$TW/th$t" scene a.scene n || return 1
+        trace_session "$BIN" "$TW/th$t" scene a.scene n || return 1
     done
     for f in h.csv s.txt p.l; do cmp "$TW/th1/$f" "$TW/th2/$f" || return 1; done
     [ "$(wc -l < "$TW/th1/h.csv")" -gt 100 ]
@@ -214,7 +205,7 @@ check "lens fan asan: 11 surfaces, no leak" long_lens
 # ---- the tessellation table: errors shrink with tessellation, refinement is exact ----
 tess_table() {
     d=$TW/tess; rm -rf "$d"
-    tr_session "$BIN" "$d" table 50 -50 8 1.5168 12 41 n || { cat "$d/err"; return 1; }
+    trace_session "$BIN" "$d" table 50 -50 8 1.5168 12 41 n || { cat "$d/err"; return 1; }
     awk '/^mesh [0-9]+ +[0-9]/ { m[++n] = $4 }
          /\+refine/ { if (!($5 < 1e-9)) bad = 1 }
          /\+normal/ { nm[++k] = $5 }

@@ -9,13 +9,6 @@
 RW=$WORK/trace-record
 mkdir -p "$RW"
 
-# rr_session BIN DIR ANSWERS...: --trace in DIR, answers from DIR/in; out, err, r.rec
-rr_session() {
-    bin=$1; dir=$2; shift 2
-    mkdir -p "$dir"
-    printf '%s\n' "$@" > "$dir/in"
-    (cd "$dir" && "$bin" --trace -i in r.rec > out 2> err)
-}
 
 # The classic sessions the traces read (records made here, by this build): the golden
 # doublet, and the golden thick lens R 3 / 4 with a second object (-10 images
@@ -47,7 +40,7 @@ near_axis_ok() {
 # are 30 and 100 left of the first surface (z = 0), as the dialogue lists them.
 record_doublet() {
     d=$RW/d; rm -rf "$d"
-    rr_session "$1" "$d" record ../doublet.rec 4 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
+    trace_session "$1" "$d" record ../doublet.rec 4 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
     [ ! -s "$d/err" ] || { cat "$d/err"; return 1; }
     grep -q '^Lens file: 4 surfaces, index left of the first surface 1 $' "$d/r.rec" &&
     grep -q '^Surface 3: radius -4.5, location 1.2, index right 1.6, semi-diameter 4 $' "$d/r.rec" &&
@@ -63,7 +56,7 @@ check "trace record asan: doublet from a classic record" record_doublet "$ASAN"
 # real one traced.
 record_thick() {
     d=$RW/t; rm -rf "$d"
-    rr_session "$BIN" "$d" record ../thick.in 2.5 10 0.8 y 40 0.8 n n || { cat "$d/err"; return 1; }
+    trace_session "$BIN" "$d" record ../thick.in 2.5 10 0.8 y 40 0.8 n n || { cat "$d/err"; return 1; }
     grep -q '^Object planes of the file, as distances left of the first surface: 10 40$' "$d/r.rec" &&
         [ "$(grep -c '^The image is virtual' "$d/r.rec")" -eq 1 ] &&
         same_images "$RW/thick.rec" "$d/r.rec" && near_axis_ok "$d/r.rec" 1
@@ -75,7 +68,7 @@ check "trace record: thick lens from grep'd answers, images = classic's, virtual
 record_prescription() {
     d=$RW/p; rm -rf "$d"; mkdir -p "$d"
     "$BIN" --to-prescription -i "$RW/doublet.rec" "$d/doublet.lens" || return 1
-    rr_session "$BIN" "$d" record doublet.lens 4 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
+    trace_session "$BIN" "$d" record doublet.lens 4 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
     sed -n '/^Lens file:/,$p' "$RW/d/r.rec" > "$d/from-record"
     sed -n '/^Lens file:/,$p' "$d/r.rec" > "$d/from-prescription"
     [ -s "$d/from-record" ] && cmp "$d/from-record" "$d/from-prescription" &&
@@ -88,7 +81,7 @@ check "trace record: the doublet's prescription file traces as its record" recor
 record_plane() {
     d=$RW/pl; rm -rf "$d"; mkdir -p "$d"
     printf 'index 1\nplane 0 1.5\n-20 4 1\nobject -50\n' > "$d/pc.lens"
-    rr_session "$BIN" "$d" record pc.lens 10 inf 1 n n || { cat "$d/err"; return 1; }
+    trace_session "$BIN" "$d" record pc.lens 10 inf 1 n n || { cat "$d/err"; return 1; }
     grep -q 'at most 20, the smallest |radius|' "$d/r.rec" &&
         grep -q '^Surface 1: plane, location 0' "$d/r.rec" && near_axis_ok "$d/r.rec" 1
 }

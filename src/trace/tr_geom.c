@@ -363,10 +363,7 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
         if (!g->nasph) return 0;
         r[nr++] = ld[2] != 0 ? -lo[2] / ld[2] : 0;     /* start from the vertex plane */
     } else {
-        double q = -(B + copysign(sqrt(disc), B));
-        if (A != 0) r[nr++] = q / A;
-        if (q != 0) r[nr++] = C / q;
-        if (nr == 2 && r[0] > r[1]) { double x = r[0]; r[0] = r[1]; r[1] = x; }
+        nr = tr_quad_roots(A, B, C, disc, r);
     }
     for (int i = 0; i < nr; i++) {
         double tt = r[i];

@@ -76,6 +76,19 @@ static inline int tr_axial_ok(const tr_shape *g, const double p[3])
     return tr_in_aperture(g, p[0], p[1]);
 }
 
+/* Both real roots of A t^2 + 2B t + C = 0 (disc = B^2 - A C >= 0) in the stable form:
+ * q = -(B + sign(B) sqrt(disc)), roots q/A and C/q (each only where it is defined),
+ * ascending.  Returns how many.  Shared by every quadric intersection. */
+static inline int tr_quad_roots(double A, double B, double C, double disc, double r[2])
+{
+    int nr = 0;
+    double q = -(B + copysign(sqrt(disc), B));
+    if (A != 0) r[nr++] = q / A;
+    if (q != 0) r[nr++] = C / q;
+    if (nr == 2 && r[0] > r[1]) { double x = r[0]; r[0] = r[1]; r[1] = x; }
+    return nr;
+}
+
 /* The hot cases of tr_shape_hit_t, inline (the trace loop calls them per segment):
  * TR_FAST_CONIC, an axial conic without aspheric terms whose frame is the world's
  * (lens surfaces): stable quadratic, and a ray leaving the surface drops the root
@@ -95,10 +108,7 @@ static inline int tr_conic_hit(const tr_shape *g, const double o[3], const doubl
         double C = c * (lo[0] * lo[0] + lo[1] * lo[1] + k1 * lo[2] * lo[2]) - 2 * lo[2];
         double disc = B * B - A * C;
         if (disc < 0) return 0;
-        double q = -(B + copysign(sqrt(disc), B));
-        if (A != 0) r[nr++] = q / A;
-        if (q != 0) r[nr++] = C / q;
-        if (nr == 2 && r[0] > r[1]) { double x = r[0]; r[0] = r[1]; r[1] = x; }
+        nr = tr_quad_roots(A, B, C, disc, r);
     }
     for (int i = 0; i < nr; i++) {
         double tt = r[i];
