@@ -14,6 +14,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "tr_int.h"
+#include "tr_packet.h"
 
 typedef struct tr_surf {
     int id, is_mesh;
@@ -27,6 +28,7 @@ typedef struct tr_surf {
     double eps;                /* mesh: plane distances below this are "here" */
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
     const tr_shape *seqg[4];   /* ... and their shapes */
+    tr_pk_set pk;              /* ... laid out for the packet */
 } tr_surf;
 
 struct trace_scene {
@@ -43,6 +45,7 @@ struct trace_scene {
     int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
     int entry[4], nentry;      /* lens: what a forward ray from left of it meets first */
     const tr_shape *entryg[4];
+    tr_pk_set entry_pk;
     double entry_z;            /* ... if it starts at z < entry_z */
 };
 
@@ -98,10 +101,13 @@ const tr_shape *tr_scene_shape(const trace_scene *sc, int id)
 void tr_scene_set_entry(trace_scene *sc, const int *cand, int n, double z)
 {
     sc->nentry = 0;
+    tr_pk_set_clear(&sc->entry_pk);
     for (int i = 0; i < n && i < 4; i++)
         if (cand[i] >= 0) {
-            sc->entryg[sc->nentry] = &sc->surf[cand[i]]->shape;
+            const tr_surf *f = sc->surf[cand[i]];
+            sc->entryg[sc->nentry] = &f->shape;
             sc->entry[sc->nentry++] = cand[i];
+            tr_pk_set_add(&sc->entry_pk, cand[i], &f->shape, &f->mat, 0);
         }
     sc->entry_z = z;
 }
@@ -110,10 +116,13 @@ void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
 {
     tr_surf *f = sc->surf[id];
     f->nseq = 0;
+    tr_pk_set_clear(&f->pk);
     for (int i = 0; i < n && i < 4; i++)
         if (cand[i] >= 0) {
-            f->seqg[f->nseq] = &sc->surf[cand[i]]->shape;
+            const tr_surf *c = sc->surf[cand[i]];
+            f->seqg[f->nseq] = &c->shape;
             f->seq[f->nseq++] = cand[i];
+            tr_pk_set_add(&f->pk, cand[i], &c->shape, &c->mat, cand[i] == id);
         }
     sc->seq_nsurf = sc->nsurf;
 }
@@ -694,14 +703,12 @@ typedef struct tr_out {
     tr_buf seg, hit;
 } tr_out;
 
-/* Rays traced side by side on the lens shortcut: their dependent chains of square
- * roots and divisions overlap in the processor (one ray alone waits on them). */
-#define TR_LANES 4
+/* Rays traced side by side on the lens shortcut (tr_packet.c): four rays' arithmetic
+ * in vector registers, one step at a time. */
+#define TR_LANES TR_PK
 
 typedef struct tr_lane {
-    tr_wray r;
-    tr_hitrec h;
-    double hp[3];                /* seq_hit's point, for the normal */
+    tr_wray r;                   /* its doubles live in the packet while it runs */
     tr_tally *ty;
     uint64_t ray;
     double p0;
@@ -992,62 +999,172 @@ static void source_ray(const trace_scene *sc, int *k, uint64_t g, tr_ray0 *r)
     tr_source_ray(&sc->src[*k], (long)(g - sc->src[*k].first), r);
 }
 
-/* Rays i0 .. i0+n-1 of the worker side by side while each stays on the lens
- * shortcut, step by step; a lane that leaves it (no candidate hit, depth limit, a
- * ray going back, reflections waiting) is finished alone afterwards by trace_rest.
- * Every lane computes exactly what trace_one would; its records wait in the lane's
- * buffers and are passed on in ray order. */
-static void trace_lanes(tr_worker *w, uint64_t i0, int n, int *k)
+/* Lane l of a packet from a ray's doubles, and back. */
+static void pk_put(tr_pk *p, int l, const tr_wray *r)
+{
+    for (int i = 0; i < 3; i++) {
+        p->o[i][l] = r->o[i];
+        p->d[i][l] = r->d[i];
+        p->e[i][l] = r->pol.e[i];
+    }
+    p->n[l] = r->n;
+    p->len[l] = r->len;
+    p->opl[l] = r->opl;
+    p->jss[l] = r->pol.jss;
+    p->jpp[l] = r->pol.jpp;
+    p->jre[l] = r->pol.jre;
+    p->jim[l] = r->pol.jim;
+}
+
+static void pk_get(const tr_pk *p, int l, tr_wray *r)
+{
+    for (int i = 0; i < 3; i++) {
+        r->o[i] = p->o[i][l];
+        r->d[i] = p->d[i][l];
+        r->pol.e[i] = p->e[i][l];
+    }
+    r->n = p->n[l];
+    r->len = p->len[l];
+    r->opl = p->opl[l];
+    r->pol.jss = p->jss[l];
+    r->pol.jpp = p->jpp[l];
+    r->pol.jre = p->jre[l];
+    r->pol.jim = p->jim[l];
+}
+
+/* The ray of lane l with the doubles of packet p (its counts and surfaces: L->r's). */
+static tr_wray *lane_ray(const tr_lane *L, const tr_pk *p, int l, tr_wray *r)
+{
+    *r = L->r;
+    pk_get(p, l, r);
+    return r;
+}
+
+static void lane_end(tr_lane *L, int *nrun)
+{
+    L->live = 0;
+    L->state = L->sp ? LANE_SLOW : LANE_DONE;
+    (*nrun)--;
+}
+
+/* The books of lane l after a packet step from in to out (x): what on_hit and
+ * interact count and record for the same step, in the same order. */
+static void lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr_pk *out,
+                       const tr_pk_aux *x, const int *id, int *nrun)
+{
+    tr_tally *ty = L->ty;
+    tr_wray *r = &L->r, s;
+    int surf = id[x->cand[l] & 3], st = (int)x->status[l];
+    double q[3] = {out->o[0][l], out->o[1][l], out->o[2][l]}, p = x->p[l];
+    if (st == TR_PK_SCALAR) {                 /* the one-ray code takes this step */
+        pk_get(in, l, r);
+        L->state = LANE_SLOW;
+        (*nrun)--;
+        return;
+    }
+    ty->segments++;
+    if (st == TR_PK_ABSORB) {
+        ty->absorbed += p;
+        emit_segment(w, &L->out, lane_ray(L, in, l, &s), L->ray, q, TRACE_END_ABSORB, surf);
+        lane_end(L, nrun);
+        return;
+    }
+    if (st == TR_PK_DETECT) {
+        tr_hitrec h = {surf, -1, x->t[l], {x->nrm[0][l], x->nrm[1][l], x->nrm[2][l]}};
+        ty->detected += p;
+        ty->hits++;
+        lane_ray(L, out, l, &s);
+        v_set(s.o, (double[3]){in->o[0][l], in->o[1][l], in->o[2][l]});
+        emit_segment(w, &L->out, &s, L->ray, q, TRACE_END_DETECT, surf);
+        emit_hit(w, &L->out, &s, L->ray, &h, q);
+        lane_end(L, nrun);
+        return;
+    }
+    if (w->want_seg)
+        emit_segment(w, &L->out, lane_ray(L, in, l, &s), L->ray, q, TRACE_END_NONE, surf);
+    if (x->mismatch[l]) ty->mismatch++;
+    ty->interactions++;
+    r->depth++;
+    r->last_surf = surf;
+    r->last_prim = -1;
+    if (w->o->fresnel && w->o->reflections) {
+        tr_wray *c = lane_ray(L, out, l, &L->stack[L->sp]);
+        if (r->depth <= 32) c->hist |= 1u << (r->depth - 1);
+        for (int i = 0; i < 3; i++) c->d[i] = x->rd[i][l];
+        c->n = x->n1[l];
+        c->pol.jss = x->Rs[l] * x->jss[l];
+        c->pol.jpp = x->Rp[l] * x->jpp[l];
+        c->pol.jre = x->rsp[l] * x->jre[l];
+        c->pol.jim = x->rsp[l] * x->jim[l];
+        keep(w, ty, &L->sp, c, L->p0);
+    } else if (w->o->fresnel) {
+        double pr = x->Rs[l] * x->jss[l] + x->Rp[l] * x->jpp[l];
+        if (pr > 0) { ty->cutoff += pr; ty->cut_reflection++; }
+    }
+    if (!strong(w, ty, out->jss[l] + out->jpp[l], L->p0)) lane_end(L, nrun);
+}
+
+/* Rays i0 .. i0+TR_LANES-1 of the worker side by side while each stays on the lens
+ * shortcut, step by step in a packet; a lane that leaves it (no candidate hit, depth
+ * limit, a ray going back, TIR, reflections waiting) is finished alone afterwards by
+ * trace_rest from where it left.  Every lane computes exactly what trace_one would;
+ * its records wait in the lane's buffers and are passed on in ray order. */
+static void trace_lanes(tr_worker *w, uint64_t i0, int *k)
 {
     const trace_scene *sc = w->sc;
     const trace_options *o = w->o;
-    int nrun = n;
+    int nrun = TR_LANES, cur = 0;
     tr_ray0 r0[TR_LANES];
+    tr_pk pk[2];
+    tr_pk_aux x;
     uint64_t g = w->first + i0;
     source_ray(sc, k, g, &r0[0]);             /* moves *k to the first ray's source */
     const tr_source *src = &sc->src[*k];
-    if (g + (uint64_t)n <= src->first + (uint64_t)src->nrays)
-        tr_source_rays(src, (long)(g - src->first), n, r0);
+    if (g + TR_LANES <= src->first + (uint64_t)src->nrays)
+        tr_source_rays(src, (long)(g - src->first), TR_LANES, r0);
     else
-        for (int l = 1; l < n; l++) source_ray(sc, k, g + (uint64_t)l, &r0[l]);
-    for (int l = 0; l < n; l++) {
+        for (int l = 1; l < TR_LANES; l++) source_ray(sc, k, g + (uint64_t)l, &r0[l]);
+    for (int l = 0; l < TR_LANES; l++) {
         tr_lane *L = &w->lane[l];
         L->ray = g + (uint64_t)l;
         L->ty = &w->tally[l];
         ray_start(&L->r, &r0[l], L->ty, &L->p0);
+        pk_put(&pk[0], l, &L->r);
         L->sp = 0;
         L->live = 1;
         L->state = LANE_RUN;
     }
     while (nrun > 0) {
-        for (int l = 0; l < n; l++) {            /* the hits */
+        const tr_pk *in = &pk[cur];
+        const tr_pk_set *set = NULL;
+        int last = 0;
+        unsigned live = 0;
+        for (int l = 0; l < TR_LANES; l++) {     /* who takes this step in the packet */
             tr_lane *L = &w->lane[l];
-            const int *cand;
-            const tr_shape *const *cg;
-            int nc;
-            if (L->state != LANE_RUN) continue;
             tr_wray *r = &L->r;
-            if (r->depth > L->ty->max_depth) L->ty->max_depth = r->depth;
-            if (r->depth >= o->max_depth ||
-                !seq_cands(sc, o, r->o, r->d, r->last_surf, r->hist, &cand, &cg, &nc) ||
-                !seq_hit(cand, cg, nc, r->last_surf, r->o, r->d, &L->h, L->hp)) {
-                L->state = LANE_SLOW;             /* trace_rest redoes this step */
-                nrun--;
-            }
-        }
-        for (int l = 0; l < n; l++)              /* their normals */
-            if (w->lane[l].state == LANE_RUN) seq_normal(sc, &w->lane[l].h, w->lane[l].hp);
-        for (int l = 0; l < n; l++) {            /* what the surfaces do */
-            tr_lane *L = &w->lane[l];
             if (L->state != LANE_RUN) continue;
-            if (!on_hit(w, &L->out, L->ty, L->stack, &L->sp, &L->r, &L->h, L->ray, L->p0)) {
-                L->live = 0;
-                L->state = L->sp ? LANE_SLOW : LANE_DONE;
+            if (r->depth > L->ty->max_depth) L->ty->max_depth = r->depth;
+            if (!set) {
+                last = r->last_surf;
+                set = last >= 0 ? &sc->surf[last]->pk : &sc->entry_pk;
+            }
+            if (r->depth < o->max_depth && r->last_surf == last && set->nc > 0 && r->hist == 0 &&
+                in->d[2][l] > 0 && (last >= 0 || in->o[2][l] < sc->entry_z)) {
+                live |= 1u << l;
+            } else {
+                pk_get(in, l, r);
+                L->state = LANE_SLOW;
                 nrun--;
             }
         }
+        if (!live) break;
+        tr_pk_step(in, &pk[cur ^ 1], &x, set, live, o->fresnel, o->reflections);
+        for (int l = 0; l < TR_LANES; l++)
+            if (live & (1u << l))
+                lane_books(w, &w->lane[l], l, in, &pk[cur ^ 1], &x, set->id, &nrun);
+        cur ^= 1;
     }
-    for (int l = 0; l < n; l++) {
+    for (int l = 0; l < TR_LANES; l++) {
         tr_lane *L = &w->lane[l];
         if (buf_move(&w->out.seg, &L->out.seg) || buf_move(&w->out.hit, &L->out.hit))
             w->nomem = 1;
@@ -1055,6 +1172,14 @@ static void trace_lanes(tr_worker *w, uint64_t i0, int n, int *k)
             trace_rest(w, &w->out, L->ty, L->stack, L->sp, &L->r, L->live, L->ray, L->p0);
         fold(w, i0 + (uint64_t)l, L->ty);
     }
+}
+
+/* tr_pk_step is compiled for AVX-512: without it rays go one by one (same bits). */
+static int packets_usable(void)
+{
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+           __builtin_cpu_supports("avx512dq");
 }
 
 /* Trace the worker's batch: rays first .. first+count-1, records to w->out in ray
@@ -1065,8 +1190,9 @@ static void trace_batch(tr_worker *w)
     const trace_options *o = w->o;
     int k = 0;
     uint64_t i = 0;
-    if (o->sequential && !o->float_hits && sc->seq_nsurf == sc->nsurf && sc->nentry > 0)
-        for (; i + TR_LANES <= w->count; i += TR_LANES) trace_lanes(w, i, TR_LANES, &k);
+    if (o->sequential && !o->float_hits && sc->seq_nsurf == sc->nsurf && sc->nentry > 0 &&
+        packets_usable())
+        for (; i + TR_LANES <= w->count; i += TR_LANES) trace_lanes(w, i, &k);
     for (; i < w->count; i++) {
         tr_ray0 r;
         source_ray(sc, &k, w->first + i, &r);
