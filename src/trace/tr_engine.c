@@ -999,8 +999,9 @@ static void source_ray(const trace_scene *sc, int *k, uint64_t g, tr_ray0 *r)
     tr_source_ray(&sc->src[*k], (long)(g - sc->src[*k].first), r);
 }
 
-/* Lane l of a packet from a ray's doubles, and back. */
-static void pk_put(tr_pk *p, int l, const tr_wray *r)
+/* Lane l of a packet from a starting ray (its books are empty), and a ray's doubles
+ * back from lane l. */
+static void pk_put(tr_pk *p, int l, const tr_wray *r, double p0)
 {
     for (int i = 0; i < 3; i++) {
         p->o[i][l] = r->o[i];
@@ -1014,6 +1015,10 @@ static void pk_put(tr_pk *p, int l, const tr_wray *r)
     p->jpp[l] = r->pol.jpp;
     p->jre[l] = r->pol.jre;
     p->jim[l] = r->pol.jim;
+    p->p0[l] = p0;
+    p->cut[l] = 0;
+    p->depth[l] = p->maxd[l] = r->depth;
+    p->nseg[l] = p->nint[l] = p->nmis[l] = p->ncutr[l] = 0;
 }
 
 static void pk_get(const tr_pk *p, int l, tr_wray *r)
@@ -1030,66 +1035,87 @@ static void pk_get(const tr_pk *p, int l, tr_wray *r)
     r->pol.jpp = p->jpp[l];
     r->pol.jre = p->jre[l];
     r->pol.jim = p->jim[l];
+    r->depth = (int)p->depth[l];
 }
 
-/* The ray of lane l with the doubles of packet p (its counts and surfaces: L->r's). */
-static tr_wray *lane_ray(const tr_lane *L, const tr_pk *p, int l, tr_wray *r)
+/* The ray of lane l as packet p holds it, having left surface `last`. */
+static tr_wray *lane_ray(const tr_lane *L, const tr_pk *p, int l, int last, tr_wray *r)
 {
     *r = L->r;
     pk_get(p, l, r);
+    r->last_surf = last;
+    r->last_prim = -1;
     return r;
 }
 
-static void lane_end(tr_lane *L, int *nrun)
+/* The books lane l kept in packet p go back to its tally (they were empty when it
+ * entered the packet, so the sums are exact). */
+static void lane_tally(tr_lane *L, const tr_pk *p, int l)
+{
+    tr_tally *ty = L->ty;
+    if (p->maxd[l] > ty->max_depth) ty->max_depth = (int)p->maxd[l];
+    ty->segments += (uint32_t)p->nseg[l];
+    ty->interactions += (uint32_t)p->nint[l];
+    ty->mismatch += (uint32_t)p->nmis[l];
+    ty->cut_reflection += (uint32_t)p->ncutr[l];
+    ty->cutoff += p->cut[l];
+}
+
+/* Lane l leaves the packet as p holds it (having left surface `last`) to go on alone:
+ * its ray and books go back to L. */
+static void lane_leave(tr_lane *L, const tr_pk *p, int l, int last)
+{
+    lane_ray(L, p, l, last, &L->r);
+    lane_tally(L, p, l);
+}
+
+/* Lane l is finished here (the one-ray code takes its reflected rays, if any). */
+static void lane_end(tr_lane *L)
 {
     L->live = 0;
     L->state = L->sp ? LANE_SLOW : LANE_DONE;
-    (*nrun)--;
 }
 
-/* The books of lane l after a packet step from in to out (x): what on_hit and
- * interact count and record for the same step, in the same order. */
-static void lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr_pk *out,
-                       const tr_pk_aux *x, const int *id, int *nrun)
+/* What on_hit and interact record for lane l's step from in (having left `last`) to
+ * out, and the books of a lane that stops here.  Returns 1 if it goes on. */
+static int lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr_pk *out,
+                      const tr_pk_aux *x, const int *id, int last, unsigned calm)
 {
     tr_tally *ty = L->ty;
-    tr_wray *r = &L->r, s;
+    tr_wray s;
     int surf = id[x->cand[l] & 3], st = (int)x->status[l];
     double q[3] = {out->o[0][l], out->o[1][l], out->o[2][l]}, p = x->p[l];
     if (st == TR_PK_SCALAR) {                 /* the one-ray code takes this step */
-        pk_get(in, l, r);
+        lane_leave(L, in, l, last);
         L->state = LANE_SLOW;
-        (*nrun)--;
-        return;
+        return 0;
     }
-    ty->segments++;
-    if (st == TR_PK_ABSORB) {
-        ty->absorbed += p;
-        emit_segment(w, &L->out, lane_ray(L, in, l, &s), L->ray, q, TRACE_END_ABSORB, surf);
-        lane_end(L, nrun);
-        return;
+    if (st == TR_PK_ABSORB || st == TR_PK_DETECT) {    /* the ray ends: books only */
+        lane_tally(L, out, l);
+        ty->segments++;
+        if (w->want_seg || w->want_hit) {
+            lane_ray(L, st == TR_PK_ABSORB ? in : out, l, last, &s);
+            v_set(s.o, (double[3]){in->o[0][l], in->o[1][l], in->o[2][l]});
+        }
+        if (st == TR_PK_ABSORB) {
+            ty->absorbed += p;
+            emit_segment(w, &L->out, &s, L->ray, q, TRACE_END_ABSORB, surf);
+        } else {
+            tr_hitrec h = {surf, -1, x->t[l], {x->nrm[0][l], x->nrm[1][l], x->nrm[2][l]}};
+            ty->detected += p;
+            ty->hits++;
+            emit_segment(w, &L->out, &s, L->ray, q, TRACE_END_DETECT, surf);
+            emit_hit(w, &L->out, &s, L->ray, &h, q);
+        }
+        lane_end(L);
+        return 0;
     }
-    if (st == TR_PK_DETECT) {
-        tr_hitrec h = {surf, -1, x->t[l], {x->nrm[0][l], x->nrm[1][l], x->nrm[2][l]}};
-        ty->detected += p;
-        ty->hits++;
-        lane_ray(L, out, l, &s);
-        v_set(s.o, (double[3]){in->o[0][l], in->o[1][l], in->o[2][l]});
-        emit_segment(w, &L->out, &s, L->ray, q, TRACE_END_DETECT, surf);
-        emit_hit(w, &L->out, &s, L->ray, &h, q);
-        lane_end(L, nrun);
-        return;
-    }
-    if (w->want_seg)
-        emit_segment(w, &L->out, lane_ray(L, in, l, &s), L->ray, q, TRACE_END_NONE, surf);
-    if (x->mismatch[l]) ty->mismatch++;
-    ty->interactions++;
-    r->depth++;
-    r->last_surf = surf;
-    r->last_prim = -1;
+    if (w->want_seg)                           /* REFRACT */
+        emit_segment(w, &L->out, lane_ray(L, in, l, last, &s), L->ray, q, TRACE_END_NONE,
+                     surf);
     if (w->o->fresnel && w->o->reflections) {
-        tr_wray *c = lane_ray(L, out, l, &L->stack[L->sp]);
-        if (r->depth <= 32) c->hist |= 1u << (r->depth - 1);
+        tr_wray *c = lane_ray(L, out, l, surf, &L->stack[L->sp]);
+        if (c->depth <= 32) c->hist |= 1u << (c->depth - 1);
         for (int i = 0; i < 3; i++) c->d[i] = x->rd[i][l];
         c->n = x->n1[l];
         c->pol.jss = x->Rs[l] * x->jss[l];
@@ -1097,26 +1123,30 @@ static void lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const t
         c->pol.jre = x->rsp[l] * x->jre[l];
         c->pol.jim = x->rsp[l] * x->jim[l];
         keep(w, ty, &L->sp, c, L->p0);
-    } else if (w->o->fresnel) {
-        double pr = x->Rs[l] * x->jss[l] + x->Rp[l] * x->jpp[l];
-        if (pr > 0) { ty->cutoff += pr; ty->cut_reflection++; }
     }
-    if (!strong(w, ty, out->jss[l] + out->jpp[l], L->p0)) lane_end(L, nrun);
+    if (calm & (1u << l)) return 1;
+    lane_leave(L, out, l, surf);              /* too weak to go on */
+    strong(w, ty, out->jss[l] + out->jpp[l], L->p0);
+    lane_end(L);
+    return 0;
 }
 
 /* Rays i0 .. i0+TR_LANES-1 of the worker side by side while each stays on the lens
- * shortcut, step by step in a packet; a lane that leaves it (no candidate hit, depth
- * limit, a ray going back, TIR, reflections waiting) is finished alone afterwards by
- * trace_rest from where it left.  Every lane computes exactly what trace_one would;
- * its records wait in the lane's buffers and are passed on in ray order. */
+ * shortcut, step by step in a packet (tr_packet.c); a lane that leaves it (no
+ * candidate hit, depth limit, a ray going back, TIR, reflections waiting) is finished
+ * alone afterwards by trace_rest from where it left.  Every lane computes exactly what
+ * trace_one would; its records wait in the lane's buffers and are passed on in ray
+ * order. */
 static void trace_lanes(tr_worker *w, uint64_t i0, int *k)
 {
     const trace_scene *sc = w->sc;
     const trace_options *o = w->o;
-    int nrun = TR_LANES, cur = 0;
+    int cur = 0, last = -1, each = w->want_seg || o->reflections;
+    unsigned run = (1u << TR_LANES) - 1;
     tr_ray0 r0[TR_LANES];
     tr_pk pk[2];
     tr_pk_aux x;
+    tr_pk_opt po = {o->fresnel, o->reflections, o->max_depth, 1, o->cutoff, sc->entry_z};
     uint64_t g = w->first + i0;
     source_ray(sc, k, g, &r0[0]);             /* moves *k to the first ray's source */
     const tr_source *src = &sc->src[*k];
@@ -1129,43 +1159,42 @@ static void trace_lanes(tr_worker *w, uint64_t i0, int *k)
         L->ray = g + (uint64_t)l;
         L->ty = &w->tally[l];
         ray_start(&L->r, &r0[l], L->ty, &L->p0);
-        pk_put(&pk[0], l, &L->r);
+        pk_put(&pk[0], l, &L->r, L->p0);
         L->sp = 0;
         L->live = 1;
         L->state = LANE_RUN;
     }
-    while (nrun > 0) {
+    while (run) {
         const tr_pk *in = &pk[cur];
-        const tr_pk_set *set = NULL;
-        int last = 0;
-        unsigned live = 0;
-        for (int l = 0; l < TR_LANES; l++) {     /* who takes this step in the packet */
-            tr_lane *L = &w->lane[l];
-            tr_wray *r = &L->r;
-            if (L->state != LANE_RUN) continue;
-            if (r->depth > L->ty->max_depth) L->ty->max_depth = r->depth;
-            if (!set) {
-                last = r->last_surf;
-                set = last >= 0 ? &sc->surf[last]->pk : &sc->entry_pk;
-            }
-            if (r->depth < o->max_depth && r->last_surf == last && set->nc > 0 && r->hist == 0 &&
-                in->d[2][l] > 0 && (last >= 0 || in->o[2][l] < sc->entry_z)) {
-                live |= 1u << l;
-            } else {
-                pk_get(in, l, r);
-                L->state = LANE_SLOW;
-                nrun--;
-            }
-        }
-        if (!live) break;
-        tr_pk_step(in, &pk[cur ^ 1], &x, set, live, o->fresnel, o->reflections);
+        tr_pk *out = &pk[cur ^ 1];
+        const tr_pk_set *set = last >= 0 ? &sc->surf[last]->pk : &sc->entry_pk;
+        if (set->nc <= 0) break;
+        po.entry = last < 0;
+        unsigned calm = tr_pk_step(in, out, &x, set, run, &po);
+        unsigned next = calm;
         for (int l = 0; l < TR_LANES; l++)
-            if (live & (1u << l))
-                lane_books(w, &w->lane[l], l, in, &pk[cur ^ 1], &x, set->id, &nrun);
+            if ((run & (1u << l)) && (each || !(calm & (1u << l))) &&
+                !lane_books(w, &w->lane[l], l, in, out, &x, set->id, last, calm))
+                next &= ~(1u << l);
+        last = -1;
+        for (int l = 0; l < TR_LANES; l++) {     /* all on from the same surface */
+            if (!(next & (1u << l))) continue;
+            int surf = set->id[x.cand[l] & 3];
+            if (last < 0) last = surf;
+            if (surf == last) continue;
+            lane_leave(&w->lane[l], out, l, surf);
+            w->lane[l].state = LANE_SLOW;
+            next &= ~(1u << l);
+        }
+        run = next;
         cur ^= 1;
     }
     for (int l = 0; l < TR_LANES; l++) {
         tr_lane *L = &w->lane[l];
+        if (run & (1u << l)) {                   /* stopped by a surface not for packets */
+            lane_leave(L, &pk[cur], l, last);
+            L->state = LANE_SLOW;
+        }
         if (buf_move(&w->out.seg, &L->out.seg) || buf_move(&w->out.hit, &L->out.hit))
             w->nomem = 1;
         if (L->state == LANE_SLOW)

@@ -276,11 +276,16 @@ static void fresnel(vd n1, vd n2, vd ci, fres *f)
     f->rsp = sel(ns == np, rr, -rr);
 }
 
-void tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *st,
-                unsigned live, int fresnel_on, int reflections)
+unsigned tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *st,
+                    unsigned live, const tr_pk_opt *o)
 {
     pick k;
     vd n[3], q[3], e[3], j[4];
+    vm on;
+    for (int l = 0; l < W; l++) on[l] = live & (1u << l) ? -1 : 0;
+    /* trace_rest's depth limit and seq_cands's direction checks */
+    vm go = on & (in->depth < o->max_depth) & (in->d[2] > 0);
+    if (o->entry) go &= in->o[2] < o->entry_z;
     nearest(st, in->o, in->d, &k);
     normal(&k, n);
     x->t = k.t;
@@ -307,7 +312,7 @@ void tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *st,
     x->jss = j[0]; x->jpp = j[1]; x->jre = j[2]; x->jim = j[3];
     x->Rs = f.Rs; x->Rp = f.Rp; x->rsp = f.rsp;
     x->n1 = n1;
-    if (reflections) {
+    if (o->reflections) {
         for (int i = 0; i < 3; i++) x->rd[i] = in->d[i] + 2.0 * ci * m[i];
         unit(x->rd);
     }
@@ -317,9 +322,7 @@ void tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *st,
     vd a = vsqrt(f.Ts * f.Tp);
 
     /* what each lane did */
-    vm on;
-    for (int l = 0; l < W; l++) on[l] = live & (1u << l) ? -1 : 0;
-    vm hit = on & (k.k >= 0) & fin;
+    vm hit = go & (k.k >= 0) & fin;
     vm refr = hit & (k.kind == TRACE_REFRACT) & ~f.bad;
     vm det = hit & (k.kind == TRACE_DETECT), abso = hit & (k.kind == TRACE_ABSORB);
     vm rot = refr | det;
@@ -333,7 +336,7 @@ void tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *st,
         out->d[i] = sel(refr, d[i], in->d[i]);
     }
     out->n = sel(refr, n2, in->n);
-    if (fresnel_on) {
+    if (o->fresnel) {
         j[0] = sel(refr, j[0] * f.Ts, j[0]);
         j[1] = sel(refr, j[1] * f.Tp, j[1]);
         j[2] = sel(refr, j[2] * a, j[2]);
@@ -343,4 +346,26 @@ void tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *st,
     out->jpp = sel(rot, j[1], in->jpp);
     out->jre = sel(rot, j[2], in->jre);
     out->jim = sel(rot, j[3], in->jim);
+
+    /* the books: on_hit, interact, strong */
+    vm one = refr & 1;
+    out->p0 = in->p0;
+    out->maxd = seli(go & (in->depth > in->maxd), in->depth, in->maxd);
+    out->depth = in->depth + one;
+    out->nseg = in->nseg + one;
+    out->nint = in->nint + one;
+    out->nmis = in->nmis + (x->mismatch & 1);
+    out->cut = in->cut;
+    out->ncutr = in->ncutr;
+    if (o->fresnel && !o->reflections) {
+        vd pr = f.Rs * x->jss + f.Rp * x->jpp;
+        vm lost = refr & (pr > 0);
+        out->cut = sel(lost, in->cut + pr, in->cut);
+        out->ncutr = in->ncutr + (lost & 1);
+    }
+    vd pw = out->jss + out->jpp;
+    vm strong = refr & ~(pw <= 0) & ~(pw < o->cutoff * in->p0);
+    unsigned calm = 0;
+    for (int l = 0; l < W; l++) calm |= strong[l] ? 1u << l : 0;
+    return calm;
 }

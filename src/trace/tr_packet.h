@@ -23,7 +23,20 @@ typedef struct tr_pk {
     tr_vd o[3], d[3];
     tr_vd n, len, opl;
     tr_vd e[3], jss, jpp, jre, jim;   /* tr_pol */
+    tr_vd p0;                         /* the source ray's power */
+    /* the ray's books since it started, kept here while it runs in the packet */
+    tr_vd cut;                        /* reflected power cut off (reflections off) */
+    tr_vm depth, maxd;                /* interactions; the deepest step start */
+    tr_vm nseg, nint, nmis, ncutr;    /* segments, interactions, index mismatches,
+                                         reflections cut */
 } tr_pk;
+
+/* The trace options a step needs; entry: the rays come from the source (the first
+ * surface's candidates), and must start at z < entry_z. */
+typedef struct tr_pk_opt {
+    int fresnel, reflections, max_depth, entry;
+    double cutoff, entry_z;
+} tr_pk_opt;
 
 /* One surface the rays may meet next.  kind: the material's; leaving: the rays start
  * on it.  Only fast shapes (TR_FAST_CONIC, TR_FAST_PLANE) may be candidates. */
@@ -73,12 +86,15 @@ typedef struct tr_pk_aux {
 } tr_pk_aux;
 
 /* One step of the lanes in mask `live` (bit l: lane l) against the candidates of s
- * (nc > 0): the nearest hit in double (the first candidate at a tie), its normal, and
- * for REFRACT lanes the rotation into the s/p basis, Fresnel coefficients (applied to
- * the powers if fresnel), the reflected direction (if reflections) and the refracted
- * ray.  in and out must not overlap.  Needs AVX-512 (the caller checks). */
-void tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *s,
-                unsigned live, int fresnel, int reflections);
+ * (nc > 0): the depth limit and direction checks of the one-ray code, the nearest hit
+ * in double (the first candidate at a tie), its normal, and for REFRACT lanes the
+ * rotation into the s/p basis, Fresnel coefficients (applied to the powers if
+ * fresnel), the reflected direction (if reflections), the refracted ray and its books
+ * (counts, reflected power cut off).  Returns the lanes that refracted and keep enough
+ * power to go on; the others' books are the caller's.  in and out must not overlap.
+ * Needs AVX-512 (the caller checks). */
+unsigned tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *s,
+                    unsigned live, const tr_pk_opt *o);
 
 #pragma GCC visibility pop
 #endif
