@@ -91,17 +91,25 @@ static void double_beats_float(const trace_api *tr)
 }
 
 /* ---- thread count must not change a single bit ---- */
+/* The array a of *n records (size bytes, room *cap) with x appended, perhaps moved;
+ * NULL: no memory. */
+static void *append(void *a, size_t *n, size_t *cap, const void *x, size_t size)
+{
+    if (*n == *cap) {
+        *cap = *cap ? 2 * *cap : 4096;
+        if (!(a = realloc(a, *cap * size))) return NULL;
+    }
+    memcpy((char *)a + (*n)++ * size, x, size);
+    return a;
+}
+
 typedef struct rec { trace_hit *h; size_t n, cap; } rec;
 static int keep(void *ctx, const trace_hit *h)
 {
     rec *r = ctx;
-    if (r->n == r->cap) {
-        r->cap = r->cap ? 2 * r->cap : 4096;
-        r->h = realloc(r->h, r->cap * sizeof *r->h);
-        if (!r->h) return 1;
-    }
-    r->h[r->n++] = *h;
-    return 0;
+    void *a = append(r->h, &r->n, &r->cap, h, sizeof *h);
+    if (a) r->h = a;
+    return !a;
 }
 
 static void threads_bitwise(const trace_api *tr)
@@ -261,13 +269,9 @@ typedef struct segrec { trace_segment *s; size_t n, cap; } segrec;
 static int keep_seg(void *ctx, const trace_segment *g)
 {
     segrec *r = ctx;
-    if (r->n == r->cap) {
-        r->cap = r->cap ? 2 * r->cap : 4096;
-        r->s = realloc(r->s, r->cap * sizeof *r->s);
-        if (!r->s) return 1;
-    }
-    r->s[r->n++] = *g;
-    return 0;
+    void *a = append(r->s, &r->n, &r->cap, g, sizeof *g);
+    if (a) r->s = a;
+    return !a;
 }
 
 typedef struct both { rec h; segrec s; } both;
