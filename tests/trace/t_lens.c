@@ -91,26 +91,21 @@ static void double_beats_float(const trace_api *tr)
 }
 
 /* ---- thread count must not change a single bit ---- */
-/* The array a of *n records (size bytes, room *cap) with x appended, perhaps moved;
- * NULL: no memory. */
-static void *append(void *a, size_t *n, size_t *cap, const void *x, size_t size)
+/* Records kept from a sink, in order. */
+typedef struct rec { void *p; size_t n, cap; } rec;
+static int push(rec *r, const void *x, size_t size)
 {
-    if (*n == *cap) {
-        *cap = *cap ? 2 * *cap : 4096;
-        if (!(a = realloc(a, *cap * size))) return NULL;
+    if (r->n == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 4096;
+        void *p = realloc(r->p, cap * size);
+        if (!p) return 1;
+        r->p = p;
+        r->cap = cap;
     }
-    memcpy((char *)a + (*n)++ * size, x, size);
-    return a;
+    memcpy((char *)r->p + r->n++ * size, x, size);
+    return 0;
 }
-
-typedef struct rec { trace_hit *h; size_t n, cap; } rec;
-static int keep(void *ctx, const trace_hit *h)
-{
-    rec *r = ctx;
-    void *a = append(r->h, &r->n, &r->cap, h, sizeof *h);
-    if (a) r->h = a;
-    return !a;
-}
+static int keep(void *ctx, const trace_hit *h) { return push(ctx, h, sizeof *h); }
 
 static void threads_bitwise(const trace_api *tr)
 {
@@ -138,7 +133,7 @@ static void threads_bitwise(const trace_api *tr)
         tr->scene_free(sc);
     }
     for (int k = 1; k < 3; k++) {
-        int same = r[k].n == r[0].n && !memcmp(r[k].h, r[0].h, r[0].n * sizeof *r[0].h);
+        int same = r[k].n == r[0].n && !memcmp(r[k].p, r[0].p, r[0].n * sizeof(trace_hit));
         CHECK(same, "%d threads: %zu hits, bit-identical to 1 thread (%zu)", k + 1,
               r[k].n, r[0].n);
         same = !memcmp(&sum[k].emitted, &sum[0].emitted, 5 * sizeof(double)) &&
@@ -152,7 +147,7 @@ static void threads_bitwise(const trace_api *tr)
     CHECK(sum[0].segments > 7 * sum[0].rays, "reflections were followed (%llu segments, "
           "%llu rays)", (unsigned long long)sum[0].segments,
           (unsigned long long)sum[0].rays);
-    for (int k = 0; k < 3; k++) free(r[k].h);
+    for (int k = 0; k < 3; k++) free(r[k].p);
 }
 
 /* Every sink call folded into one hash, in the order the calls come. */
@@ -264,21 +259,12 @@ static void threads_stream(const trace_api *tr)
     tr->scene_free(sc);
 }
 
-/* Segments, compared bytewise like the hits (records zero their padding). */
-typedef struct segrec { trace_segment *s; size_t n, cap; } segrec;
-static int keep_seg(void *ctx, const trace_segment *g)
-{
-    segrec *r = ctx;
-    void *a = append(r->s, &r->n, &r->cap, g, sizeof *g);
-    if (a) r->s = a;
-    return !a;
-}
-
-typedef struct both { rec h; segrec s; } both;
+/* Hits and segments, compared bytewise (records zero their padding). */
+typedef struct both { rec h, s; } both;
 static int both_hit(void *ctx, const trace_hit *h) { return keep(&((both *)ctx)->h, h); }
 static int both_seg(void *ctx, const trace_segment *g)
 {
-    return keep_seg(&((both *)ctx)->s, g);
+    return push(&((both *)ctx)->s, g, sizeof *g);
 }
 
 /* The lens shortcut (no BVH between consecutive surfaces; on AVX-512 processors eight
@@ -318,8 +304,8 @@ static void sequential_same(const trace_api *tr)
         }
         int same = r[0].h.n == r[1].h.n && r[0].h.n > 1000 && r[0].s.n == r[1].s.n &&
                    (!segs || r[0].s.n > r[0].h.n) &&
-                   !memcmp(r[0].h.h, r[1].h.h, r[0].h.n * sizeof *r[0].h.h) &&
-                   (!segs || !memcmp(r[0].s.s, r[1].s.s, r[0].s.n * sizeof *r[0].s.s)) &&
+                   !memcmp(r[0].h.p, r[1].h.p, r[0].h.n * sizeof(trace_hit)) &&
+                   (!segs || !memcmp(r[0].s.p, r[1].s.p, r[0].s.n * sizeof(trace_segment))) &&
                    !memcmp(&sum[0].rays, &sum[1].rays, 10 * sizeof(uint64_t)) &&
                    sum[0].max_depth_seen == sum[1].max_depth_seen &&
                    !memcmp(&sum[0].emitted, &sum[1].emitted, 5 * sizeof(double));
@@ -329,7 +315,7 @@ static void sequential_same(const trace_api *tr)
               reflections ? "on" : "off", segs ? ", segments" : "", r[1].h.n,
               segs ? ", the segments" : "", ms[1], ms[0], (unsigned long long)sum[1].rays,
               (unsigned long long)sum[1].cut_power);
-        for (int k = 0; k < 2; k++) { free(r[k].h.h); free(r[k].s.s); }
+        for (int k = 0; k < 2; k++) { free(r[k].h.p); free(r[k].s.p); }
     }
 }
 
