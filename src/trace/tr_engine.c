@@ -703,7 +703,7 @@ typedef struct tr_out {
     tr_buf seg, hit;
 } tr_out;
 
-/* Rays traced side by side on the lens shortcut (tr_packet.c): four rays' arithmetic
+/* Rays traced side by side on the lens shortcut (tr_packet.c): TR_PK rays' arithmetic
  * in vector registers, one step at a time. */
 #define TR_LANES TR_PK
 

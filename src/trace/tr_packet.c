@@ -1,9 +1,9 @@
-/* tr_packet.c -- one step of four rays side by side through a sequential lens's
+/* tr_packet.c -- one step of eight rays side by side through a sequential lens's
  * candidate surfaces (see tr_packet.h).  Each function here is the vector twin of a
  * one-ray function and says which: the same operations in the same order, a branch
  * becoming a select between lanes, so every lane rounds exactly as that ray would
  * alone (GCC vector extensions: IEEE add, multiply, divide and square root per
- * element, and -ffp-contract=off from the build keeps them unfused).  Four rays at a
+ * element, and -ffp-contract=off from the build keeps them unfused).  Eight rays at a
  * time keep the divider and the square-root unit busy instead of waiting on one
  * ray's dependent chain; that is the whole point of this file. */
 #include <float.h>
@@ -26,7 +26,8 @@ void tr_pk_set_add(tr_pk_set *s, int id, const tr_shape *g, const trace_material
         return;
     }
     s->id[i] = id;
-    s->cd[i] = (tr_pk_cand){g, leaving, m->kind, m->n_front, m->n_back};
+    s->g[i] = g;
+    s->leaving[i] = leaving;
     s->c[i] = g->c;
     s->ck1[i] = g->ck1;
     s->cone[i] = g->fast == TR_FAST_CONIC;
@@ -188,10 +189,9 @@ static void nearest(const tr_pk_set *s, const vd o[3], const vd d[3], pick *k)
     k->k = msplat(-1);
     for (int j = 0; j < 3; j++) k->p[j] = splat(0);
     for (int i = 0; i < s->nc; i++) {
-        const tr_pk_cand *c = &s->cd[i];
-        int cone = c->g->fast == TR_FAST_CONIC;
-        vm ok = cone ? conic_hit(c->g, c->leaving, o, d, &t, p)
-                     : plane_hit(c->g, c->leaving, o, d, &t);
+        int cone = s->g[i]->fast == TR_FAST_CONIC;
+        vm ok = cone ? conic_hit(s->g[i], s->leaving[i], o, d, &t, p)
+                     : plane_hit(s->g[i], s->leaving[i], o, d, &t);
         vm up = ok & (t < best);
         best = sel(up, t, best);
         k->k = seli(up, msplat(i), k->k);

@@ -38,23 +38,16 @@ typedef struct tr_pk_opt {
     double cutoff, entry_z;
 } tr_pk_opt;
 
-/* One surface the rays may meet next.  kind: the material's; leaving: the rays start
- * on it.  Only fast shapes (TR_FAST_CONIC, TR_FAST_PLANE) may be candidates. */
-typedef struct tr_pk_cand {
-    const tr_shape *g;
-    int leaving, kind;
-    double n_front, n_back;
-} tr_pk_cand;
-
-/* The candidates after one surface (a lens's hint), with their figures laid out a
- * packet wide for the packet to pick a lane's own with one shuffle.  Built with the
- * scene. */
+/* The surfaces the rays may meet after one surface (a lens's hint): only fast shapes
+ * (TR_FAST_CONIC, TR_FAST_PLANE).  Their figures are laid out a packet wide, for the
+ * packet to pick a lane's own with one shuffle.  Built with the scene. */
 typedef struct tr_pk_set {
-    int nc;                      /* 0: some candidate is not a fast shape */
+    int nc;                      /* how many; -1: some candidate is not a fast shape */
     int id[4];                   /* their surface ids */
-    tr_pk_cand cd[4];
+    const tr_shape *g[4];
+    int leaving[4];              /* the rays start on it */
     double c[TR_PK], ck1[TR_PK], cone[TR_PK], kind[TR_PK], nf[TR_PK], nb[TR_PK],
-           wn[3][TR_PK];
+           wn[3][TR_PK];         /* curvature terms, material kind and indices, -w */
 } tr_pk_set;
 
 /* Empty s, then add the candidates in order (surface id, shape g, material m). */

@@ -107,22 +107,30 @@ static int push(rec *r, const void *x, size_t size)
 }
 static int keep(void *ctx, const trace_hit *h) { return push(ctx, h, sizeof *h); }
 
-static void threads_bitwise(const trace_api *tr)
+/* The triplet with mounts and a detector at the paraxial focus, lit by a collimated
+ * grid of count x count rays filling the pupil. */
+static trace_scene *triplet_grid(const trace_api *tr, long count)
 {
     trace_lens_surface s[TT_NSURF];
     trace_lens l;
     tt_triplet(s, &l, 1);
     l.z_detector = tt_paraxial_image(&l, -INFINITY);
+    trace_scene *sc = tr->scene_new();
+    trace_source src = {0};
+    src.type = TRACE_SRC_GRID;
+    src.dir[2] = 1; src.at[2] = -5; src.radius = TT_EPD / 2; src.count = count;
+    src.up[1] = 1;
+    tr->add_lens(sc, &l);
+    tr->add_source(sc, &src, NULL);
+    return sc;
+}
+
+static void threads_bitwise(const trace_api *tr)
+{
     rec r[3] = {{0}};
     trace_summary sum[3];
     for (int k = 0; k < 3; k++) {
-        trace_scene *sc = tr->scene_new();
-        trace_source src = {0};
-        src.type = TRACE_SRC_GRID;
-        src.dir[2] = 1; src.at[2] = -5; src.radius = TT_EPD / 2; src.count = 60;
-        src.up[1] = 1;
-        tr->add_lens(sc, &l);
-        tr->add_source(sc, &src, NULL);
+        trace_scene *sc = triplet_grid(tr, 60);
         trace_options o;
         tr->options_default(&o);
         o.threads = k + 1;
@@ -196,17 +204,7 @@ static int st_progress(void *ctx, uint64_t done, uint64_t total)
  * batches). */
 static void threads_stream(const trace_api *tr)
 {
-    trace_lens_surface s[TT_NSURF];
-    trace_lens l;
-    tt_triplet(s, &l, 1);
-    l.z_detector = tt_paraxial_image(&l, -INFINITY);
-    trace_scene *sc = tr->scene_new();
-    trace_source src = {0};
-    src.type = TRACE_SRC_GRID;
-    src.dir[2] = 1; src.at[2] = -5; src.radius = TT_EPD / 2; src.count = 90;
-    src.up[1] = 1;
-    tr->add_lens(sc, &l);
-    tr->add_source(sc, &src, NULL);
+    trace_scene *sc = triplet_grid(tr, 90);
     trace_source cone = {0};                 /* a second source: skew rays, ghosts */
     cone.type = TRACE_SRC_CONE;
     cone.at[1] = 8; cone.at[2] = -60; cone.dir[1] = -8; cone.dir[2] = 60;
