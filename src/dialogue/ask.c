@@ -2,8 +2,9 @@
  * (several per line, like the original's cin >>); a line may start with "input:" so
  * that `grep input: rec` replays.  On a terminal a bad answer is explained and asked
  * again; in a replay it is reported as FILE:LINE and the session stops (exit 2).
- * The record is flushed before every read, and SIGINT/SIGTERM are only let in while
- * we wait for input, so an interrupted session keeps every accepted answer. */
+ * The record is flushed before every read; a signal while we wait for input ends the
+ * session at once, one during a computation sets the stop flag that long operations
+ * poll (lm_stop_requested), so an interrupted session keeps every accepted answer. */
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -11,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <readline/readline.h>
 #include <readline/history.h>
@@ -18,16 +20,58 @@
 
 static char history_path[4096];
 
-static void on_signal(int sig)
+/* Stopping.  The signal handler only records the signal, except while we wait for
+ * an answer (nothing half-done then: the record was flushed before the read), or on
+ * a second signal (the user insists): then it runs the stop hooks and exits at once.
+ * Long operations poll lm_stop_requested() and unwind themselves; main() turns a
+ * recorded signal into exit status 128+N. */
+static volatile sig_atomic_t stop_sig, waiting_for_input;
+#define MAX_HOOKS 8
+static struct { void (*fn)(void *); void *ctx; } hooks[MAX_HOOKS];
+static volatile sig_atomic_t nhooks;
+
+void lm_run_stop_hooks(void)
+{
+    for (int i = nhooks - 1; i >= 0; i--)
+        if (hooks[i].fn) hooks[i].fn(hooks[i].ctx);
+}
+
+int lm_on_stop(void (*fn)(void *ctx), void *ctx)
+{
+    if (nhooks >= MAX_HOOKS) return -1;
+    hooks[nhooks].ctx = ctx;
+    hooks[nhooks].fn = fn;
+    nhooks++;
+    return 0;
+}
+
+void lm_on_stop_remove(void (*fn)(void *ctx), void *ctx)
+{
+    for (int i = 0; i < nhooks; i++)
+        if (hooks[i].fn == fn && hooks[i].ctx == ctx) hooks[i].fn = NULL;
+}
+
+int lm_stop_requested(void) { return stop_sig; }
+
+static void stop_now(int sig)
 {
     static const char msg[] =
         "\nlensmat: interrupted; the record file keeps every answer accepted so far\n";
-    ssize_t r = write(2, msg, sizeof msg - 1);
+    ssize_t r;
+    lm_run_stop_hooks();
+    r = write(2, msg, sizeof msg - 1);
     (void)r;
     _exit(128 + sig);
 }
 
-static void signals_setup(sigset_t *set)
+static void on_signal(int sig)
+{
+    int again = stop_sig != 0;
+    stop_sig = sig;
+    if (waiting_for_input || again) stop_now(sig);
+}
+
+static void signals_setup(void)
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -35,10 +79,7 @@ static void signals_setup(sigset_t *set)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-    sigemptyset(set);
-    sigaddset(set, SIGINT);
-    sigaddset(set, SIGTERM);
-    sigprocmask(SIG_BLOCK, set, NULL);
+    sigaction(SIGHUP, &sa, NULL);
 }
 
 static void history_setup(void)
@@ -53,22 +94,61 @@ static void history_setup(void)
 int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
                int original)
 {
-    sigset_t set;
     memset(io, 0, sizeof *io);
     io->original = original;
     io->rec_name = rec_name;
     io->in = in;
     io->src = in_name;
+    if (in) {
+        struct stat st;
+        if (fstat(fileno(in), &st) == 0 && S_ISREG(st.st_mode)) {
+            io->in_known = 1;
+            io->in_dev = st.st_dev;
+            io->in_ino = st.st_ino;
+        }
+    }
+    {
+        char msg[1024];
+        if (lm_check_output(io, rec_name, msg, sizeof msg)) {
+            fprintf(stderr, "lensmat: %s\n", msg);
+            return -1;
+        }
+    }
     io->rec = fopen(rec_name, "w");
     if (!io->rec) {
         fprintf(stderr, "lensmat: cannot write the record file %s: %s\n", rec_name,
                 strerror(errno));
         return -1;
     }
+    {
+        struct stat st;
+        if (fstat(fileno(io->rec), &st) == 0 && S_ISREG(st.st_mode)) {
+            io->rec_known = 1;
+            io->rec_dev = st.st_dev;
+            io->rec_ino = st.st_ino;
+        }
+    }
     io->interactive = in == stdin && isatty(0) && isatty(1);
     if (io->interactive) history_setup();
-    signals_setup(&set);
+    signals_setup();
     io->cur = "";
+    return 0;
+}
+
+int lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return 0;            /* not there yet: nothing to lose */
+    if (io->in_known && st.st_dev == io->in_dev && st.st_ino == io->in_ino) {
+        snprintf(msg, cap, "%s is the file the answers are read from; refusing to "
+                 "write over it", path);
+        return -1;
+    }
+    if (io->rec_known && st.st_dev == io->rec_dev && st.st_ino == io->rec_ino) {
+        snprintf(msg, cap, "%s is the record file of this session; refusing to write "
+                 "over it", path);
+        return -1;
+    }
     return 0;
 }
 
@@ -114,17 +194,14 @@ void lm_matrix(lm_io *io, int where, const char *elem_fmt, double a, double b,
 /* Read the next answer line.  Returns 0, or -1 at end of input. */
 static int read_line(lm_io *io)
 {
-    sigset_t set;
     ssize_t n;
-    sigemptyset(&set);
-    sigaddset(&set, SIGINT);
-    sigaddset(&set, SIGTERM);
     fflush(stdout);
     fflush(io->rec);
-    sigprocmask(SIG_UNBLOCK, &set, NULL);
+    waiting_for_input = 1;
+    if (stop_sig) stop_now(stop_sig);   /* a signal came during the last computation */
     if (io->interactive) {
         char *l = readline("");
-        sigprocmask(SIG_BLOCK, &set, NULL);
+        waiting_for_input = 0;
         if (!l) return -1;
         if (*l) {
             add_history(l);
@@ -138,7 +215,7 @@ static int read_line(lm_io *io)
         io->cap = strlen(l) + 1;
     } else {
         n = getline(&io->buf, &io->cap, io->in);
-        sigprocmask(SIG_BLOCK, &set, NULL);
+        waiting_for_input = 0;
         if (n < 0) return -1;
     }
     io->line++;

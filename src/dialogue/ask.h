@@ -21,6 +21,8 @@ typedef struct lm_io {
     char *buf;              /* current answer line */
     size_t cap;
     const char *cur;        /* unread part of buf */
+    int in_known, rec_known;   /* in_dev/in_ino, rec_dev/rec_ino are valid */
+    unsigned long long in_dev, in_ino, rec_dev, rec_ino;
 } lm_io;
 
 /* Output streams for lm_say. */
@@ -70,6 +72,24 @@ int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
 int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
                 int (*check)(void *ctx, const char *word, char *msg, size_t cap),
                 void *ctx, char *buf, size_t cap);
+/* Stopping (SIGINT, SIGTERM, SIGHUP).  A signal while lensmat waits for an answer,
+ * or a second signal, runs the stop hooks and exits with 128+N at once.  During a
+ * computation it only sets the stop flag: every long operation polls
+ * lm_stop_requested() (at least every ~50 ms of work), leaves no output under its
+ * final name, and returns LM_FAIL; main() then exits with 128+N.
+ * lm_stop_requested: the signal number, or 0. */
+int  lm_stop_requested(void);
+/* Stop hooks run, newest first, from the signal handler before such an exit (so they
+ * must be async-signal-safe: e.g. one write or ioctl that switches a laser off) and
+ * from lm_run_stop_hooks.  At most 8; lm_on_stop returns 0 or -1 when full. */
+int  lm_on_stop(void (*fn)(void *ctx), void *ctx);
+void lm_on_stop_remove(void (*fn)(void *ctx), void *ctx);
+void lm_run_stop_hooks(void);
+/* An output file may not be the answers' file or the record (same device and inode,
+ * so links and other spellings count): 0 if path is fine (also when it does not
+ * exist yet), else -1 with why in msg.  Every dialogue checks each output with it
+ * before opening anything for writing. */
+int  lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap);
 /* After the last question: warn about answers left unread (replay only). */
 void lm_check_leftover(lm_io *io);
 

@@ -130,5 +130,9 @@ int main(int argc, char **argv)
     rc = o.dlg->run(&io);
     if (lm_io_close(&io) < 0 && rc == LM_GO) rc = LM_FAIL;
     if (in != stdin) fclose(in);
+    if (lm_stop_requested()) {
+        lm_run_stop_hooks();
+        return 128 + lm_stop_requested();
+    }
     return rc == LM_FAIL ? 2 : 0;
 }
