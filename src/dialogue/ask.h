@@ -18,6 +18,7 @@ typedef struct lm_io {
     long line;              /* line number of the current answer line */
     int interactive;        /* terminal: readline, re-ask on errors */
     int original;           /* --original: keep the original program's bytes */
+    int show_answers;       /* --example: print each answer on stdout, as if typed */
     char *buf;              /* current answer line */
     size_t cap;
     const char *cur;        /* unread part of buf */
@@ -64,8 +65,9 @@ int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int
  * its index and the record echoes it as written in `choices`. */
 int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
                   const char *const *choices, int *idx);
-/* The same for one blank-free word (a file name): copied into buf (cap bytes; longer
- * answers are refused), echoed as "input: WORD".  check (may be NULL) returns 0 to
+/* The same for one word (a file name): blank-free, or quoted ("my lens.rec", see
+ * lm_next_word) to hold blanks; copied into buf (cap bytes; longer answers are
+ * refused), echoed as "input: WORD" (quoted again when it needs it, lm_quote_word).  check (may be NULL) returns 0 to
  * accept, else writes why into msg: the answer is then handled like a bad number
  * (terminal: message and ask again; replay: SRC:LINE message, LM_FAIL) and is not
  * echoed, so a record never holds a rejected answer. */
@@ -90,7 +92,8 @@ void lm_run_stop_hooks(void);
  * exist yet), else -1 with why in msg.  Every dialogue checks each output with it
  * before opening anything for writing. */
 int  lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap);
-/* After the last question: warn about answers left unread (replay only). */
+/* After the last question: warn about answers left unread, on the last line read or
+ * on any later one, with that line (replay only). */
 void lm_check_leftover(lm_io *io);
 
 #endif
