@@ -282,7 +282,8 @@ static int next_word(lm_io *io, char *tok, size_t cap)
     }
 }
 
-/* --example: show the answer on stdout as if it had been typed. */
+/* --example: show the answer on stdout as if it had been typed, in the form the
+ * record echoes it (which reads back as the same answer). */
 static void show_answer(lm_io *io, const char *tok)
 {
     if (io->show_answers) printf("%s\n", tok);
@@ -369,7 +370,7 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
         else lm_format_echo(*v, echo, sizeof echo);
         if ((spec->flags & LM_ALLOW_PLANE) && *v == 0.0) *v = INFINITY;
         lm_say(io, LM_REC, "input: %s\n", echo);
-        show_answer(io, tok);
+        show_answer(io, echo);
         return LM_GO;
     }
 }
@@ -392,7 +393,7 @@ int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int
         }
         *yes = c == 'y';
         lm_say(io, LM_REC, "input: %c\n", c);
-        show_answer(io, tok);
+        show_answer(io, c == 'y' ? "y" : "n");
         return LM_GO;
     }
 }
@@ -418,7 +419,7 @@ int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
         }
         *idx = i;
         lm_say(io, LM_REC, "input: %s\n", choices[i]);
-        show_answer(io, tok);
+        show_answer(io, choices[i]);
         return LM_GO;
     }
 }

@@ -124,7 +124,7 @@ int main(int argc, char **argv)
         return 1;
     }
     /* before the first question: a session that could not finish is not begun */
-    if (o.dlg->needs && !lm_engine_load(o.dlg->needs)) {
+    if (o.dlg->needs && !lm_engine_present(o.dlg->needs)) {
         fprintf(stderr, P(NEEDS_MODULE), o.dlg->option, o.dlg->needs);
         return 1;
     }
