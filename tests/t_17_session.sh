@@ -21,12 +21,12 @@ check "--example --thick: answers shown as the record echoes them" sh -c "
     grep '^input: ' th.rec | sed 's/^input: //' > th.ans && grep -cxFf th.ans th.out > /dev/null &&
     head -n 2 th.out | tail -n 1 | grep -qx cm"
 
-escaped() {
+escaped() (   # a subshell: its cd stays inside
     cd "$S" && printf '25\n1\n\033[31mabc\n' | "$BIN" e.rec > /dev/null 2> e.err; [ $? -eq 2 ] || return 1
     grep -qF "<stdin>:3: the radius of the lens surface: '\\x1b[31mabc' is not a number" e.err &&
         [ "$(tr -dc '\033' < e.err | wc -c)" -eq 0 ] || { cat -v e.err; return 1; }
     "$BIN" "--bad$(printf '\033')" x.rec 2> e2.err; [ $? -eq 1 ] && grep -qF "'--bad\\x1b'" e2.err
-}
+)
 check "messages escape control bytes (no raw ESC on the terminal)" escaped
 check "a NUL byte in an answer line: FILE:LINE error, exit 2, answers before kept" sh -c "
     cd '$S' && printf '25\n1\n3\0003\n0\n' > nul.in && '$BIN' -i nul.in nul.rec > /dev/null 2> nul.err;
@@ -46,7 +46,7 @@ check "UTF-8 byte-order mark and # comment lines in a replay; line numbers stay 
     ! '$BIN' -i bom2.in bom2.rec > /dev/null 2> bom2.err && grep -q '^lensmat: bom2.in:5: ' bom2.err"
 
 # file names with blanks: quoted answers, echoed quoted, replayed
-quoted_name() {
+quoted_name() (   # a subshell: its cd stays inside
     cd "$S" || return 1
     "$BIN" "my lens.rec" < "$GOLDEN/cases/thick_r3_r4.in" > /dev/null || return 1
     printf 'record\n"my lens.rec"\n1\n10\n1\nn\nn\n' > q.in
@@ -63,11 +63,11 @@ quoted_name() {
     printf 'record\n"my lens.rec\n' > q5.in
     "$BIN" --trace -i q5.in q5.rec > /dev/null 2> q5.err; [ $? -eq 2 ] &&
         grep -q 'q5.in:2: .*quote is not closed' q5.err
-}
+)
 check "a quoted file name with a blank is an answer; echoed quoted; the replay works" quoted_name
 
 # no output over an input: nothing truncated, whatever the spelling
-same_file() {
+same_file() (   # a subshell: its cd stays inside
     cd "$S" || return 1
     cp "$CIN" same.in; cp same.in keep
     "$BIN" -i same.in same.in > /dev/null 2> sf.err; [ $? -eq 1 ] || return 1
@@ -79,7 +79,7 @@ same_file() {
     rm -f sym.in; ln -s "$S/same.in" sym.in
     "$BIN" sym.in < same.in > /dev/null 2> /dev/null; [ $? -eq 1 ] && cmp same.in keep || return 1
     "$BIN" ./same.in < "$S/../s17/same.in" > /dev/null 2> /dev/null; [ $? -eq 1 ] && cmp same.in keep
-}
+)
 check "an output is never the input: -i same same, self < self, hard link, symlink, spelling" same_file
 
 check "--input=F and -- are accepted" sh -c "
@@ -97,7 +97,7 @@ check "--original is refused where it means nothing, kept where it does" sh -c "
     '$BIN' --prescription --original --example o3.rec > /dev/null"
 
 # a dialogue whose engine module is missing says so before its first question
-missing_module() {
+missing_module() (   # a subshell: its cd stays inside
     mkdir -p "$S/alone" && cp "$BIN" "$S/alone/lensmat" && cd "$S/alone" || return 1
     printf 'cm\ncardinal\n' > f.in
     LENSMAT_LIBDIR=/nonexistent ./lensmat --fit -i f.in f.rec > f.out 2> f.err; [ $? -eq 1 ] || return 1
@@ -107,7 +107,7 @@ missing_module() {
     ./lensmat --trace --example t.rec > /dev/null 2> t.err; [ $? -eq 1 ] || return 1
     # LENSMAT_LIBDIR points to the modules
     LENSMAT_LIBDIR=$TOP/build/lib ./lensmat --trace --example t.rec > /dev/null
-}
+)
 check "missing engine module: said before the first question, exit 1; LENSMAT_LIBDIR finds it" missing_module
 
 # the same readers under ASan/UBSan
@@ -116,3 +116,7 @@ check "asan: escaped messages" escaped
 check "asan: quoted file names" quoted_name
 check "asan: no output over an input" same_file
 BIN=$SAVED_BIN
+
+# the table against --help and the man page; the quoted-word reader
+unit "$TOP/build/obj/unit_dialogue"
+unit "$TOP/build/asan/unit_dialogue"
