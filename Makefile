@@ -63,8 +63,9 @@ build/asan/unit_%: tests/unit_%.c $(SANLIB)
 build/obj/bench_paraxial: tests/bench_paraxial.c $(LIBOBJ)
 	$(CC) $(BASE) $(OPT) -o $@ $< $(LIBOBJ) $(LIBS)
 
-# libFuzzer target for the answer reader and number parser (clang from Debian): the
-# core sources (not main.c) compiled with the fuzzer's instrumentation.
+# libFuzzer target for the answer reader, the number parser and every dialogue of
+# src/dialogue/table.c (clang from Debian): the core sources (not main.c) compiled
+# with the fuzzer's instrumentation.
 build/fuzz_answers: tests/fuzz_answers.c $(LIBCORE) $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
