@@ -124,7 +124,10 @@ int lm_gauss(lm_io *io)
         rc = px_gauss_surface(n1, n2, r, z1, &g);
         if (first) {
             calc_power(c, GS(POWER), g.power);
-            calc_say(c, GS(FOCAL), CL(g.focal_obj), CL(g.focal_img));
+            if (isfinite(g.focal_obj) && isfinite(g.focal_img))
+                calc_say(c, GS(FOCAL), CL(g.focal_obj), CL(g.focal_img));
+            else    /* no power (a plane, or n1 = n2): found by the dialogue fuzzer */
+                calc_say(c, GS(NO_FOCUS));
             first = 0;
         }
         if (rc == PX_OK)
