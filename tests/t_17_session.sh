@@ -124,4 +124,4 @@ unit "$TOP/build/asan/unit_dialogue"
 # found by the dialogue fuzzer: a plane surface in --gauss printed focal points -inf, inf
 check "--gauss, a surface without power: no inf printed" sh -c "
     cd '$S' && printf 'cm\n1\n3\n0\n1.4\nn\n' | '$BIN' --gauss g.rec > g.out &&
-    grep -q 'no power: its focal points are at infinity' g.rec && ! grep -v '^input:' g.rec | grep -qw inf"
+    grep -q 'no power: its focal points are at infinity' g.rec && ! grep -q '= -*inf' g.rec"
