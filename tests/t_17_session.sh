@@ -125,3 +125,8 @@ unit "$TOP/build/asan/unit_dialogue"
 check "--gauss, a surface without power: no inf printed" sh -c "
     cd '$S' && printf 'cm\n1\n3\n0\n1.4\nn\n' | '$BIN' --gauss g.rec > g.out &&
     grep -q 'no power: its focal points are at infinity' g.rec && ! grep -q '= -*inf' g.rec"
+# found by the dialogue fuzzer: an afocal --thick lens ended the dialogue with the
+# paraxial engine's code (no "Output was written", no leftover check)
+check "--thick, an afocal lens: the dialogue ends normally" sh -c "
+    cd '$S' && printf 'cm\n1\n0\n1\n1.5\n0\n1\n' | '$BIN' --thick af.rec > af.out &&
+    grep -q afocal af.out && grep -q '^Output was written' af.out"

@@ -53,6 +53,7 @@ int lm_thick(lm_io *io)
         return rc;
     rc = px_thick_lens(n1, r1, t, n, r2, n3, &l);
     if (rc != PX_OK && rc != PX_AT_INFINITY) return LM_FAIL;
+    rc = LM_GO;     /* PX_AT_INFINITY (afocal) is no dialogue outcome (found by the fuzzer) */
     calc_say(c, TK(SURFACES), t);
     calc_say(c, TK(MATRIX));
     calc_matrix(c, l.first.m);
