@@ -130,3 +130,7 @@ check "--gauss, a surface without power: no inf printed" sh -c "
 check "--thick, an afocal lens: the dialogue ends normally" sh -c "
     cd '$S' && printf 'cm\n1\n0\n1\n1.5\n0\n1\n' | '$BIN' --thick af.rec > af.out &&
     grep -q afocal af.out && grep -q '^Output was written' af.out"
+# found by the dialogue fuzzer: --thin printed an answer of inf as "di= inf"
+check "--thin, a distance at infinity: said as infinity, no inf printed" sh -c "
+    cd '$S' && printf 'cm\nf\n168\ninf\n-2\n' | '$BIN' --thin ti.rec > ti.out &&
+    grep -q 'di= infinity' ti.rec && ! grep -q '= -*inf\\>' ti.rec"

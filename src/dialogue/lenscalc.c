@@ -76,10 +76,23 @@ int lm_thick(lm_io *io)
 const char *lm_thick_example(void) { return TK(EXAMPLE); }
 
 /* ---- --thin ---- */
+/* A distance for the result line: %g, or "infinity" (an answer of inf is no number
+ * to print: found by the dialogue fuzzer). */
+static const char *thin_num(char *buf, size_t cap, double v)
+{
+    if (isinf(v)) snprintf(buf, cap, "%sinfinity", v < 0 ? "-" : "");
+    else snprintf(buf, cap, "%g", v);
+    return buf;
+}
+
 static void thin_report(calc *c, const px_thin *t, int unknown, double h)
 {
-    if (unknown == PX_THIN_NONE) calc_say(c, TN(SCRIPT), CL(t->f), CL(t->d_o), CL(t->d_i));
-    else calc_say(c, TN(RESULT), CL(t->f), CL(t->d_o), CL(t->d_i));
+    char f[32], d_o[32], d_i[32];
+    thin_num(f, sizeof f, CL(t->f));
+    thin_num(d_o, sizeof d_o, CL(t->d_o));
+    thin_num(d_i, sizeof d_i, CL(t->d_i));
+    if (unknown == PX_THIN_NONE) calc_say(c, TN(SCRIPT), f, d_o, d_i);
+    else calc_say(c, TN(RESULT), f, d_o, d_i);
     calc_power(c, TN(POWER), t->power);
     if (isinf(t->mag)) { calc_say(c, TN(MAG_INF)); return; }
     calc_say(c, TN(MAG), CL(t->mag), CL(h * t->mag));
