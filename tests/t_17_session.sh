@@ -134,3 +134,9 @@ check "--thick, an afocal lens: the dialogue ends normally" sh -c "
 check "--thin, a distance at infinity: said as infinity, no inf printed" sh -c "
     cd '$S' && printf 'cm\nf\n168\ninf\n-2\n' | '$BIN' --thin ti.rec > ti.out &&
     grep -q 'di= infinity' ti.rec && ! grep -q '= -*inf\\>' ti.rec"
+check "a NUL byte in a prescription or lens file: FILE:LINE, not a silent cut" sh -c "
+    cd '$S' && printf 'nearpoint 25\n3 0 1.5\n-3 0 1\000junk\nobject -2\n' > p.rx &&
+    '$BIN' --prescription -i p.rx p.rec > /dev/null 2> p.err; [ \$? -eq 2 ] &&
+    grep -q '^lensmat: p.rx:3: this line holds a NUL byte' p.err &&
+    printf '25\n1\n3\n0\n1.5\n\000y\n' > c.in && printf 'record\nc.in\n' > r.in &&
+    '$BIN' --trace -i r.in t.rec > /dev/null 2> t.err; [ \$? -eq 2 ] && grep -q 'c.in:6: this line holds a NUL' t.err"
