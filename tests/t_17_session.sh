@@ -89,6 +89,8 @@ check "--input=F and -- are accepted" sh -c "
 check "-i missing: a lensmat: message, exit 1, no record made" sh -c "
     cd '$S' && '$BIN' -i missing.in m.rec > /dev/null 2> m.err; [ \$? -eq 1 ] &&
     grep -q \"^lensmat: cannot read the answers' file missing.in: No such file\" m.err && [ ! -e m.rec ]"
+check "-i a folder: refused with a message, exit 1" sh -c "
+    cd '$S' && '$BIN' -i '$S' d.rec > /dev/null 2> d.err; [ \$? -eq 1 ] && grep -q 'Is a directory' d.err && [ ! -e d.rec ]"
 check "--original is refused where it means nothing, kept where it does" sh -c "
     cd '$S' && printf 'cm\n1\n3\n5\n1.4\n4\n1\nn\n' > th.in &&
     '$BIN' --thick --original -i th.in o.rec > /dev/null 2> o.err; [ \$? -eq 1 ] &&

@@ -1,10 +1,11 @@
 /* main.c -- the command line: choose a dialogue (one option, from the table in
- * table.c), check the engine module it needs loads, open the session (answers from
+ * table.c), check the engine module it needs is there, open the session (answers from
  * a terminal, a replay file or the embedded example; the record file), run it, and
  * turn its outcome into the exit status. */
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "ask.h"
 #include "dialogues.h"
 #include "engine.h"
@@ -93,6 +94,7 @@ static int parse_args(int argc, char **argv, options *o)
 static FILE *open_answers(const options *o, const char **name)
 {
     FILE *f;
+    struct stat st;
     if (o->example) {
         const char *ex = o->dlg->example ? o->dlg->example() : NULL;
         if (!ex) { fprintf(stderr, P(NO_EXAMPLE), o->dlg->option); return NULL; }
@@ -103,6 +105,11 @@ static FILE *open_answers(const options *o, const char **name)
     *name = o->input;
     f = fopen(o->input, "r");
     if (!f) fprintf(stderr, P(CANNOT_READ), shown(o->input), strerror(errno));
+    else if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
+        fprintf(stderr, P(CANNOT_READ), shown(o->input), strerror(EISDIR));
+        fclose(f);
+        f = NULL;
+    }
     return f;
 }
 
