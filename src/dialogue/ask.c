@@ -465,7 +465,8 @@ int lm_ask_index(lm_io *io, const char *out, const char *rec, const lm_numspec *
         }
         if (st != LM_NUM_OK && st != LM_NUM_PLANE) {
             /* a word gets the media named; "1,5" just is not a number */
-            if (complain(io, spec->what, st == LM_NUM_SYNTAX && !isalpha((unsigned char)tok[0]) ?
+            int word = isalpha((unsigned char)tok[0]);
+            if (complain(io, spec->what, st == LM_NUM_SYNTAX && !word ?
                          "'%s' is not a number" : st == LM_NUM_SYNTAX ?
                          "'%s' is not a number, nor a medium lensmat knows (air, water, "
                          "cornea, crown, flint, ...)" : st == LM_NUM_NAN ?

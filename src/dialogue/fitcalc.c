@@ -51,7 +51,8 @@ static int least_squares(calc *c)
         calc_mark(c, &m);
         if ((rc = calc_yn(c, FT(MORE), FT(MORE_WHAT), &more))) return rc;
         if (!more && !distinct_x(&d)) {
-            if ((rc = calc_reject(c, &m, NULL, FT(MORE), FT(AGAIN_MORE), FT(SAME_X), d.n, d.x[0])))
+            if ((rc = calc_reject(c, &m, NULL, FT(MORE), FT(AGAIN_MORE), FT(SAME_X), d.n,
+                                  d.x[0])))
                 return rc;
             continue;
         }

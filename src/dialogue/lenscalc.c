@@ -29,13 +29,15 @@ static int thick_objects(calc *c, px_lens *l)
         calc_mark(c, &m);
         if ((rc = calc_num(c, TK(OBJECT), TK(OBJECT_WHAT), LM_ALLOW_INF, &z))) return rc;
         if (z > 0 && isinf(z)) {
-            if ((rc = calc_reject(c, &m, TK(OBJECT_WHAT), TK(OBJECT), TK(AGAIN_OBJECT), "%s", TK(PLUS_INF))))
+            if ((rc = calc_reject(c, &m, TK(OBJECT_WHAT), TK(OBJECT), TK(AGAIN_OBJECT), "%s",
+                                  TK(PLUS_INF))))
                 return rc;
             continue;
         }
         if (isinf(z)) {
             double zf2 = l->first.z_f2.v;
-            calc_say(c, TK(IMAGE_AT_INF), CL(zf2), zf2 >= l->sys.z_last ? TK(REAL) : TK(VIRTUAL));
+            calc_say(c, TK(IMAGE_AT_INF), CL(zf2),
+                     zf2 >= l->sys.z_last ? TK(REAL) : TK(VIRTUAL));
         } else {
             if ((rc = calc_num(c, TK(HEIGHT), TK(HEIGHT_WHAT), 0, &h))) return rc;
             if (px_conjugate(&l->sys, z, &cj) == PX_OK)
@@ -151,7 +153,8 @@ int lm_gauss(lm_io *io)
         calc_mark(c, &m);
         if ((rc = calc_num(c, GS(Z1), GS(Z1_WHAT), LM_NONZERO | LM_ALLOW_INF, &z1))) return rc;
         if (z1 > 0 && isinf(z1)) {
-            if ((rc = calc_reject(c, &m, GS(Z1_WHAT), GS(Z1), GS(AGAIN_Z1), "%s", GS(PLUS_INF)))) return rc;
+            if ((rc = calc_reject(c, &m, GS(Z1_WHAT), GS(Z1), GS(AGAIN_Z1), "%s", GS(PLUS_INF))))
+                return rc;
             continue;
         }
         rc = px_gauss_surface(n1, n2, r, z1, &g);
