@@ -2,9 +2,10 @@
 """calc_tty.py BIN HOME -- the calculation dialogues' checks of answers that do not go
 together, on a pseudo-terminal: each bad group is explained (why, and what is asked
 again), asked again, the session completes with exit 0, and the record holds only
-the accepted answers (its grep'd answers are exactly those typed and accepted).
+the accepted answers (its grep'd answers are exactly those typed and accepted,
+and replay to the same record).
 Prints one line per failed check; exit 0 when all hold."""
-import os, sys
+import os, subprocess, sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from ptydrive import drive
 
@@ -83,6 +84,15 @@ def main():
             bad.append("%s: screen lacks %r" % (name, w))
         if ins != accepted:
             bad.append("%s: record answers %r, want %r" % (name, ins, accepted))
+        # the terminal's record is exactly what a replay of its answers writes
+        rec2 = os.path.join(home, "c2.rec")
+        with open(rec) as f:
+            answers = "".join(l for l in f if l.startswith("input: "))
+        r2 = subprocess.run([bin_, opt, rec2], input=answers.encode(),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        if r2.returncode != 0 or open(rec).read() != open(rec2).read():
+            bad.append("%s: the replay of the record's answers (exit %d) writes another "
+                       "record" % (name, r2.returncode))
         if rc != 0 or miss or ins != accepted:
             bad.append("---- screen ----\n" + out[-2000:])
     for b in bad:
