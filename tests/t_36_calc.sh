@@ -233,3 +233,6 @@ check "prescription example = classic example" sh -c "cd '$WORK' &&
     grep -q '^object -4' pe.lens && grep -q '^nearpoint 25' pe.lens"
 check "--help lists every calculation" sh -c "'$BIN' --help > '$WORK/h' && for d in thick thin gauss pair magnifier microscope telescope vision cornea fit prescription to-prescription; do grep -q -- \"--\$d \" '$WORK/h' || exit 1; done"
 check "only --fit loads GSL" sh -c "! ldd '$BIN' | grep -q gsl && ldd '$TOP/build/lib/lensmat-fit.so' | grep -q libgsl"
+# README: an output that cannot be written completely is exit status 2
+check "write error: exit 2 with a message" sh -c "'$BIN' --thick --example /dev/full > /dev/null 2> '$WORK/full.err'
+    [ \$? -eq 2 ] && grep -q 'error writing the record file /dev/full' '$WORK/full.err'"
