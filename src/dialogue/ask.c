@@ -353,9 +353,25 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
             continue;
         }
         st = lm_parse_number(tok, v);
+        if (st == LM_NUM_SYNTAX && (spec->flags & LM_INDEX) &&
+            lm_parse_index(tok, v) == LM_NUM_OK) {      /* a medium's name */
+            size_t i;
+            for (i = 0; tok[i] && i < sizeof echo - 1; i++)
+                echo[i] = (char)tolower((unsigned char)tok[i]);
+            echo[i] = '\0';
+            lm_say(io, LM_REC, "input: %s\n", echo);
+            show_answer(io, echo);
+            lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
+            return LM_GO;
+        }
         if (st != LM_NUM_OK && st != LM_NUM_PLANE) {
-            if (complain(io, spec->what, st == LM_NUM_SYNTAX ? "'%s' is not a number" :
-                         st == LM_NUM_NAN ? "'%s': nan is not a number" :
+            /* for an index, a word gets the media named; "1,5" just is not a number */
+            int word = (spec->flags & LM_INDEX) && isalpha((unsigned char)tok[0]);
+            if (complain(io, spec->what, st == LM_NUM_SYNTAX && !word ?
+                         "'%s' is not a number" : st == LM_NUM_SYNTAX ?
+                         "'%s' is not a number, nor a medium lensmat knows (air, water, "
+                         "cornea, crown, flint, ...)" : st == LM_NUM_NAN ?
+                         "'%s': nan is not a number" :
                          "'%s' is out of range (|x| <= 1e30)", tok)) return LM_FAIL;
             continue;
         }
@@ -475,4 +491,52 @@ void lm_check_leftover(lm_io *io)
         }
         if (++lines > 100000 || read_line(io) != 0) return;
     }
+}
+
+/* ---- answers checked together, indices by name (see ask.h) ---------------------- */
+#include <ctype.h>
+#include "../paraxial/paraxial.h"
+
+void lm_mark_set(lm_io *io, lm_mark *m)
+{
+    fflush(io->rec);
+    m->rec_off = ftell(io->rec);
+}
+
+int lm_mark_reject(lm_io *io, const lm_mark *m, const char *what, const char *msg,
+                   const char *again, const char *rec_prompt)
+{
+    fflush(io->rec);
+    if (m->rec_off >= 0 && ftruncate(fileno(io->rec), m->rec_off) == 0)
+        fseek(io->rec, m->rec_off, SEEK_SET);
+    else    /* a record that cannot be cut back (a pipe): say so in it */
+        fprintf(io->rec, "(the answers above were rejected: %s)\n", msg);
+    if (io->interactive) {
+        fprintf(stderr, "lensmat: %s: %s; %s.\n", what, msg, again);
+        io->cur = "";
+        return LM_GO;
+    }
+    fprintf(stderr, "lensmat: %s:%ld: %s: %s\n", io->src, io->line > 0 ? io->line : 1,
+            what, msg);
+    if (rec_prompt) fputs(rec_prompt, io->rec);
+    return LM_FAIL;
+}
+
+enum lm_num_status lm_parse_index(const char *tok, double *v)
+{
+    enum lm_num_status st = lm_parse_number(tok, v);
+    double n;
+    if (st == LM_NUM_SYNTAX && (n = px_medium_index(tok)) > 0) {
+        *v = n;
+        return LM_NUM_OK;
+    }
+    return st;
+}
+
+int lm_ask_index(lm_io *io, const char *out, const char *rec, const lm_numspec *spec,
+                 double *v)
+{
+    lm_numspec named = *spec;
+    named.flags |= LM_INDEX;
+    return lm_ask_number(io, out, rec, &named, v);
 }
