@@ -142,3 +142,10 @@ check "a NUL byte in a prescription or lens file: FILE:LINE, not a silent cut" s
     grep -q '^lensmat: p.rx:3: this line holds a NUL byte' p.err &&
     printf '25\n1\n3\n0\n1.5\n\000y\n' > c.in && printf 'record\nc.in\n' > r.in &&
     '$BIN' --trace -i r.in t.rec > /dev/null 2> t.err; [ \$? -eq 2 ] && grep -q 'c.in:6: this line holds a NUL' t.err"
+check "lens and prescription files: BOM and # comment lines as in a replay" sh -c "
+    cd '$S' && { printf '\357\273\277# my lens\n'; cat '$CIN'; } > lb.in &&
+    '$BIN' --to-prescription -i lb.in lb.rx && '$BIN' --prescription -i lb.rx lb.rec > /dev/null &&
+    cmp lb.rec '$GOLDEN/cases/convex_thin_doc.rec' &&
+    { printf '\357\273\277'; cat lb.rx; } > lb2.rx && '$BIN' --prescription -i lb2.rx lb2.rec > /dev/null &&
+    cmp lb.rec lb2.rec && printf 'record\nlb.in\n1\n10\n1\nn\nn\n' > lt.in &&
+    '$BIN' --trace -i lt.in lt.rec > /dev/null"

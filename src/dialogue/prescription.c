@@ -61,6 +61,10 @@ static char *slurp(FILE *in, const char *src, char *err, size_t cap)
         return NULL;
     }
     s[len] = '\0';
+    if (len >= 3 && !memcmp(s, "\xef\xbb\xbf", 3)) {   /* a UTF-8 byte-order mark */
+        len -= 3;
+        memmove(s, s + 3, len + 1);
+    }
     if ((t = memchr(s, '\0', len))) {   /* every string function would cut there */
         long line = 1;
         for (const char *p = s; p < t; p++) line += *p == '\n';
@@ -237,15 +241,18 @@ static int fail_at(cursor *c, const char *what, const char *fmt, const char *tok
     return LM_FAIL;
 }
 
-/* Move to the next line: 0, or -1 at the end. */
+/* Move to the next line that is not a comment (first non-blank byte '#', as lm_ask
+ * skips them): 0, or -1 at the end. */
 static int next_line(cursor *c)
 {
     char *nl;
-    if (!c->next || !*c->next) return -1;
-    if ((nl = strchr(c->next, '\n'))) *nl = '\0';
-    c->cur = lm_line_start(c->next);
-    c->next = nl ? nl + 1 : NULL;
-    c->line++;
+    do {
+        if (!c->next || !*c->next) return -1;
+        if ((nl = strchr(c->next, '\n'))) *nl = '\0';
+        c->cur = lm_line_start(c->next);
+        c->next = nl ? nl + 1 : NULL;
+        c->line++;
+    } while (c->cur[strspn(c->cur, " \t")] == '#');
     return 0;
 }
 
