@@ -25,7 +25,9 @@ escaped() (   # a subshell: its cd stays inside
     cd "$S" && printf '25\n1\n\033[31mabc\n' | "$BIN" e.rec > /dev/null 2> e.err; [ $? -eq 2 ] || return 1
     grep -qF "<stdin>:3: the radius of the lens surface: '\\x1b[31mabc' is not a number" e.err &&
         [ "$(tr -dc '\033' < e.err | wc -c)" -eq 0 ] || { cat -v e.err; return 1; }
-    "$BIN" "--bad$(printf '\033')" x.rec 2> e2.err; [ $? -eq 1 ] && grep -qF "'--bad\\x1b'" e2.err
+    "$BIN" "--bad$(printf '\033')" x.rec 2> e2.err; [ $? -eq 1 ] && grep -qF "'--bad\\x1b'" e2.err || return 1
+    printf 'nearpoint 25\n3 0 \033[31m1.5\n' | "$BIN" --prescription e3.rec 2> e3.err
+    grep -qF '\x1b[31m1.5' e3.err && [ "$(tr -dc '\033' < e3.err | wc -c)" -eq 0 ]
 )
 check "messages escape control bytes (no raw ESC on the terminal)" escaped
 check "a NUL byte in an answer line: FILE:LINE error, exit 2, answers before kept" sh -c "

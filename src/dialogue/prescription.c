@@ -191,6 +191,14 @@ static int read_prescription(rx *r, char *s)
     return LM_GO;
 }
 
+/* An error on stderr, an answer's control bytes escaped (lm_escape). */
+static void say_error(const char *err)
+{
+    char shown[4 * 1200];
+    lm_escape(err, shown, sizeof shown);
+    fprintf(stderr, PS(ERROR), shown);
+}
+
 int lm_prescription(lm_io *io)
 {
     rx r;
@@ -204,7 +212,7 @@ int lm_prescription(lm_io *io)
     if (!(s = slurp(io->in, io->src, err, sizeof err))) rc = LM_FAIL;
     else rc = read_prescription(&r, s);
     free(s);
-    if (rc) { fprintf(stderr, PS(ERROR), err); free(r.ans.s); return rc; }
+    if (rc) { say_error(err); free(r.ans.s); return rc; }
     answers = fmemopen(r.ans.s, r.ans.len, "r");
     if (!answers) { free(r.ans.s); return LM_FAIL; }
     snprintf(src, sizeof src, "%s (as classic answers)", io->src);
@@ -456,7 +464,7 @@ int lm_to_prescription(lm_io *io)
     char err[1200], *s = slurp(io->in, io->src, err, sizeof err);
     if (!s || lens_of_text(io->src, s, &lf, err, sizeof err)) {
         free(s);
-        fprintf(stderr, PS(ERROR), err);
+        say_error(err);
         return LM_FAIL;
     }
     free(s);
