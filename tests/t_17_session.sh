@@ -25,7 +25,9 @@ escaped() (   # a subshell: its cd stays inside
     cd "$S" && printf '25\n1\n\033[31mabc\n' | "$BIN" e.rec > /dev/null 2> e.err; [ $? -eq 2 ] || return 1
     grep -qF "<stdin>:3: the radius of the lens surface: '\\x1b[31mabc' is not a number" e.err &&
         [ "$(tr -dc '\033' < e.err | wc -c)" -eq 0 ] || { cat -v e.err; return 1; }
-    "$BIN" "--bad$(printf '\033')" x.rec 2> e2.err; [ $? -eq 1 ] && grep -qF "'--bad\\x1b'" e2.err
+    "$BIN" "--bad$(printf '\033')" x.rec 2> e2.err; [ $? -eq 1 ] && grep -qF "'--bad\\x1b'" e2.err || return 1
+    printf 'nearpoint 25\n3 0 \033[31m1.5\n' | "$BIN" --prescription e3.rec 2> e3.err
+    grep -qF '\x1b[31m1.5' e3.err && [ "$(tr -dc '\033' < e3.err | wc -c)" -eq 0 ]
 )
 check "messages escape control bytes (no raw ESC on the terminal)" escaped
 check "a NUL byte in an answer line: FILE:LINE error, exit 2, answers before kept" sh -c "
@@ -142,3 +144,10 @@ check "a NUL byte in a prescription or lens file: FILE:LINE, not a silent cut" s
     grep -q '^lensmat: p.rx:3: this line holds a NUL byte' p.err &&
     printf '25\n1\n3\n0\n1.5\n\000y\n' > c.in && printf 'record\nc.in\n' > r.in &&
     '$BIN' --trace -i r.in t.rec > /dev/null 2> t.err; [ \$? -eq 2 ] && grep -q 'c.in:6: this line holds a NUL' t.err"
+check "lens and prescription files: BOM and # comment lines as in a replay" sh -c "
+    cd '$S' && { printf '\357\273\277# my lens\n'; cat '$CIN'; } > lb.in &&
+    '$BIN' --to-prescription -i lb.in lb.rx && '$BIN' --prescription -i lb.rx lb.rec > /dev/null &&
+    cmp lb.rec '$GOLDEN/cases/convex_thin_doc.rec' &&
+    { printf '\357\273\277'; cat lb.rx; } > lb2.rx && '$BIN' --prescription -i lb2.rx lb2.rec > /dev/null &&
+    cmp lb.rec lb2.rec && printf 'record\nlb.in\n1\n10\n1\nn\nn\n' > lt.in &&
+    '$BIN' --trace -i lt.in lt.rec > /dev/null"
