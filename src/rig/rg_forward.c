@@ -105,6 +105,11 @@ unsigned rg_travel_check(const rg_geometry *g, const rg_pose *p)
 
 int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b)
 {
+    return rg_forward_path(g, p, b, 1);
+}
+
+int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b, int checks)
+{
     double n1[3], n2[3], c2[3], w[3];
     for (int i = 0; i < 3; i++)
         b->spot[i] = b->normal[i] = b->d3[i] = b->det[i] = NAN;
@@ -126,6 +131,7 @@ int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b)
         v3sub(rel, g->detector, b->spot);
         v3axpy(b->det, b->spot, v3dot(rel, w) / dn, b->d3);
     }
+    if (!checks) return 0;
     /* what stands in the way: m2 across the detector leg and the incoming laser, m1
      * across the legs to and from the cornea */
     rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);

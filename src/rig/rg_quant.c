@@ -14,9 +14,9 @@ static double qstep(const rg_joint *j, double x)
 }
 
 static void land(const rg_geometry *g, const rg_pose *p, const double target[3],
-                 rg_beam *b, double *ec, double *ed)
+                 rg_beam *b, double *ec, double *ed, int checks)
 {
-    if (rg_forward_beam(g, p, b)) { *ec = *ed = INFINITY; return; }
+    if (rg_forward_path(g, p, b, checks)) { *ec = *ed = INFINITY; return; }
     *ec = v3dist(b->spot, target);
     *ed = isfinite(b->det[0]) ? v3dist(b->det, g->detector) : INFINITY;
 }
@@ -34,13 +34,33 @@ int rg_quantise(const rg_geometry *g, const rg_target *t, const rg_solution *s,
                          1u << RG_J_M2B;
     q->pose.j[RG_J_U] = qstep(&g->joint[RG_J_U], s->pose.j[RG_J_U]);
     q->pose.j[RG_J_V] = qstep(&g->joint[RG_J_V], s->pose.j[RG_J_V]);
+    double c2[3], n1[3], n2[3], h1[3], d1[3];
+    rg_m2_center(g, q->pose.j[RG_J_U], q->pose.j[RG_J_V], c2);
+    rg_gimbal_normal(&g->m1, s->pose.j[RG_J_M1A], s->pose.j[RG_J_M1B], n1);
+    rg_gimbal_normal(&g->m2, s->pose.j[RG_J_M2A], s->pose.j[RG_J_M2B], n2);
+    /* the four angles for the quantised centre: the construction, then Newton's check */
+    if (rg_aim_stage(g, s->target, s->back, c2, n1, n2) < 0 ||
+        rg_gimbal_angles(&g->m1, n1, &q->pose.j[RG_J_M1A], &q->pose.j[RG_J_M1B]) ||
+        rg_gimbal_angles(&g->m2, n2, &q->pose.j[RG_J_M2A], &q->pose.j[RG_J_M2B])) {
+        for (int k = 0; k < RG_NJOINTS; k++)     /* Newton from the solution's angles */
+            if (k != RG_J_U && k != RG_J_V) q->pose.j[k] = s->pose.j[k];
+    }
     if (rg_newton(g, &q->pose, ANG, s->target, in, tol, 30, &res) < 0)
         q->diag |= RG_D_NO_CONVERGE;
     rg_beam b;
-    land(g, &q->pose, s->target, &b, &q->err_cornea_resolved, &q->err_detector_resolved);
+    land(g, &q->pose, s->target, &b, &q->err_cornea_resolved, &q->err_detector_resolved,
+         0);
+    /* m1 on its grid; m2's angles re-aimed at the target from where m1 now sends the
+     * beam; then m2 on its grid */
     q->pose.j[RG_J_M1A] = qstep(&g->joint[RG_J_M1A], q->pose.j[RG_J_M1A]);
     q->pose.j[RG_J_M1B] = qstep(&g->joint[RG_J_M1B], q->pose.j[RG_J_M1B]);
     rg_pose keep = q->pose;
+    rg_gimbal_normal(&g->m1, q->pose.j[RG_J_M1A], q->pose.j[RG_J_M1B], n1);
+    rg_gimbal_normal(&g->m2, q->pose.j[RG_J_M2A], q->pose.j[RG_J_M2B], n2);
+    int ok = rg_aim_m1_beam(g, n1, h1, d1) == 0 &&
+             rg_aim_m2(g, s->target, h1, d1, c2, n2) >= 0 &&
+             rg_gimbal_angles(&g->m2, n2, &q->pose.j[RG_J_M2A], &q->pose.j[RG_J_M2B]) == 0;
+    if (!ok) q->pose = keep;
     if (rg_newton(g, &q->pose, 1u << RG_J_M2A | 1u << RG_J_M2B, s->target, in, tol,
                   30, &res) < 0)
         q->pose = keep;     /* m2's angles stay as re-solved for the stage */
@@ -49,7 +69,7 @@ int rg_quantise(const rg_geometry *g, const rg_target *t, const rg_solution *s,
     for (int k = 0; k < RG_NJOINTS; k++)
         q->steps[k] = g->joint[k].steps_per > 0
                     ? (int64_t)llround(q->pose.j[k] * g->joint[k].steps_per) : 0;
-    land(g, &q->pose, s->target, &q->beam, &q->err_cornea, &q->err_detector);
+    land(g, &q->pose, s->target, &q->beam, &q->err_cornea, &q->err_detector, 1);
     q->diag |= q->beam.diag;
     if (q->diag & RG_D_FATAL) {
         char txt[512];
