@@ -33,6 +33,8 @@ RG_HIDDEN int rg_gimbal_angles(const rg_gimbal *m, const double n[3], double *a,
 /* The beam through the two mirrors only: hit points, directions and the diagnostics
  * of the mirrors (miss, grazing).  0 or -1 (beam lost: b->diag says where). */
 RG_HIDDEN int rg_mirrors(const rg_geometry *g, const rg_pose *p, rg_beam *b);
+/* The same with ap 0: mirrors unbounded (the model's equations past the rims). */
+RG_HIDDEN int rg_mirrors_ap(const rg_geometry *g, const rg_pose *p, rg_beam *b, int ap);
 /* The whole path, plus blocking tests: 0 or -1. */
 RG_HIDDEN int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b);
 /* The same; checks 0: no blocking or travel tests (derivatives, landing errors). */

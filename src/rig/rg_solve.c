@@ -31,7 +31,7 @@ typedef struct nt_ctx {
 static int residual(const nt_ctx *c, const rg_pose *p, double *F)
 {
     rg_beam b;
-    if (rg_mirrors(c->g, p, &b)) return -1;
+    if (rg_mirrors_ap(c->g, p, &b, 0)) return -1;
     double rel[3], q[3], dd[3];
     v3sub(rel, c->target, b.h2);
     double along = v3dot(rel, b.d2);

@@ -230,7 +230,15 @@ static void solutions(void)
     rg_geometry th = g;
     th.m1.offset = 10;
     th.m2.offset = -6;
-    report("mirror offsets 10 / -6 mm", scan(&th, 100, 10 * RT_DEG), 100, 1);
+    rg_target t0 = {RG_T_ANGLES, 0, 0};
+    rg_solution s0;
+    int r0 = rg->solve(&th, &t0, NULL, &s0, err, sizeof err);
+    CHECK(r0 == RG_EUNREACH && (s0.diag & RG_D_MISS_MIRROR),
+          "m1's surface 10 mm off its axes: the beam misses its 5 mm rim: %s", err);
+    th.m1.offset = 4;
+    th.m1.radius = th.m2.radius = 8;
+    th.m1.mount_radius = th.m2.mount_radius = 10;
+    report("mirror offsets 4 / -6 mm (8 mm rims)", scan(&th, 100, 7 * RT_DEG), 100, 1);
     /* height/meridian targets */
     rg_target t = {RG_T_HEIGHT, 1.3, 0.7};
     rg_solution s;
