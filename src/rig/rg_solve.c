@@ -265,7 +265,7 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
     /* mirror surfaces off the axes: the construction repeated until the surfaces
      * sit where the normals put them (rg_aim.c) */
     int offs = g->m1.offset != 0 || g->m2.offset != 0, passes = 0;
-    if (offs) {
+    if (offs && !o.newton_only) {
         passes = rg_aim_full(g, P, bk, n1, n2, C2);
         if (passes < 0) return fail(s, RG_D_NO_CONVERGE, err, errcap);
         v3sub(d, C2, g->m2.center);

@@ -152,7 +152,9 @@ typedef struct rg_solve_opts {
     double cond_max;           /* RG_D_ILLCOND above this (0: 1e4) */
     double tol;                /* Newton residual, mm (0: 1e-12) */
     int max_iter;              /* Newton iterations (0: 30) */
-    int no_checks;             /* 1: skip blocking/conditioning (speed); never in use */
+    int no_checks;             /* 1: skip the condition number (baseline timing only) */
+    int newton_only;           /* 1: mirror offsets by Newton alone, from the zero-offset
+                                  closed form (tests: the two methods must agree) */
 } rg_solve_opts;
 
 /* The beam through a pose (forward model, exact: offsets, finite mirrors). */
@@ -164,7 +166,8 @@ typedef struct rg_beam {
     double normal[3];          /* outward cornea normal there */
     double d3[3];              /* direction reflected by the cornea */
     double det[3];             /* where it crosses the detector plane (through the
-                                  detector point, normal to target->detector) */
+                                  detector point, normal along apex->detector: a
+                                  camera looking at the eye); NaN: never */
     double inc1, inc2, inc3;   /* incidence angles at m1, m2, cornea (rad) */
 } rg_beam;
 

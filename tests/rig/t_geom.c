@@ -239,6 +239,23 @@ static void solutions(void)
     th.m1.radius = th.m2.radius = 8;
     th.m1.mount_radius = th.m2.mount_radius = 10;
     report("mirror offsets 4 / -6 mm (8 mm rims)", scan(&th, 100, 7 * RT_DEG), 100, 1);
+    /* Newton alone from the zero-offset closed form lands on the same poses */
+    rg_solve_opts nopt = {0};
+    nopt.newton_only = 1;
+    double dp = 0;
+    int nits = 100, nok = 0;
+    for (int i = 0; i < 50; i++) {
+        rg_target t = rt_scan(i, 50, 12 * RT_DEG);
+        rg_solution a, b;
+        if (rg->solve(&g, &t, NULL, &a, err, sizeof err) ||
+            rg->solve(&g, &t, &nopt, &b, err, sizeof err)) continue;
+        nok++;
+        nits = b.iterations < nits ? b.iterations : nits;
+        for (int j = 0; j < RG_NJOINTS; j++) dp = fmax(dp, fabs(a.pose.j[j] - b.pose.j[j]));
+    }
+    CHECK(nok == 50 && nits >= 2 && dp < 1e-11,
+          "Newton on the exact model (>= %d iterations) and the repeated construction agree "
+          "on 50 poses to %.1e (rad, mm)", nits, dp);
     /* height/meridian targets */
     rg_target t = {RG_T_HEIGHT, 1.3, 0.7};
     rg_solution s;
