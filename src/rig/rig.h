@@ -269,7 +269,8 @@ typedef struct rig_api {
                     rg_quantised *q, char *err, size_t errcap);
     /* Independent check through the trace engine: mirrors as TRACE_MIRROR planes, the
      * cornea as a TRACE_AXIAL surface with Fresnel reflection (a biconic: its
-     * tangent plane at the target), a detector disc at the detector point.
+     * tangent plane where the forward model's beam meets it), a detector disc at
+     * the detector point.
      * target: the point the beam should hit (a solution's target).  RG_OK (v
      * filled; v->hit 0 when the traced beam never reached the detector) or RG_EIO
      * (the trace engine failed: message). */
