@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <string.h>
 #include <gsl/gsl_linalg.h>
-#include <gsl/gsl_errno.h>
 #include "rig/rg_geom.h"
 #include "rig/rg_vec.h"
 
@@ -77,7 +76,6 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
     double F[6], Fn[6], J[36], dx[6];
     if (residual(&c, p, F)) { *res = INFINITY; return -1; }
     double f = maxabs(F, n);
-    gsl_error_handler_t *old = gsl_set_error_handler_off();
     int it = 0, status = -1;
     for (;;) {
         if (f <= tol) { status = it; break; }
@@ -104,7 +102,17 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
         perm.size = n;
         perm.data = pd;
         int sg;
-        if (gsl_linalg_LU_decomp(&A.matrix, &perm, &sg) ||
+        /* GSL reports a singular matrix through its global error handler (abort by
+         * default, and not ours to change in a thread-safe engine): look first */
+        int finite = 1;
+        for (int r = 0; r < n * n; r++) finite &= isfinite(J[r]);
+        if (!finite || gsl_linalg_LU_decomp(&A.matrix, &perm, &sg)) break;
+        double dmax = 0, dmin = INFINITY;
+        for (int r = 0; r < n; r++) {
+            dmax = fmax(dmax, fabs(J[r * n + r]));
+            dmin = fmin(dmin, fabs(J[r * n + r]));
+        }
+        if (!(dmin > 1e-14 * dmax) ||
             gsl_linalg_LU_solve(&A.matrix, &perm, &B.vector, &X.vector))
             break;
         /* damped: halve the step until the residual falls */
@@ -127,7 +135,6 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
         }
         if (!ok) break;     /* no descent: at the rounding floor or stuck */
     }
-    gsl_set_error_handler(old);
     *res = f;
     if (status < 0 && f <= tol * 1e3) status = it;   /* at the rounding floor */
     return status;
@@ -192,9 +199,10 @@ int rg_jacobian(const rg_geometry *g, const rg_pose *p, double *J, double *cond,
         gsl_matrix_view Vv = gsl_matrix_view_array(V, 4, 4);
         gsl_vector_view Sv = gsl_vector_view_array(S, 4);
         gsl_vector_view Wv = gsl_vector_view_array(work, 4);
-        gsl_error_handler_t *old = gsl_set_error_handler_off();
-        int bad = gsl_linalg_SV_decomp(&A.matrix, &Vv.matrix, &Sv.vector, &Wv.vector);
-        gsl_set_error_handler(old);
+        /* (finite input: the only error SV_decomp can raise is non-convergence) */
+        int bad = 0;
+        for (int r = 0; r < RG_NJOINTS * 4; r++) bad |= !isfinite(At[r]);
+        if (!bad) bad = gsl_linalg_SV_decomp(&A.matrix, &Vv.matrix, &Sv.vector, &Wv.vector);
         *cond = bad ? INFINITY : (S[3] > 0 ? S[0] / S[3] : INFINITY);
     }
     return RG_OK;

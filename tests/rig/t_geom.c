@@ -5,6 +5,7 @@
  * point recovered to 1e-9 mm, the reflection law at every mirror), stiff cases
  * (grazing, near-parallel to p2, blocking, decentred and tilted eyes at the edge of
  * travel), quantisation, the rig-file keys. */
+#include <pthread.h>
 #include "unit.h"
 #include "rig/rt.h"
 
@@ -571,6 +572,44 @@ static void keys(void)
           "beam, parallel axes, zero vector (%s)", err);
 }
 
+/* ---- pure functions: two threads get the same poses as one ------------------ */
+typedef struct th_job { rg_geometry g; rg_pose pose[200]; int rc[200]; } th_job;
+static void *th_run(void *arg)
+{
+    th_job *j = arg;
+    char e[512];
+    for (int i = 0; i < 200; i++) {
+        rg_target t = rt_scan(i, 200, 14 * RT_DEG);
+        rg_solution s;
+        rg_quantised q;
+        j->rc[i] = rg->solve(&j->g, &t, NULL, &s, e, sizeof e);
+        if (!j->rc[i]) j->rc[i] = rg->quantise(&j->g, &t, &s, &q, e, sizeof e);
+        j->pose[i] = j->rc[i] ? s.pose : q.pose;
+    }
+    return NULL;
+}
+static void threads(void)
+{
+    static th_job a, b, c;
+    rg->geometry_default(&a.g);
+    b.g = c.g = a.g;
+    th_run(&c);
+    pthread_t t1, t2;
+    pthread_create(&t1, NULL, th_run, &a);
+    pthread_create(&t2, NULL, th_run, &b);
+    pthread_join(t1, NULL);
+    pthread_join(t2, NULL);
+    int same = 1, fails = 0;
+    for (int i = 0; i < 200; i++) {
+        same &= a.rc[i] == c.rc[i] && b.rc[i] == c.rc[i] &&
+                !memcmp(&a.pose[i], &c.pose[i], sizeof c.pose[i]) &&
+                !memcmp(&b.pose[i], &c.pose[i], sizeof c.pose[i]);
+        fails += c.rc[i] != 0;
+    }
+    CHECK(same && fails > 0 && fails < 200, "two threads solving and quantising at once "
+          "get the same bits as one (200 targets, %d refused)", fails);
+}
+
 int main(void)
 {
     rg = rt_rig();
@@ -586,6 +625,7 @@ int main(void)
     stiff();
     quantisation();
     quantisation_eyes();
+    threads();
     keys();
     return unit_failed();
 }
