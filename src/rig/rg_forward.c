@@ -33,7 +33,7 @@ static int mirror_hit(const rg_gimbal *m, const double c[3], const double n[3],
     v3axpy(h, o, t, d);
     if (ap && m->radius > 0 && v3dist(h, p0) > m->radius) return -1;
     v3reflect(out, d, n);
-    *inc = acos(fmin(1, -dn));
+    *inc = -dn;                 /* the cosine; rg_forward_path makes it an angle */
     return 0;
 }
 
@@ -128,7 +128,6 @@ int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b, int chec
                                   g->cornea.zone * (1 + 1e-12))
         b->diag |= RG_D_OFF_CORNEA;
     v3reflect(b->d3, b->d2, b->normal);
-    b->inc3 = acos(fmin(1, fabs(v3dot(b->d2, b->normal))));
     rg_detector_normal(g, w);
     double dn = v3dot(b->d3, w);
     if (dn > 0) {
@@ -136,7 +135,13 @@ int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b, int chec
         v3sub(rel, g->detector, b->spot);
         v3axpy(b->det, b->spot, v3dot(rel, w) / dn, b->d3);
     }
-    if (!checks) return 0;
+    if (!checks) {
+        b->inc1 = b->inc2 = NAN;
+        return 0;
+    }
+    b->inc1 = acos(fmin(1, b->inc1));
+    b->inc2 = acos(fmin(1, b->inc2));
+    b->inc3 = acos(fmin(1, fabs(v3dot(b->d2, b->normal))));
     /* what stands in the way: m2 across the detector leg and the incoming laser, m1
      * across the legs to and from the cornea */
     rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);

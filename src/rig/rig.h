@@ -184,9 +184,9 @@ typedef struct rg_solution {
 } rg_solution;
 
 /* Quantised pose: stage first, angles re-solved for the quantised centre, then m1's
- * angles (each grid corner around them), m2's re-aimed at the target, then m2's (the
- * grid corners again; the nearest landing of the 16 wins); the landing errors of
- * that pose on the exact forward model.  Steps count from the zero pose (joint 0). */
+ * angles (each grid corner around them), m2's re-aimed at the target and rounded (the
+ * nearest landing of the 4 wins); the landing errors of that pose on the exact
+ * forward model.  Steps count from the zero pose (joint 0). */
 typedef struct rg_quantised {
     rg_pose pose;              /* commanded (on the step grid) */
     int64_t steps[RG_NJOINTS]; /* step counts from the zero pose */
