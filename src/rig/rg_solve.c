@@ -212,13 +212,41 @@ int rg_jacobian(const rg_geometry *g, const rg_pose *p, double *J, double *cond,
 }
 
 /* ---- the backward solution ------------------------------------------------------- */
-static int fail(rg_solution *s, unsigned bit, char *err, size_t errcap)
+/* The message: what the diagnostics say, and the figures behind them (which joint
+ * wants how much of what travel, the angle to p2, the incidences, the condition). */
+static void message(const rg_geometry *g, const rg_solution *s, char *err, size_t errcap)
 {
     char txt[512];
-    s->diag |= bit;
+    size_t l;
     snprintf(err, errcap, "%s", rg_diag_text(s->diag, txt, sizeof txt));
+#define ADD(...) do { l = strlen(err); if (l < errcap) snprintf(err + l, errcap - l, __VA_ARGS__); } while (0)
+    if (s->diag & RG_D_TRAVEL)
+        for (int k = 0; k < RG_NJOINTS; k++) {
+            const rg_joint *j = &g->joint[k];
+            double u = k == RG_J_U || k == RG_J_V ? 1 : 180 / RG_PI;
+            if (j->lo < j->hi && (s->pose.j[k] < j->lo || s->pose.j[k] > j->hi))
+                ADD(" (%s needs %.4g, travel %.4g..%.4g %s)", rg_joint_name(k),
+                    s->pose.j[k] * u, j->lo * u, j->hi * u, u == 1 ? "mm" : "deg");
+        }
+    if (s->diag & (RG_D_PARALLEL_P2 | RG_D_NEAR_PARALLEL))
+        ADD(" (backward ray %.3g deg from p2)", s->p2_angle * 180 / RG_PI);
+    if ((s->diag & RG_D_GRAZING) && isfinite(s->beam.inc1))
+        ADD(" (incidence m1 %.3g, m2 %.3g, cornea %.3g deg)", s->beam.inc1 * 180 / RG_PI,
+            s->beam.inc2 * 180 / RG_PI, s->beam.inc3 * 180 / RG_PI);
+    else if (s->diag & RG_D_GRAZING)
+        ADD(" (incidence on the cornea %.3g deg)", s->beam.inc3 * 180 / RG_PI);
+    if (s->diag & RG_D_ILLCOND) ADD(" (condition number %.3g)", s->cond);
+#undef ADD
+}
+
+static int fail_g(const rg_geometry *g, rg_solution *s, unsigned bit, char *err,
+                  size_t errcap)
+{
+    s->diag |= bit;
+    message(g, s, err, errcap);
     return (s->diag & RG_D_FATAL) == RG_D_TRAVEL ? RG_ETRAVEL : RG_EUNREACH;
 }
+#define fail(s, bit, err, cap) fail_g(g, s, bit, err, cap)
 
 int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts,
              rg_solution *s, char *err, size_t errcap)
@@ -228,6 +256,7 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
     memset(s, 0, sizeof *s);
     s->cond = NAN;
     s->p2_angle = NAN;
+    s->beam.inc1 = s->beam.inc2 = s->beam.inc3 = NAN;
     int rc = rg_cornea_point(&g->cornea, t, s->target, s->normal, err, errcap);
     if (rc == RG_EUNREACH) { s->diag |= RG_D_OFF_CORNEA; return rc; }
     if (rc) return rc;
@@ -239,7 +268,8 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
     v3norm(r);
     double ci = v3dot(r, N);
     if (!(ci > 1e-9)) return fail(s, RG_D_DETECTOR_SIDE, err, errcap);
-    if (acos(fmin(1, ci)) > o.max_incidence) return fail(s, RG_D_GRAZING, err, errcap);
+    s->beam.inc3 = acos(fmin(1, ci));
+    if (s->beam.inc3 > o.max_incidence) return fail(s, RG_D_GRAZING, err, errcap);
     double *bk = s->back;
     v3scale(bk, N, 2 * ci);
     v3sub(bk, bk, r);
@@ -317,15 +347,8 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
         if (!(s->cond <= o.cond_max)) s->diag |= RG_D_ILLCOND;
     }
     if (s->diag & RG_D_FATAL) return fail(s, 0, err, errcap);
-    if (s->diag) {
-        char txt[512];
-        snprintf(err, errcap, "%s", rg_diag_text(s->diag, txt, sizeof txt));
-        if (s->diag & RG_D_ILLCOND) {
-            size_t l = strlen(err);
-            if (l < errcap)
-                snprintf(err + l, errcap - l, " (condition number %.3g)", s->cond);
-        }
-    } else if (errcap) err[0] = 0;
+    if (s->diag) message(g, s, err, errcap);
+    else if (errcap) err[0] = 0;
     return RG_OK;
 }
 
