@@ -204,7 +204,7 @@ static void report(const char *what, scan_res r, int want, int newton)
           (newton ? r.it_min >= 1 : r.it_max == 0),
           "%s: %d/%d solved, traced beam hits target to %.1e mm and detector to %.1e mm; "
           "reflection law to %.1e; independent model %.1e mm; beam on m2's centre %.1e mm; "
-          "Newton %g..%g iterations", what, r.n, want, r.et, r.ed, r.law, r.ind, r.m2c,
+          "%g..%g construction passes + Newton steps", what, r.n, want, r.et, r.ed, r.law, r.ind, r.m2c,
           r.it_min, r.it_max);
 }
 
@@ -226,6 +226,15 @@ static void solutions(void)
         char what[120];
         snprintf(what, sizeof what, "%s cornea, eye tilted (4, -3, 10 deg), decentred", name[model]);
         report(what, scan(&c, 120, 8 * RT_DEG), 120, 1);
+    }
+    /* conics of every kind: hyperboloid (keratoconus-like), paraboloid, oblate */
+    static const double qs[] = {-1.5, -1.0, 0.5};
+    for (int i = 0; i < 3; i++) {
+        rg_geometry c = g;
+        c.cornea.Q = qs[i];
+        char what[80];
+        snprintf(what, sizeof what, "conic cornea Q = %g", qs[i]);
+        report(what, scan(&c, 60, 10 * RT_DEG), 60, 1);
     }
     /* thick mirrors far off their axes: the construction must still converge */
     rg_geometry th = g;
