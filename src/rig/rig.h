@@ -178,7 +178,8 @@ typedef struct rg_solution {
     double back[3];            /* unit backward ray, target toward m2 */
     double p2_angle;           /* angle between the backward ray and p2 (rad) */
     double cond;               /* condition number of the joints-to-spot map */
-    int iterations;            /* Newton iterations (0: closed form was exact) */
+    int iterations;            /* offsets: construction passes + Newton steps (0:
+                                  mirrors on their axes, the closed form is exact) */
     double residual;           /* largest model residual at the end (mm) */
     rg_beam beam;              /* the forward model through the pose */
 } rg_solution;
