@@ -17,6 +17,7 @@ void rg_opts_fill(const rg_solve_opts *in, rg_solve_opts *o)
     if (!(o->cond_max > 0)) o->cond_max = 1e4;
     if (!(o->tol > 0)) o->tol = 1e-12;
     if (o->max_iter <= 0) o->max_iter = 30;
+    if (!(o->trace_tol > 0)) o->trace_tol = 1e-6;
 }
 
 /* ---- Newton on the exact model ------------------------------------------------- */
@@ -236,6 +237,7 @@ static void message(const rg_geometry *g, const rg_solution *s, char *err, size_
     else if (s->diag & RG_D_GRAZING)
         ADD(" (incidence on the cornea %.3g deg)", s->beam.inc3 * 180 / RG_PI);
     if (s->diag & RG_D_ILLCOND) ADD(" (condition number %.3g)", s->cond);
+    if (s->diag & RG_D_TRACE_MISS) ADD(" (by %.3g mm)", s->traced_err);
 #undef ADD
 }
 
@@ -257,6 +259,7 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
     s->cond = NAN;
     s->p2_angle = NAN;
     s->beam.inc1 = s->beam.inc2 = s->beam.inc3 = NAN;
+    s->traced_err = NAN;
     int rc = rg_cornea_point(&g->cornea, t, s->target, s->normal, err, errcap);
     if (rc == RG_EUNREACH) { s->diag |= RG_D_OFF_CORNEA; return rc; }
     if (rc) return rc;
@@ -346,6 +349,17 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
         if (rg_jacobian(g, &s->pose, J, &s->cond, e2, sizeof e2)) s->cond = INFINITY;
         if (!(s->cond <= o.cond_max)) s->diag |= RG_D_ILLCOND;
     }
+    if (o.trace && !(s->diag & RG_D_FATAL)) {
+        /* the independent check, when the caller hands us the tracer */
+        rg_verify v;
+        char e2[256];
+        if (rg_verify_pose(o.trace, g, &s->pose, P, &v, e2, sizeof e2)) {
+            snprintf(err, errcap, "%s", e2);
+            return RG_EIO;
+        }
+        s->traced_err = v.hit ? fmax(v.err_target, v.err_detector) : INFINITY;
+        if (!(s->traced_err <= o.trace_tol)) s->diag |= RG_D_TRACE_MISS;
+    }
     if (s->diag & RG_D_FATAL) return fail(s, 0, err, errcap);
     if (s->diag) message(g, s, err, errcap);
     else if (errcap) err[0] = 0;
@@ -369,6 +383,7 @@ const char *rg_diag_text(unsigned diag, char *buf, size_t cap)
         "beam misses the cornea",
         "ill-conditioned pose",
         "backward ray close to parallel to p2",
+        "the traced beam misses the target or the detector (a bug)",
     };
     size_t l = 0;
     if (cap) buf[0] = 0;

@@ -143,9 +143,12 @@ enum rg_diag {
     RG_D_MISS_CORNEA   = 1 << 11,  /* forward: the beam misses the cornea */
     RG_D_ILLCOND       = 1 << 12,  /* warning: joints-to-spot map ill-conditioned */
     RG_D_NEAR_PARALLEL = 1 << 13,  /* warning: backward ray within 2x the p2 limit */
-    RG_D_FATAL         = (1 << 12) - 1
+    RG_D_TRACE_MISS    = 1 << 14,  /* the trace engine's beam missed target or detector
+                                      by more than trace_tol (a bug: never seen) */
+    RG_D_FATAL         = ((1 << 12) - 1) | (1 << 14)
 };
 
+struct trace_api;              /* src/trace/trace.h: the caller passes the engine table */
 typedef struct rg_solve_opts {
     double min_p2_angle;       /* smallest angle backward ray / p2 (rad; 0: 2 deg) */
     double max_incidence;      /* largest incidence on a mirror (rad; 0: 80 deg) */
@@ -155,6 +158,9 @@ typedef struct rg_solve_opts {
     int no_checks;             /* 1: skip the condition number (baseline timing only) */
     int newton_only;           /* 1: mirror offsets by Newton alone, from the zero-offset
                                   closed form (tests: the two methods must agree) */
+    const struct trace_api *trace;  /* non-NULL: every solution also traced through
+                                       the trace engine (rig_api.verify) */
+    double trace_tol;          /* largest traced miss accepted (mm; 0: 1e-6) */
 } rg_solve_opts;
 
 /* The beam through a pose (forward model, exact: offsets, finite mirrors). */
@@ -182,6 +188,8 @@ typedef struct rg_solution {
                                   mirrors on their axes, the closed form is exact) */
     double residual;           /* largest model residual at the end (mm) */
     rg_beam beam;              /* the forward model through the pose */
+    double traced_err;         /* with opts->trace: the traced beam's largest miss of
+                                  target and detector point (mm); else NaN */
 } rg_solution;
 
 /* Quantised pose: stage first, angles re-solved for the quantised centre, then m1's
@@ -209,7 +217,6 @@ typedef struct rg_verify {
     double reflect_err;        /* largest reflection-law defect seen at any mirror or
                                   the cornea, |d_out - (d_in - 2(d_in.n)n)| */
 } rg_verify;
-struct trace_api;              /* src/trace/trace.h: the caller passes the engine table */
 
 /* ==== end of geometry ============================================================ */
 

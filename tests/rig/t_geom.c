@@ -266,6 +266,26 @@ static void solutions(void)
     CHECK(nok == 50 && nits >= 2 && dp < 1e-11,
           "Newton on the exact model (>= %d iterations) and the repeated construction agree "
           "on 50 poses to %.1e (rad, mm)", nits, dp);
+    /* the tracer inside solve: every solution checked in the same call */
+    rg_solve_opts topt = {0};
+    topt.trace = tr;
+    double terr = 0;
+    int tok = 0, tbits = 0;
+    for (int i = 0; i < 40; i++) {
+        rg_target t = rt_scan(i, 40, 12 * RT_DEG);
+        rg_solution a;
+        if (rg->solve(&g, &t, &topt, &a, err, sizeof err) == RG_OK) tok++;
+        terr = fmax(terr, a.traced_err);
+        tbits |= a.diag & RG_D_TRACE_MISS;
+    }
+    topt.trace_tol = 1e-16;             /* tighter than rounding: must be reported */
+    rg_target t1 = {RG_T_ANGLES, 5 * RT_DEG, 1.0};
+    rg_solution a1;
+    int r1 = rg->solve(&g, &t1, &topt, &a1, err, sizeof err);
+    CHECK(tok == 40 && !tbits && terr < 1e-9 && r1 == RG_EUNREACH &&
+          (a1.diag & RG_D_TRACE_MISS) && strstr(err, "traced"),
+          "solve with the tracer: 40 solutions traced to %.1e mm; a miss over trace_tol is "
+          "refused (%s)", terr, err);
     /* height/meridian targets */
     rg_target t = {RG_T_HEIGHT, 1.3, 0.7};
     rg_solution s;
