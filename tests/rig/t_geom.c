@@ -236,6 +236,11 @@ static void solutions(void)
         snprintf(what, sizeof what, "conic cornea Q = %g", qs[i]);
         report(what, scan(&c, 60, 10 * RT_DEG), 60, 1);
     }
+    /* a stage whose axes are not at right angles (p2_v 10 deg off): u, v still exact */
+    rg_geometry sk = g;
+    sk.p2_v[0] = sin(10 * RT_DEG);
+    sk.p2_v[1] = cos(10 * RT_DEG);
+    report("stage axes 80 deg apart", scan(&sk, 60, 10 * RT_DEG), 60, 1);
     /* thick mirrors far off their axes: the construction must still converge */
     rg_geometry th = g;
     th.m1.offset = 10;
