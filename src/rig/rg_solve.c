@@ -146,10 +146,19 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
  * detector plane. */
 static int spot4(const rg_geometry *g, const rg_pose *p, const double base[3],
                  const double t1[3], const double t2[3], const double dbase[3],
-                 const double e1[3], const double e2[3], double out[4])
+                 const double e1[3], const double e2[3], double out[4],
+                 const double n1b[3], const double n2b[3], int k)
 {
     rg_beam b;
-    if (rg_forward_path(g, p, &b, 0) || !isfinite(b.det[0])) return -1;
+    double n1[3], n2[3];
+    /* only the moved joint's mirror turns */
+    if (k == RG_J_M1A || k == RG_J_M1B)
+        rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);
+    else v3copy(n1, n1b);
+    if (k == RG_J_M2A || k == RG_J_M2B)
+        rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2);
+    else v3copy(n2, n2b);
+    if (rg_forward_nn(g, p, &b, 0, n1, n2) || !isfinite(b.det[0])) return -1;
     double d[3];
     v3sub(d, b.spot, base);
     out[0] = v3dot(d, t1);
@@ -168,7 +177,9 @@ int rg_jacobian(const rg_geometry *g, const rg_pose *p, double *J, double *cond,
         snprintf(err, errcap, "the beam of this pose does not reach the detector");
         return RG_EUNREACH;
     }
-    double t1[3], t2[3], w[3], e1[3], e2[3], hint[3] = {0, 0, 1};
+    double t1[3], t2[3], w[3], e1[3], e2[3], hint[3] = {0, 0, 1}, n1b[3], n2b[3];
+    rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1b);
+    rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2b);
     v3basis(b.normal, g->p2_u, t1, t2);
     rg_detector_normal(g, w);
     v3basis(w, hint, e1, e2);
@@ -179,10 +190,10 @@ int rg_jacobian(const rg_geometry *g, const rg_pose *p, double *J, double *cond,
         double h = 1e-7, sp[4];     /* spot moves from the base spot */
         rg_pose q = *p;
         q.j[k] += h;
-        if (spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sp)) {
+        if (spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sp, n1b, n2b, k)) {
             q.j[k] = p->j[k] - h;   /* at an edge: the other side */
             h = -h;
-            if (spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sp)) {
+            if (spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sp, n1b, n2b, k)) {
                 snprintf(err, errcap, "the beam leaves the detector within 1e-7 of "
                          "joint %s", rg_joint_name(k));
                 return RG_EUNREACH;
