@@ -108,7 +108,7 @@ int main(int argc, char **argv)
     if (rg->geometry_check(&g, err, sizeof err)) { fprintf(stderr, "%s\n", err); return 1; }
 
     /* exactness: every pose of the scan traced */
-    double worst = 0, tt = now();
+    double worst = 0, tt = now(), cmin = INFINITY, cmax = 0;
     int unreach = 0, missed = 0;
     for (int i = 0; i < NPTS; i++) {
         rg_target t = rt_scan(i, NPTS, THMAX);
@@ -120,6 +120,8 @@ int main(int argc, char **argv)
             continue;
         }
         worst = fmax(worst, fmax(v.err_target, v.err_detector));
+        cmin = fmin(cmin, s.cond);
+        cmax = fmax(cmax, s.cond);
     }
     tt = now() - tt;
     if (unreach || missed) {
@@ -128,6 +130,9 @@ int main(int argc, char **argv)
     }
     printf("BENCH rig_solution_err_um %.3g um\n", worst * 1e3);
     printf("BENCH rig_trace_check_points_per_s %.0f points/s\n", NPTS / tt);
+    /* the joints-to-spot map's condition number (one step per joint) over the scan */
+    printf("BENCH rig_cond_min %.0f ratio\n", cmin);
+    printf("BENCH rig_cond_max %.0f ratio\n", cmax);
 
     /* quantised, the example rig's steps */
     double ec, ed;
