@@ -425,6 +425,88 @@ static void stiff(void)
           "limit: %s", lin, cond, err);
 }
 
+/* ---- the Jacobian and its condition number, independently -------------------- */
+/* Eigenvalues of a symmetric 4x4 by cyclic Jacobi rotations. */
+static void jacobi4(double A[4][4], double ev[4])
+{
+    for (int sweep = 0; sweep < 60; sweep++)
+        for (int p = 0; p < 4; p++)
+            for (int q = p + 1; q < 4; q++) {
+                if (fabs(A[p][q]) < 1e-300) continue;
+                double th = 0.5 * atan2(2 * A[p][q], A[q][q] - A[p][p]);
+                double c = cos(th), s = sin(th);
+                for (int k = 0; k < 4; k++) {       /* A = G^T A G */
+                    double a = A[k][p], b = A[k][q];
+                    A[k][p] = c * a - s * b;
+                    A[k][q] = s * a + c * b;
+                }
+                for (int k = 0; k < 4; k++) {
+                    double a = A[p][k], b = A[q][k];
+                    A[p][k] = c * a - s * b;
+                    A[q][k] = s * a + c * b;
+                }
+            }
+    for (int i = 0; i < 4; i++) ev[i] = A[i][i];
+}
+
+static void jacobian_indep(void)
+{
+    rg_geometry g;
+    rg->geometry_default(&g);
+    rg_target t = {RG_T_ANGLES, 8 * RT_DEG, 2.2};
+    rg_solution s;
+    rg->solve(&g, &t, NULL, &s, err, sizeof err);
+    double J[4 * RG_NJOINTS], cond;
+    rg->jacobian(&g, &s.pose, J, &cond, err, sizeof err);
+    /* the test's own spot coordinates: tangent plane at the spot, detector plane
+     * normal along apex -> detector */
+    rt_path b0;
+    rt_forward(&g, &s.pose, &b0);
+    double nn[3] = {b0.nc[0], b0.nc[1], b0.nc[2]}, w[3] = {g.detector[0] - g.cornea.trans[0],
+                    g.detector[1] - g.cornea.trans[1], g.detector[2] - g.cornea.trans[2]};
+    rt_unit(w);
+    double worst = 0;
+    for (int k = 0; k < RG_NJOINTS; k++) {
+        double h = 1e-4, pt[2][2];     /* spot moves for +h and -h */
+        for (int sgn = 0; sgn < 2; sgn++) {
+            rg_pose p = s.pose;
+            p.j[k] += sgn ? -h : h;
+            rt_path b;
+            rt_forward(&g, &p, &b);
+            /* detector hit: the reflected line meets the detector plane */
+            double r[3] = {g.detector[0] - b.spot[0], g.detector[1] - b.spot[1], g.detector[2] - b.spot[2]};
+            double tt = rt_dot(r, w) / rt_dot(b.d3, w), det[3];
+            for (int i = 0; i < 3; i++) det[i] = b.spot[i] + tt * b.d3[i];
+            double ds[3] = {b.spot[0] - b0.spot[0], b.spot[1] - b0.spot[1], b.spot[2] - b0.spot[2]};
+            double dd[3] = {det[0] - g.detector[0], det[1] - g.detector[1], det[2] - g.detector[2]};
+            /* compare through norms in each plane: bases may differ by a rotation */
+            double ps = rt_dot(ds, nn);
+            pt[sgn][0] = sqrt(fmax(0, rt_dot(ds, ds) - ps * ps));
+            pt[sgn][1] = sqrt(rt_dot(dd, dd));
+        }
+        double eng_s = hypot(J[0 * RG_NJOINTS + k], J[1 * RG_NJOINTS + k]);
+        double eng_d = hypot(J[2 * RG_NJOINTS + k], J[3 * RG_NJOINTS + k]);
+        double ind_s = 0.5 * (pt[0][0] + pt[1][0]) / h, ind_d = 0.5 * (pt[0][1] + pt[1][1]) / h;
+        worst = fmax(worst, fmax(fabs(eng_s - ind_s) / ind_s, fabs(eng_d - ind_d) / ind_d));
+    }
+    /* condition number from the engine's J, scaled by one step, by Jacobi on J J^T */
+    double A[4][4] = {{0}}, ev[4];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++)
+            for (int k = 0; k < RG_NJOINTS; k++) {
+                double sc = 1 / g.joint[k].steps_per;
+                A[r][c] += J[r * RG_NJOINTS + k] * J[c * RG_NJOINTS + k] * sc * sc;
+            }
+    jacobi4(A, ev);
+    double lmax = 0, lmin = INFINITY;
+    for (int i = 0; i < 4; i++) { lmax = fmax(lmax, ev[i]); lmin = fmin(lmin, ev[i]); }
+    double cind = sqrt(lmax / lmin);
+    CHECK(worst < 1e-3 && fabs(cind - cond) < 1e-6 * cond,
+          "Jacobian columns (spot speed on the cornea and the detector per joint) agree with "
+          "the independent model to %.1e; condition number %.6g = Jacobi on J J^T %.6g",
+          worst, cond, cind);
+}
+
 /* ---- quantisation ----------------------------------------------------------- */
 static double quant_max(rg_geometry g, double spd, double spmm, double *ed, double *res,
                         int *ongrid, double *trace_agree)
@@ -657,6 +739,7 @@ int main(void)
     gimbals();
     solutions();
     stiff();
+    jacobian_indep();
     quantisation();
     quantisation_eyes();
     threads();
