@@ -130,6 +130,10 @@ static int draw_layout(const im_layout *l, const im_out *out, im_layout_info *in
     const double left = 20, right = 20, top = 38, bottom = 78;
     Map m;
     m.s = fmin((W - left - right) / (zhi - zlo), (H - top - bottom) / (2 * ymax));
+    if (out->height <= 0) {   /* no height asked: as tall as the lens needs at this scale */
+        H = (int)fmax(260, fmin(H, ceil(top + bottom + 2 * ymax * m.s + 40)));
+        m.s = fmin(m.s, (H - top - bottom) / (2 * ymax));
+    }
     m.x0 = left + ((W - left - right) - m.s * (zhi - zlo)) / 2 - m.s * zlo;
     m.y0 = top + (H - top - bottom) / 2;
     info->px_per_unit = m.s;

@@ -67,7 +67,7 @@ using namespace imd;
 
 static void marker(Canvas &c, Pt p, int shape, Rgb col)
 {
-    const double r = 4.5;
+    const double r = 3.5;
     switch (shape % 4) {
     case 0: c.disc(p, r, col); break;
     case 1: c.fill({{p.x - r, p.y - r}, {p.x + r, p.y - r}, {p.x + r, p.y + r}, {p.x - r, p.y + r}}, col); break;

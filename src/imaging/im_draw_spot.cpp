@@ -27,6 +27,10 @@ extern "C" void im_draw_spot_stat(const im_sd_point *pt, int n, int group, im_sd
             mx = fmax(mx, r2);
         }
     s->rms = sqrt(s2 / k);
+    /* a centroid that is zero but for rounding (symmetric bundles) is said as 0 */
+    double scale = sqrt(mx) + fabs(s->cx) + fabs(s->cy);
+    if (fabs(s->cx) < 1e-12 * scale) s->cx = 0;
+    if (fabs(s->cy) < 1e-12 * scale) s->cy = 0;
     s->rmax = sqrt(mx);
 }
 
@@ -118,7 +122,16 @@ static int draw_spot(const im_spotdiag *sp, const im_out *out, im_sd_info *info,
             c.text({f.x0, y}, "Airy radius: no wavelength given", GREY);
     }
     if (sp->title) c.text({20, 24}, sp->title, BLACK, 1.2);
-    c.text({(double)W - 20, 24}, "- - RMS   .. max   -- Airy", GREY, 0.9, RIGHT);
+    /* the key of the circles, top right */
+    double kx = W - 20 - 3 * 90;
+    const char *kname[3] = {"RMS", "max", "Airy"};
+    Rgb kcol[3] = {BLACK, GREY, GREEN};
+    double kdash[3] = {4, 2, 0};
+    for (int i = 0; i < 3; i++) {
+        if (i == 2 && !(sp->airy_radius > 0)) break;
+        c.line({kx + 90 * i, 20}, {kx + 90 * i + 28, 20}, kcol[i], i == 2 ? 1.6 : 1, kdash[i]);
+        c.text({kx + 90 * i + 34, 20 + th / 2}, kname[i], kcol[i], 0.9);
+    }
     return c.write(out, err, cap);
 }
 
