@@ -48,6 +48,25 @@ const char *im_cv_version(void);
 /* The reading front (im_frame.c): by content. */
 int im_decode(const void *buf, size_t len, const char *name, im_frame **out,
               int *was_colour, char *err, size_t cap);
+int im_read(const char *path, im_frame **out, int *was_colour, char *err, size_t cap);
+int im_read_raw(const char *path, int width, int height, int bits, im_frame **out,
+                char *err, size_t cap);
+int im_write(const im_frame *f, const char *path, char *err, size_t cap);
+
+/* The rest of the frame table (im_synth.c, im_source.c, im_centroid.c). */
+int im_synth(const im_sensor *s, const im_spot_src *spots, int nspots, uint64_t seed,
+             int threads, im_frame **out, char *err, size_t cap);
+int im_synth_expected(const im_sensor *s, const im_spot_src *spots, int nspots,
+                      double *counts, char *err, size_t cap);
+int im_source_open(const char *spec, int first, int timeout_ms, im_source **out,
+                   char *err, size_t cap);
+int im_source_next(im_source *src, im_frame **out, char *err, size_t cap);
+void im_source_close(im_source *src);
+int im_camera_loaded(void);
+im_centroider *im_centroider_new(void);
+void im_centroider_free(im_centroider *c);
+int im_centroid(im_centroider *c, const im_frame *f, const im_centroid_opt *opt,
+                im_spot *spots, int cap, im_centroid_result *res, char *err, size_t errcap);
 
 #ifdef __cplusplus
 }
