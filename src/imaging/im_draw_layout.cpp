@@ -176,46 +176,57 @@ static int draw_layout(const im_layout *l, const im_out *out, im_layout_info *in
         snprintf(k->name, sizeof k->name, "%s", name);
         k->x = foot.x; k->y = foot.y; k->label_x = label.x; k->label_y = label.y;
     };
-    /* object and image arrows, labelled beyond their tips */
+    /* Labels never overlap: each is put at its wanted place or moved away from the
+     * axis a row at a time until it clears every label placed before it. */
     double th = Canvas::text_height(1);
-    auto arrow = [&](const char *name, double z, double y, bool dashed) {
-        Pt foot = m(z, 0), tip = m(z, y);
-        cv.arrow(foot, tip, BLACK, 2, dashed ? 4 : 0);
-        Pt lab = {tip.x, y >= 0 ? tip.y - 6 : tip.y + 6 + th};
-        double w = Canvas::text_width(name);
-        cv.fill({{lab.x - w / 2 - 2, lab.y + 3}, {lab.x + w / 2 + 2, lab.y + 3},
-                 {lab.x + w / 2 + 2, lab.y - th - 3}, {lab.x - w / 2 - 2, lab.y - th - 3}}, WHITE);
-        cv.text(lab, name, BLACK, 1, CENTER);
-        add_mark(name, foot, {lab.x - w / 2, lab.y});
+    struct Box { double x0, y0, x1, y1; };
+    std::vector<Box> placed;
+    auto place = [&](double x, double base, double w, int dir) {
+        for (int row = 0; row < 8; row++, base += dir * (th + 6)) {
+            Box b = {x - 2, base - th - 3, x + w + 2, base + 3};
+            bool clash = false;
+            for (const Box &o : placed)
+                if (b.x0 < o.x1 && b.x1 > o.x0 && b.y0 < o.y1 && b.y1 > o.y0) clash = true;
+            if (!clash || row == 7) { placed.push_back(b); return base; }
+        }
+        return base;
     };
-    if (obj) arrow("object", l->z_obj, l->y_obj, false);
-    if (img) arrow(l->image_virtual ? "image (virtual)" : "image", l->z_img, l->y_img,
-                   l->image_virtual != 0);
+    auto label = [&](Pt at, const char *s, Rgb col) {
+        double w = Canvas::text_width(s);
+        cv.fill({{at.x - 2, at.y + 3}, {at.x + w + 2, at.y + 3}, {at.x + w + 2, at.y - th - 3},
+                 {at.x - 2, at.y - th - 3}}, WHITE);
+        cv.text(at, s, col);
+    };
 
-    /* cardinal ticks: across the axis, labels below in rows that do not overlap */
-    std::vector<std::pair<double, double>> rows[6];   /* per row: occupied x spans */
+    /* cardinal ticks across the axis, labels below it */
     std::vector<int> order;
     for (int i = 0; i < 6; i++) if (!std::isnan(ticks[i].z) && near(ticks[i].z)) order.push_back(i);
     std::stable_sort(order.begin(), order.end(),
                      [&](int a, int b) { return ticks[a].z < ticks[b].z; });
+    struct Lab { Pt at; const char *s; Rgb col; };
+    std::vector<Lab> labels;
     for (int i : order) {
         Pt foot = m(ticks[i].z, 0);
         cv.line({foot.x, foot.y - 9}, {foot.x, foot.y + 9}, ticks[i].col, 2);
         double w = Canvas::text_width(ticks[i].name), x = foot.x - w / 2;
-        int row = 0;
-        for (; row < 5; row++) {
-            bool clash = false;
-            for (auto &s : rows[row]) if (x < s.second + 4 && x + w > s.first - 4) clash = true;
-            if (!clash) break;
-        }
-        rows[row].push_back({x, x + w});
-        Pt lab = {x, foot.y + 12 + th + row * (th + 6)};
-        if (row > 0) cv.line({foot.x, foot.y + 9}, {foot.x, lab.y - th - 2}, ticks[i].col, 1, 2);
-        cv.fill({{x - 2, lab.y + 3}, {x + w + 2, lab.y + 3}, {x + w + 2, lab.y - th - 3},
-                 {x - 2, lab.y - th - 3}}, WHITE);
-        cv.text(lab, ticks[i].name, ticks[i].col);
-        add_mark(ticks[i].name, foot, lab);
+        double want = foot.y + 12 + th, y = place(x, want, w, +1);
+        if (y > want) cv.line({foot.x, foot.y + 9}, {foot.x, y - th - 2}, ticks[i].col, 1, 2);
+        labels.push_back({{x, y}, ticks[i].name, ticks[i].col});
+        add_mark(ticks[i].name, foot, {x, y});
     }
+    /* object and image arrows, labelled beyond their tips */
+    auto arrow = [&](const char *name, double z, double y, bool dashed) {
+        Pt foot = m(z, 0), tip = m(z, y);
+        cv.arrow(foot, tip, BLACK, 2, dashed ? 4 : 0);
+        double w = Canvas::text_width(name), x = tip.x - w / 2;
+        double base = place(x, y >= 0 ? tip.y - 6 : tip.y + 6 + th, w, y >= 0 ? -1 : +1);
+        labels.push_back({{x, base}, name, BLACK});
+        add_mark(name, foot, {x, base});
+    };
+    if (obj) arrow("object", l->z_obj, l->y_obj, false);
+    if (img) arrow(l->image_virtual ? "image (virtual)" : "image", l->z_img, l->y_img,
+                   l->image_virtual != 0);
+    for (const Lab &k : labels) label(k.at, k.s, k.col);
 
     /* scale bar, bottom left, and the title */
     const char *unit = l->unit && *l->unit ? l->unit : "units";
