@@ -190,3 +190,18 @@ no_opencv_unless_drawing() {
         { echo "--draw did not map OpenCV"; tail -3 "$DW/maps/draw/err"; return 1; }
 }
 check "start-up: classic, --thick and --trace sessions map no OpenCV; --draw does" no_opencv_unless_drawing
+
+# The tessellation table plotted: the record holds the (deterministic) errors, the
+# times go to the terminal only, so the record replays exactly; the plot exists.
+table_plot() {
+    d=$DW/table
+    draw_session "$BIN" "$d" "$RX" 8,8,5.5,5.5,7.5,7.5 mm inf 0 1 table tab.png done ||
+        { cat "$d/err"; return 1; }
+    [ -s "$d/tab.png" ] && [ -s "$d/tab.svg" ] &&
+    [ "$(grep -c '^  mesh .*triangles  RMS error' "$d/r.rec")" -eq 18 ] &&
+    ! grep -q 'trace .* ms' "$d/r.rec" && grep -q 'trace .* ms' "$d/out" &&
+    grep -q '^  mesh +refine   128    196608 triangles  RMS error [0-9.]*e-1[0-9] ' "$d/r.rec" &&
+    mkdir -p "$d/replay" && grep input: "$d/r.rec" > "$d/replay/in" &&
+    (cd "$d/replay" && "$BIN" --draw -i in r.rec > out 2> err) && cmp "$d/r.rec" "$d/replay/r.rec"
+}
+check "draw: the tessellation table on log-log axes, record replays exactly" table_plot

@@ -20,6 +20,7 @@
 #include "drawcalc.h"
 #include "engine.h"
 #include "prompts_draw.h"
+#include "../trace/scene.h"
 
 #define P(k) draw_prompts[DRAW_##k]
 #define MAXSURF 200
@@ -27,11 +28,13 @@
 #define M_PI 3.14159265358979323846
 #endif
 #define WORD 4096
+#define TABLE_GRID 201   /* the table's bundle: 201 x 201 cells (31 700 rays) */
 
 typedef struct dsess {
     lm_io *io;
     const imaging_api *im;
     const trace_api *tr;
+    const scene_api *sa;             /* the trace front end (the table), on first use */
     trace_lens_surface surf[MAXSURF];
     trace_lens lens;
     dw_scene sc;
@@ -309,7 +312,22 @@ static void report_layout(dsess *d, const im_layout_info *li)
     if (li->offpicture) lm_say(io, LM_BOTH, P(OFFPICTURE), li->offpicture);
 }
 
-/* One picture: what (0 layout, 1 spot, 2 fan), its questions, drawing, report. */
+static const char *const whats[] = {"layout", "spot", "fan", "table", "done", NULL};
+enum { W_LAYOUT, W_SPOT, W_FAN, W_TABLE, W_DONE };
+
+static void report_table(dsess *d, const sc_tess_row *rows)
+{
+    static const char *const model[] = {"analytic", "mesh", "mesh +normal", "mesh +refine"};
+    for (int i = 0; i < 1 + 3 * DW_TESS_LEVELS; i++) {
+        const sc_tess_row *r = &rows[i];
+        lm_say(d->io, LM_BOTH, P(TABLE_ROW), model[r->model], r->level, r->triangles,
+               r->err_rms, r->err_max, r->lost);
+        lm_say(d->io, LM_OUT, P(TABLE_TIME_OUT), r->trace_ms);
+        lm_say(d->io, LM_BOTH, "\n");
+    }
+}
+
+/* One picture: its questions, drawing, report. */
 static int picture(dsess *d, int what)
 {
     lm_io *io = d->io;
@@ -320,6 +338,7 @@ static int picture(dsess *d, int what)
     im_layout_info li;
     im_sd_info si;
     im_plot_info pi;
+    sc_tess_row rows[1 + 3 * DW_TESS_LEVELS];
     int rc;
 
     if (what == 1 && d->sc.unit &&
@@ -329,6 +348,10 @@ static int picture(dsess *d, int what)
                           sizeof png)))
         return rc;
     if (need_engines(d, &load_ms)) return LM_FAIL;
+    if (what == W_TABLE && !d->sa) {
+        scene_api_fn get = (scene_api_fn)lm_engine_symbol("trace", SC_API_SYMBOL);
+        if (!get || !(d->sa = get(SC_API_ABI))) { fputs(P(NO_TRACE), stderr); return LM_FAIL; }
+    }
     d->sc.lens = &d->lens;
     d->sc.wavelength = lens_wavelength(d, nm);
     im_out out = {png, p.svg, 0, 0};
@@ -342,9 +365,13 @@ static int picture(dsess *d, int what)
     } else if (what == 1) {
         snprintf(title, sizeof title, "Spot diagram at the paraxial image plane");
         rc = dw_spot(d->tr, d->im, &d->sc, title, &out, &si, &airy, err, sizeof err);
-    } else {
+    } else if (what == W_FAN) {
         snprintf(title, sizeof title, "Ray fan: transverse aberration");
         rc = dw_fan(d->tr, d->im, &d->sc, title, &out, &pi, err, sizeof err);
+    } else {
+        snprintf(title, sizeof title, "Tessellated first element: error against trace time");
+        lm_say(io, LM_BOTH, P(TABLE_INTRO), TABLE_GRID, TABLE_GRID);
+        rc = dw_table(d->sa, d->im, &d->sc, TABLE_GRID, title, &out, rows, err, sizeof err);
     }
     if (rc) {
         lm_say(io, LM_BOTH, P(FAILED), err);
@@ -352,7 +379,9 @@ static int picture(dsess *d, int what)
     }
     lm_say(io, LM_OUT, P(TIMING_OUT), now_ms() - t0, load_ms);
     lm_say(io, LM_BOTH, P(WRITTEN), png, p.svg,
-           what == 0 ? P(WRITTEN_LAYOUT) : what == 1 ? P(WRITTEN_SPOT) : P(WRITTEN_FAN));
+           what == W_LAYOUT ? P(WRITTEN_LAYOUT) : what == W_SPOT ? P(WRITTEN_SPOT)
+           : what == W_FAN ? P(WRITTEN_FAN) : P(WRITTEN_TABLE));
+    if (what == W_TABLE) report_table(d, rows);
     if (what == 0) report_layout(d, &li);
     if (what == 1) {
         int ng = d->sc.field != 0 ? 2 : 1;
@@ -368,11 +397,10 @@ static int picture(dsess *d, int what)
 
 static int pictures(dsess *d)
 {
-    static const char *const whats[] = {"layout", "spot", "fan", "done", NULL};
     int rc, what;
     for (;;) {
         if ((rc = lm_ask_choice(d->io, P(WHAT), P(WHAT), P(WHAT_WHAT), whats, &what))) return rc;
-        if (what == 3) return LM_GO;
+        if (what == W_DONE) return LM_GO;
         if ((rc = picture(d, what))) return rc;
     }
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 #include "drawcalc.h"
 #include "../paraxial/paraxial.h"
+#include "../trace/scene.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -344,4 +345,72 @@ out:
     collect_free(&c);
     free(rays); free(x); free(y);
     return rc;
+}
+
+int dw_table(const scene_api *sa, const imaging_api *im, const dw_scene *s, long grid,
+             const char *title, const im_out *out, sc_tess_row *rows, char *err, size_t cap)
+{
+    static const int levels[DW_TESS_LEVELS] = {4, 8, 16, 32, 64, 128};
+    static const char *const names[3] = {"mesh: flat triangles", "mesh + analytic normals",
+                                         "mesh + re-intersection"};
+    const trace_lens *l = s->lens;
+    sc_tess_spec sp;
+    px_system sys;
+    px_cardinal k;
+    double x[3][DW_TESS_LEVELS], y[3][DW_TESS_LEVELS];
+    im_series ser[3];
+    char note[160];
+
+    if (l->nsurf < 2 || fabs(l->surf[0].n_right - l->n_object) < 1e-12) {
+        set_err(err, cap, "%s", "the lens has no first element (glass between surfaces 1 and 2)");
+        return -1;
+    }
+    memset(&sp, 0, sizeof sp);
+    sp.r1 = isfinite(l->surf[0].radius) ? l->surf[0].radius : 0;
+    sp.r2 = isfinite(l->surf[1].radius) ? l->surf[1].radius : 0;
+    sp.thickness = l->surf[1].z - l->surf[0].z;
+    sp.n = l->surf[0].n_right;
+    sp.aperture = fmin(l->surf[0].semi_diameter, l->surf[1].semi_diameter);
+    if (!(sp.thickness > 0)) { set_err(err, cap, "%s", "the first element has no thickness"); return -1; }
+    /* the element alone in air, its paraxial focus the detector (as --trace's table) */
+    px_system_init(&sys, 1);
+    px_system_translate(&sys, 0);
+    px_system_refract(&sys, l->surf[0].radius, sp.n);
+    px_system_translate(&sys, sp.thickness);
+    px_system_refract(&sys, l->surf[1].radius, 1);
+    if (px_is_afocal(&sys)) {
+        px_system_free(&sys);
+        set_err(err, cap, "%s", "the first element is afocal");
+        return -1;
+    }
+    px_cardinal_points(&sys, 0, &k);
+    px_system_free(&sys);
+    if (!(k.focal2 > sp.thickness)) {
+        set_err(err, cap, "%s", "the first element does not focus a parallel beam behind itself");
+        return -1;
+    }
+    sp.z_detector = k.focal2;
+    sp.beam_radius = 0.9 * sp.aperture;
+    sp.grid = grid;
+    sp.levels = levels;
+    sp.nlevels = DW_TESS_LEVELS;
+    if (sa->tess_table(&sp, rows, err)) return -1;
+    for (int m = 0; m < 3; m++) {
+        for (int i = 0; i < DW_TESS_LEVELS; i++) {
+            const sc_tess_row *r = &rows[1 + i * 3 + m];
+            x[m][i] = r->trace_ms;
+            y[m][i] = r->err_rms;
+        }
+        ser[m].name = names[m];
+        ser[m].n = DW_TESS_LEVELS;
+        ser[m].x = x[m];
+        ser[m].y = y[m];
+        ser[m].style = IM_LINES | IM_MARKERS;
+    }
+    snprintf(note, sizeof note, "levels 4, 8, ..., 128 per model; the analytic "
+             "surfaces (the reference) trace in %.3g ms", rows[0].trace_ms);
+    char ylab[96];
+    snprintf(ylab, sizeof ylab, "RMS error at the detector (%s)", s->unit ? s->unit : "units");
+    im_plot P = {title, "trace time (ms)", ylab, 1, 1, 0, 3, ser, note};
+    return im->draw->plot(&P, out, NULL, err, cap) ? -1 : 0;
 }

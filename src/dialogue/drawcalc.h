@@ -41,4 +41,15 @@ int dw_fan(const trace_api *tr, const imaging_api *im, const dw_scene *s,
            const char *title, const im_out *out, im_plot_info *info,
            char *err, size_t cap);
 
+/* The tracer's error-against-run-time table (trace/scene.h) for the first element
+ * of the lens (surfaces 1 and 2, the glass between them), a grid x grid collimated
+ * bundle, plotted on log-log axes: RMS detector error against trace time, one
+ * marker per model.  rows: 1 + 3 * DW_TESS_LEVELS filled. */
+#define DW_TESS_LEVELS 6
+struct sc_tess_row;
+struct scene_api;
+int dw_table(const struct scene_api *sa, const imaging_api *im, const dw_scene *s,
+             long grid, const char *title, const im_out *out, struct sc_tess_row *rows,
+             char *err, size_t cap);
+
 #endif

@@ -27,12 +27,13 @@ static std::vector<double> ticks(double lo, double hi, bool lg, std::vector<doub
         return t;
     }
     int a = (int)floor(log10(lo) + 1e-9), b = (int)ceil(log10(hi) - 1e-9);
+    int every = b - a > 24 ? 4 : b - a > 12 ? 2 : 1;   /* labelled decades */
     for (int e = a; e <= b; e++)
         for (int k = 1; k < 10; k++) {
             double v = k * pow(10, e);
             if (v < lo * (1 - 1e-9) || v > hi * (1 + 1e-9)) continue;
-            if (k == 1 || (b - a <= 2 && (k == 2 || k == 5))) t.push_back(v);
-            else if (minor) minor->push_back(v);
+            if ((k == 1 && (e % every) == 0) || (b - a <= 2 && (k == 2 || k == 5))) t.push_back(v);
+            else if (minor && (k == 1 || b - a <= 6)) minor->push_back(v);
         }
     return t;
 }
@@ -48,13 +49,13 @@ void axes(Canvas &c, const Frame &f, const char *xlabel, const char *ylabel)
         Pt p = f.at(v, f.ymin);
         c.line({p.x, f.y0}, {p.x, f.y1}, LIGHTGREY);
         c.line({p.x, f.y1}, {p.x, f.y1 + 5}, BLACK);
-        c.text({p.x, f.y1 + 8 + th}, num(v), BLACK, 0.9, CENTER);
+        c.text({p.x, f.y1 + 8 + th}, f.logx ? fmt("%g", v) : num(v), BLACK, 0.9, CENTER);
     }
     for (double v : ty) {
         Pt p = f.at(f.xmin, v);
         c.line({f.x0, p.y}, {f.x1, p.y}, LIGHTGREY);
         c.line({f.x0 - 5, p.y}, {f.x0, p.y}, BLACK);
-        c.text({f.x0 - 8, p.y + th / 2}, num(v), BLACK, 0.9, RIGHT);
+        c.text({f.x0 - 8, p.y + th / 2}, f.logy ? fmt("%g", v) : num(v), BLACK, 0.9, RIGHT);
     }
     c.rect({f.x0, f.y0}, {f.x1, f.y1}, BLACK, 1);
     if (xlabel) c.text({(f.x0 + f.x1) / 2, f.y1 + 2 * th + 22}, xlabel, BLACK, 1, CENTER);
