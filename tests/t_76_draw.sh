@@ -9,6 +9,9 @@
 # --draw session does.
 # GOLDEN_UPDATE=1 ONLY=t_76 sh tests/run.sh rewrites golden/images/ from this build.
 
+unit "$TOP/build/obj/imaging_tests/t_draw"
+unit "$TOP/build/asan/imaging_tests/t_draw"
+
 DW=$WORK/draw
 CMP=$TOP/build/obj/imaging_tests/draw_pngcmp
 GI=$GOLDEN/images
