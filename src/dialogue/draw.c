@@ -373,6 +373,7 @@ static int picture(dsess *d, int what)
         lm_say(io, LM_BOTH, P(TABLE_INTRO), TABLE_GRID, TABLE_GRID);
         rc = dw_table(d->sa, d->im, &d->sc, TABLE_GRID, title, &out, rows, err, sizeof err);
     }
+    if (lm_stop_requested()) return LM_FAIL;   /* the pictures are whole (atomic writes) */
     if (rc) {
         lm_say(io, LM_BOTH, P(FAILED), err);
         return io->interactive ? LM_GO : LM_FAIL;
