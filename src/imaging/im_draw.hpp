@@ -44,6 +44,7 @@ public:
     const cv::Mat &image() const { return img_; }
 private:
     void seg(Pt a, Pt b, Rgb c, double width);
+    void run(const std::vector<Pt> &p, Rgb c, double width, double dash);
     int w_, h_;
     cv::Mat img_;
     std::string svg_;

@@ -65,9 +65,51 @@ void Canvas::seg(Pt a, Pt b, Rgb c, double width)
     cv::line(img_, fix(a), fix(b), bgr(c), t, cv::LINE_AA, SHIFT);
 }
 
+/* Clip segment a-b to the rectangle (Liang-Barsky); false if nothing is left. */
+static bool clip(Pt &a, Pt &b, double x0, double y0, double x1, double y1)
+{
+    double t0 = 0, t1 = 1, dx = b.x - a.x, dy = b.y - a.y;
+    double p[4] = {-dx, dx, -dy, dy}, q[4] = {a.x - x0, x1 - a.x, a.y - y0, y1 - a.y};
+    for (int i = 0; i < 4; i++) {
+        if (p[i] == 0) { if (q[i] < 0) return false; continue; }
+        double t = q[i] / p[i];
+        if (p[i] < 0) { if (t > t1) return false; if (t > t0) t0 = t; }
+        else { if (t < t0) return false; if (t < t1) t1 = t; }
+    }
+    Pt a2 = {a.x + t0 * dx, a.y + t0 * dy}, b2 = {a.x + t1 * dx, a.y + t1 * dy};
+    a = a2; b = b2;
+    return true;
+}
+
+/* A polyline reaching far outside the picture (a ray from a distant object) is cut
+ * to the picture plus a margin, in runs, before it is drawn. */
+void Canvas::polyline(const std::vector<Pt> &p, Rgb c, double width, double dash)
+{
+    const double m = 20, x0 = -m, y0 = -m, x1 = w_ + m, y1 = h_ + m;
+    bool inside = true;
+    for (const Pt &q : p) {
+        if (!std::isfinite(q.x) || !std::isfinite(q.y)) return;
+        if (q.x < x0 || q.x > x1 || q.y < y0 || q.y > y1) inside = false;
+    }
+    if (inside) { run(p, c, width, dash); return; }
+    std::vector<Pt> cur;
+    for (size_t i = 0; i + 1 < p.size(); i++) {
+        Pt a = p[i], b = p[i + 1];
+        if (!clip(a, b, x0, y0, x1, y1)) { run(cur, c, width, dash); cur.clear(); continue; }
+        if (cur.empty() || cur.back().x != a.x || cur.back().y != a.y) {
+            run(cur, c, width, dash);
+            cur.clear();
+            cur.push_back(a);
+        }
+        cur.push_back(b);
+        if (b.x != p[i + 1].x || b.y != p[i + 1].y) { run(cur, c, width, dash); cur.clear(); }
+    }
+    run(cur, c, width, dash);
+}
+
 /* Dashes are cut here for the PNG (OpenCV has none) and given to SVG as a dasharray,
  * starting at the same phase. */
-void Canvas::polyline(const std::vector<Pt> &p, Rgb c, double width, double dash)
+void Canvas::run(const std::vector<Pt> &p, Rgb c, double width, double dash)
 {
     std::string d;
     if (p.size() < 2) return;
