@@ -208,3 +208,30 @@ table_plot() {
     (cd "$d/replay" && "$BIN" --draw -i in r.rec > out 2> err) && cmp "$d/r.rec" "$d/replay/r.rec"
 }
 check "draw: the tessellation table on log-log axes, record replays exactly" table_plot
+
+# On a terminal: refused answers are explained and asked again, never recorded.
+tty_draw() {
+    python3 - "$BIN" "$DW/tty" "$RX" "$TOP/tests" <<'PYEOF'
+import os, sys
+bin_, d, rx = sys.argv[1:4]
+sys.path.insert(0, sys.argv[4])
+from ptydrive import drive
+os.makedirs(d, exist_ok=True)
+rc, out = drive([bin_, "--draw", "t.rec"],
+                [rx.encode() + b"\n", b"30\n", b"8\n", b"mm\n", b"inf\n", b"0\n", b"1\n",
+                 b"layout\n", b"pic.jpg\n", b"pic.png\n", b"done\n"], cwd=d, home=d, timeout=60)
+rec = open(os.path.join(d, "t.rec")).read()
+fails = []
+if rc != 0: fails.append("exit %d" % rc)
+if "surface 1 has radius 22.01359" not in out: fails.append("no re-ask for the semi-diameter")
+if "must end in .png" not in out: fails.append("no re-ask for the picture name")
+if "input: 30" in rec or "input: pic.jpg" in rec: fails.append("a refused answer was recorded")
+if "Written: pic.png and pic.svg (layout)" not in rec: fails.append("record")
+if not os.path.getsize(os.path.join(d, "pic.png")): fails.append("no picture")
+print("\n".join(fails) or "ok", out[-800:] if fails else "")
+sys.exit(1 if fails else 0)
+PYEOF
+}
+if command -v python3 > /dev/null; then
+    check "draw tty: a bad semi-diameter and picture name are asked again" tty_draw
+fi
