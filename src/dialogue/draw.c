@@ -173,6 +173,12 @@ static int read_lens(dsess *d)
         d->surf[i].semi_diameter = semi[i];
     }
     echo_lens(d);
+    if (d->lf.nobj) {   /* the file's own object planes, ready for the object question */
+        lm_say(d->io, LM_BOTH, "%s", P(FILE_OBJECTS));
+        for (int i = 0; i < d->lf.nobj; i++)
+            lm_say(d->io, LM_BOTH, P(FILE_OBJECT), lm_clean(d->io, d->surf[0].z - d->lf.obj[i]));
+        lm_say(d->io, LM_BOTH, "\n");
+    }
     return LM_GO;
 }
 
