@@ -32,7 +32,7 @@ draw_session() {
 golden_sessions() {
     bin=$1; d=$2
     draw_session "$bin" "$d/f4" "$GOLDEN/cases/thick_r3_r4.in" 2.8 mm 10 0.5 0.8 layout fig4_layout.png done &&
-    draw_session "$bin" "$d/f5" "$GOLDEN/cases/diverging_rm3_r3.in" 2.5 mm 10 0.5 0.8 layout fig5_layout.png done &&
+    draw_session "$bin" "$d/f5" "$GOLDEN/cases/diverging_rm3_r3.in" 2.5 mm 10 0.5 0.5 layout fig5_layout.png done &&
     draw_session "$bin" "$d/f6" "$GOLDEN/cases/reversed_r1_rm3.in" 0.9 mm 10 0.5 0.8 layout fig6_layout.png done &&
     draw_session "$bin" "$d/tri" "$RX" 8,8,5.5,5.5,7.5,7.5 mm inf 14 1 \
         layout triplet_layout.png spot 587.6 triplet_spot.png fan triplet_fan.png done

@@ -86,6 +86,7 @@ typedef struct collect {
     long nray;
     double *zy;        /* per ray: up to MAXPT points (z, y) */
     int *npt;
+    int *end;          /* per ray: how its last segment ended (enum trace_end) */
     trace_hit *hit;    /* per ray: its hit (ray < 0: none) */
     int *has_hit;
 } collect;
@@ -97,6 +98,7 @@ static int on_segment(void *ctx, const trace_segment *sg)
     long r = (long)sg->ray;
     if (r < 0 || r >= c->nray || sg->depth >= MAXPT - 1) return 0;
     double *p = c->zy + (size_t)r * 2 * MAXPT;
+    c->end[r] = sg->end;
     if (c->npt[r] == 0) { p[0] = sg->p0[2]; p[1] = sg->p0[1]; c->npt[r] = 1; }
     if (c->npt[r] < MAXPT) {
         p[2 * c->npt[r]] = sg->p1[2]; p[2 * c->npt[r] + 1] = sg->p1[1];
@@ -130,8 +132,9 @@ static int run(const trace_api *tr, const trace_lens *lens, double z_det, double
     c->npt = calloc((size_t)n, sizeof *c->npt);
     c->hit = calloc((size_t)n, sizeof *c->hit);
     c->has_hit = calloc((size_t)n, sizeof *c->has_hit);
+    c->end = calloc((size_t)n, sizeof *c->end);
     if (segments) c->zy = calloc((size_t)n * 2 * MAXPT, sizeof *c->zy);
-    if (!c->npt || !c->hit || !c->has_hit || (segments && !c->zy)) {
+    if (!c->npt || !c->hit || !c->has_hit || !c->end || (segments && !c->zy)) {
         set_err(err, cap, "%s", "out of memory");
         return -1;
     }
@@ -159,7 +162,7 @@ static int run(const trace_api *tr, const trace_lens *lens, double z_det, double
 
 static void collect_free(collect *c)
 {
-    free(c->zy); free(c->npt); free(c->hit); free(c->has_hit);
+    free(c->zy); free(c->npt); free(c->hit); free(c->has_hit); free(c->end);
     memset(c, 0, sizeof *c);
 }
 
@@ -181,14 +184,15 @@ int dw_layout(const trace_api *tr, const imaging_api *im, const dw_scene *s,
     dw_first f;
     double size = lens_size(l), z_start = l->surf[0].z - 0.25 * size;
     int nf = nfields(s);
-    long n = (long)nf * FAN_RAYS;
+    long n = (long)nf * FAN_RAYS, nir = 0;
     trace_ray *rays = calloc((size_t)n, sizeof *rays);
     im_surface *surf = calloc((size_t)l->nsurf, sizeof *surf);
-    im_ray *ir = calloc((size_t)n, sizeof *ir);
+    im_ray *ir = calloc((size_t)(2 * n), sizeof *ir);
+    double *back = calloc((size_t)(4 * n), sizeof *back);   /* virtual continuations */
     collect c = {0};
     int rc = -1;
 
-    if (!rays || !surf || !ir) { set_err(err, cap, "%s", "out of memory"); goto out; }
+    if (!rays || !surf || !ir || !back) { set_err(err, cap, "%s", "out of memory"); goto out; }
     dw_first_order(s, &f);
     for (int k = 0; k < nf; k++)
         for (int i = 0; i < FAN_RAYS; i++)
@@ -202,9 +206,29 @@ int dw_layout(const trace_api *tr, const imaging_api *im, const dw_scene *s,
     if (run(tr, l, esc == 0 ? f.z_img : NAN, esc > 0 ? esc : 1, rays, n, 1, &c, err, cap))
         goto out;
     for (long i = 0; i < n; i++) {
-        ir[i].zy = c.zy + (size_t)i * 2 * MAXPT;
-        ir[i].n = c.npt[i];
-        ir[i].group = (int)(i / FAN_RAYS);
+        ir[nir].zy = c.zy + (size_t)i * 2 * MAXPT;
+        ir[nir].n = c.npt[i];
+        ir[nir++].group = (int)(i / FAN_RAYS);
+    }
+    /* a virtual image: each ray that leaves the lens, continued back to the image
+     * plane, dashed (as the document's Figure 5) */
+    for (long i = 0; i < n && f.image_virtual; i++) {
+        const double *p = c.zy + (size_t)i * 2 * MAXPT;
+        int k = c.npt[i];
+        if (k != l->nsurf + 2 || c.end[i] != TRACE_END_ESCAPE) continue;   /* through every surface */
+        double z0 = p[2 * (k - 2)], y0 = p[2 * (k - 2) + 1];
+        double dz = p[2 * (k - 1)] - z0, dy = p[2 * (k - 1) + 1] - y0;
+        if (!(dz > 0)) continue;
+        double *b = back + 4 * i, yb = y0 + dy * (f.z_img - z0) / dz;
+        /* only the rays that come back near their image point (the aberrated
+         * margin would hide the picture) */
+        double y_want = i < FAN_RAYS ? 0 : f.y_img;
+        if (!(fabs(yb - y_want) <= 0.1 * size)) continue;
+        b[0] = z0; b[1] = y0; b[2] = f.z_img; b[3] = yb;
+        ir[nir].zy = b;
+        ir[nir].n = 2;
+        ir[nir].group = (int)(i / FAN_RAYS);
+        ir[nir++].dashed = 1;
     }
     for (int i = 0; i < l->nsurf; i++) {
         surf[i].z = l->surf[i].z;
@@ -212,7 +236,7 @@ int dw_layout(const trace_api *tr, const imaging_api *im, const dw_scene *s,
         surf[i].semi = l->surf[i].semi_diameter;
         surf[i].n_right = l->surf[i].n_right;
     }
-    im_layout L = {title, s->unit, l->n_object, l->nsurf, surf, (int)n, ir,
+    im_layout L = {title, s->unit, l->n_object, l->nsurf, surf, (int)nir, ir,
                    f.z_f1, f.z_f2, f.z_h1, f.z_h2, f.z_n1, f.z_n2,
                    isinf(s->z_obj) ? NAN : s->z_obj, s->field,
                    f.z_img, f.y_img, f.image_virtual};
@@ -229,7 +253,7 @@ int dw_layout(const trace_api *tr, const imaging_api *im, const dw_scene *s,
     rc = im->draw->layout(&L, out, info, err, cap) ? -1 : 0;
 out:
     collect_free(&c);
-    free(rays); free(surf); free(ir);
+    free(rays); free(surf); free(ir); free(back);
     return rc;
 }
 

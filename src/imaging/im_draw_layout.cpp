@@ -161,7 +161,7 @@ static int draw_layout(const im_layout *l, const im_out *out, im_layout_info *in
         std::vector<Pt> p;
         for (int k = 0; k < l->ray[i].n; k++)
             p.push_back(m(l->ray[i].zy[2 * k], l->ray[i].zy[2 * k + 1]));
-        cv.polyline(p, palette(l->ray[i].group), 1);
+        cv.polyline(p, palette(l->ray[i].group), 1, l->ray[i].dashed ? 3 : 0);
     }
     /* every surface's profile (also those that bound no body) */
     for (int i = 0; i < l->nsurf; i++) {

@@ -63,6 +63,7 @@ typedef struct im_ray {
     const double *zy;          /* 2 n doubles */
     int n;
     int group;                 /* colour: 0, 1, ... (e.g. the object point) */
+    int dashed;                /* 1: dashed (e.g. a ray's virtual continuation) */
 } im_ray;
 
 typedef struct im_layout {

@@ -93,7 +93,7 @@ static void layout_geometry(void)
     double h1 = -f * (n - 1) * t / (n * r2), h2 = t - f * (n - 1) * t / (n * r1);
     im_surface s[2] = {{0, r1, 0, {0}, 0, 8, n}, {t, r2, 0, {0}, 0, 8, 1}};
     double ray[6] = {-10, 3, 0, 3, 40, -2};
-    im_ray r = {ray, 3, 0};
+    im_ray r = {ray, 3, 0, 0};
     im_layout L = {"a <lens> & rays", "mm", 1, 2, s, 1, &r,
                    h1 - f, h2 + f, h1, h2, h1, h2, -60, 3, NAN, 0, 0};
     im_layout_info info;
@@ -137,7 +137,7 @@ static void layout_bad(void)
     s[0].semi = 5;
     L.nsurf = 1;
     double far[4] = {-1e300, 1e300, 1e300, -1e300};
-    im_ray r = {far, 2, 0};
+    im_ray r = {far, 2, 0, 1};
     L.nray = 1; L.ray = &r;
     CHECK(D->layout(&L, &out, NULL, err, sizeof err) == IM_OK && exists(png),
           "layout: a ray out at 1e300 is left out, not a crash");
