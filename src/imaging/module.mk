@@ -77,6 +77,11 @@ build/asan/imaging_tests/%: tests/imaging/%.c build/asan/lib/lensmat-imaging.so 
 	$(CC) $(BASE) -D_DEFAULT_SOURCE $(SAN) -pthread -Itests -o $@ $< \
 	    build/asan/lib/lensmat-imaging.so -Wl,-rpath,$(abspath build/asan/lib) -ldl -lm
 
+# The load benchmark must not link the module it times.
+build/obj/imaging_tests/bench_load: tests/imaging/bench_load.c $(IM_HDR) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -o $@ $< -ldl
+
 # libFuzzer target for the frame readers (PNG, TIFF, raw): our decoding and checking
 # code instrumented by clang, OpenCV's decoders as they ship.
 IM_FUZZSRC := src/imaging/im_frame_io.cpp src/imaging/im_frame.c

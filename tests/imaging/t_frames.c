@@ -66,6 +66,20 @@ static void noise_model(void)
     CHECK(fabs(m - 1000) < 0.3 && fabs(sqrt(v) / sqrt(2500 + 1.0 / 12) - 1) < 0.01,
           "read noise: mean %.3f (1000), sigma %.3f (50)", m, sqrt(v));
     fa->frame_free(f);
+    /* The ziggurat's tails: beyond 3 and 4 sigma as often as a normal law says. */
+    long n3 = 0, n4 = 0, tot = 0;
+    for (uint64_t seed = 20; seed < 23; seed++) {
+        fa->synth(&s, NULL, 0, seed, 1, &f, err, sizeof err);
+        for (int i = 0; i < f->width * f->height; i++, tot++) {
+            double d = fabs(f->px[i] + 0.5 - 1000.5);
+            n3 += d > 150;
+            n4 += d > 200;
+        }
+        fa->frame_free(f);
+    }
+    double p3 = (double)n3 / tot, e4 = 6.334e-5 * tot;
+    CHECK(fabs(p3 / 0.0026998 - 1) < 0.06 && n4 > e4 - 4 * sqrt(e4) && n4 < e4 + 4 * sqrt(e4),
+          "read-noise tails: %.5f beyond 3 sigma (0.00270), %ld beyond 4 (%.0f)", p3, n4, e4);
     /* Shot noise: Poisson photo-electrons, variance = mean (gain 1, no read noise),
      * both through GSL (mean 4) and the PTRS sampler (mean 400). */
     double means[2] = {4, 400};
