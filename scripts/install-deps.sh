@@ -4,7 +4,7 @@
 # Run by make (through the build/.deps stamp); safe to run by hand.
 set -e
 PKGS="gcc g++ make libreadline-dev libgsl-dev libembree-dev libgpiod-dev
-      libopencv-dev clang libclang-rt-14-dev python3"
+      libopencv-dev clang libclang-rt-14-dev python3 pkg-config zlib1g-dev"
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||

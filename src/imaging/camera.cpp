@@ -131,14 +131,18 @@ int cam_write_video(const char *path, const uint16_t *const *frames, int n, int 
         cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
         cv::VideoWriter w;
         std::string tmp = std::string(path) + ".part.avi";
-        if (!w.open(tmp, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
-                    fps > 0 ? fps : 10, cv::Size(width, height), false))
-            return say(err, cap, -3, "%s: cannot write a video%s", path);
+        // FFmpeg's MJPEG encoder; OpenCV's own one (no FFmpeg) asserts on smooth frames.
+        bool ok = w.open(tmp, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                         fps > 0 ? fps : 10, cv::Size(width, height), true);
+        if (!ok) ok = w.open(tmp, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                             fps > 0 ? fps : 10, cv::Size(width, height), true);
+        if (!ok) return say(err, cap, -3, "%s: cannot write a video%s", path);
         double scale = bits > 8 ? 255.0 / ((1 << bits) - 1) : 1;
         for (int k = 0; k < n; k++) {
-            cv::Mat src(height, width, CV_16U, const_cast<uint16_t *>(frames[k])), g;
+            cv::Mat src(height, width, CV_16U, const_cast<uint16_t *>(frames[k])), g, c;
             src.convertTo(g, CV_8U, scale);
-            w.write(g);
+            cv::cvtColor(g, c, cv::COLOR_GRAY2BGR);
+            w.write(c);
         }
         w.release();
         if (rename(tmp.c_str(), path) != 0) {
@@ -146,6 +150,8 @@ int cam_write_video(const char *path, const uint16_t *const *frames, int n, int 
             return say(err, cap, -3, "%s: cannot rename into place%s", path);
         }
         return 0;
+    } catch (const cv::Exception &e) {
+        return say(err, cap, -3, "%s: cannot write a video: %s", path, e.msg.c_str());
     } catch (...) {
         return say(err, cap, -3, "%s: cannot write a video%s", path);
     }

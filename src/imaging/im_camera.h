@@ -18,7 +18,7 @@ typedef struct im_cam_api {
     int (*next)(void *h, uint16_t **px, int *width, int *height, int *bits, double *t,
                 char *err, size_t cap);
     void (*close)(void *h);
-    /* Writes 8-bit grey frames as an MJPG AVI (OpenCV's own writer: no FFmpeg); used by
+    /* Writes frames (scaled to 8 bits) as an MJPG AVI; used by
      * the tests and to save synthetic sequences.  Returns 0 or < 0 with a message. */
     int (*write_video)(const char *path, const uint16_t *const *frames, int n, int width,
                        int height, int bits, double fps, char *err, size_t cap);

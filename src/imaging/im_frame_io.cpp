@@ -3,6 +3,9 @@
 // Nothing C++ leaves this file: every entry point catches and returns an IM_E* code.
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
+#include <mutex>
+#include <sstream>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -20,6 +23,17 @@ void quiet_opencv()
         done = true;
     }
 }
+
+// imdecode reports a decoder's exception on std::cerr whatever the log level; while it
+// runs, std::cerr writes into a string instead (our calls are serialised for that).
+std::mutex cerr_lock;
+struct quiet_cerr {
+    std::ostringstream text;
+    std::streambuf *old;
+    std::lock_guard<std::mutex> hold{cerr_lock};
+    quiet_cerr() : old(std::cerr.rdbuf(text.rdbuf())) {}
+    ~quiet_cerr() { std::cerr.rdbuf(old); }
+};
 
 const char *depth_name(int depth)
 {
@@ -43,7 +57,11 @@ extern "C" int im_cv_decode(const void *buf, size_t len, const char *name, im_fr
         if (len > (size_t)INT32_MAX)
             return im_err(err, cap, IM_EFORMAT, "%s: file too large", name);
         cv::Mat raw(1, (int)len, CV_8U, const_cast<void *>(buf));
-        cv::Mat m = cv::imdecode(raw, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
+        cv::Mat m;
+        {
+            quiet_cerr q;
+            m = cv::imdecode(raw, cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
+        }
         if (m.empty() || m.dims != 2)
             return im_err(err, cap, IM_EFORMAT, "%s: the image data do not decode (truncated "
                           "or corrupt, or the header states more than the file holds)", name);

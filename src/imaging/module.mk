@@ -24,7 +24,7 @@ IM_CVLIBS   = $(filter-out -lopencv_%,$(shell pkg-config --libs opencv4 2>/dev/n
               -lopencv_imgcodecs -lopencv_imgproc -lopencv_core
 CAM_CVLIBS  = $(filter-out -lopencv_%,$(shell pkg-config --libs opencv4 2>/dev/null)) \
               -lopencv_videoio -lopencv_imgproc -lopencv_core
-IM_LIBS     = $(IM_CVLIBS) -lgsl -lgslcblas -ldl -lm -pthread
+IM_LIBS     = $(IM_CVLIBS) -lgsl -lgslcblas -lz -ldl -lm -pthread
 CXX        ?= g++
 # C++: the same warnings, no exceptions leave the shim (every entry point catches).
 # Internal symbols hidden: the module exports imaging_get_api (camera: camera_get_api).
@@ -77,18 +77,24 @@ build/asan/imaging_tests/%: tests/imaging/%.c build/asan/lib/lensmat-imaging.so 
 	$(CC) $(BASE) -D_DEFAULT_SOURCE $(SAN) -pthread -Itests -o $@ $< \
 	    build/asan/lib/lensmat-imaging.so -Wl,-rpath,$(abspath build/asan/lib) -ldl -lm
 
+# The load benchmark must not link the module it times.
+build/obj/imaging_tests/bench_load: tests/imaging/bench_load.c $(IM_HDR) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -o $@ $< -ldl
+
 # libFuzzer target for the frame readers (PNG, TIFF, raw): our decoding and checking
 # code instrumented by clang, OpenCV's decoders as they ship.
 IM_FUZZSRC := src/imaging/im_frame_io.cpp src/imaging/im_frame.c
 build/fuzz_frame: tests/imaging/fuzz_frame.c $(IM_FUZZSRC) $(IM_HDR) | $(DEPS)
 	@mkdir -p $(@D)/fuzz_frame.d
-	$(CLANG) $(BASE) -D_DEFAULT_SOURCE -O1 -g -fsanitize=fuzzer-no-link,address,undefined \
+	$(CLANG) $(BASE) -D_DEFAULT_SOURCE -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION \
+	    -O1 -g -fsanitize=fuzzer-no-link,address,undefined \
 	    -c src/imaging/im_frame.c -o $(@D)/fuzz_frame.d/im_frame.o
 	$(CLANG)++ -std=c++17 -Isrc -O1 -g -fsanitize=fuzzer-no-link,address,undefined \
 	    $(IM_CVFLAGS) -c src/imaging/im_frame_io.cpp -o $(@D)/fuzz_frame.d/im_frame_io.o
 	$(CLANG)++ -O1 -g -fsanitize=fuzzer,address,undefined -Isrc -x c++ \
 	    tests/imaging/fuzz_frame.c -x none $(@D)/fuzz_frame.d/im_frame.o \
-	    $(@D)/fuzz_frame.d/im_frame_io.o -o $@ $(IM_CVLIBS) -ldl -lm
+	    $(@D)/fuzz_frame.d/im_frame_io.o -o $@ $(IM_CVLIBS) -lz -ldl -lm
 
 all: build/lib/lensmat-imaging.so build/lib/lensmat-camera.so
 MODULE_TEST_BINS  += build/lib/lensmat-imaging.so build/asan/lib/lensmat-imaging.so \

@@ -11,7 +11,7 @@
 
 #pragma GCC diagnostic ignored "-Wunused-function"
 
-static int it_failed;
+static int it_failed __attribute__((unused));
 #define CHECK(cond, ...) do { if (cond) { printf("PASS "); } else { printf("FAIL "); \
     it_failed++; } printf(__VA_ARGS__); printf("\n"); } while (0)
 
