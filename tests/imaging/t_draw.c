@@ -149,6 +149,31 @@ static void layout_bad(void)
     CHECK(D->layout(&L, &out, NULL, err, sizeof err) == IM_EINVAL, "layout: a 50-pixel picture is refused");
 }
 
+/* The profile of an asphere (paraboloid R 10, k = -1, plus A4 s^4) drawn where its
+ * sag puts it: the first point of its outline in the SVG is the edge at y = -semi,
+ * z = s^2/20 + A4 s^4. */
+static void asphere_profile(void)
+{
+    const double semi = 6, a4 = 1e-3;
+    im_surface s[1] = {{0, 10, -1, {0, a4}, 2, semi, 1.5}};
+    im_layout L = {NULL, "mm", 1, 1, s, 0, NULL, NAN, NAN, NAN, NAN, NAN, NAN, NAN, 0, NAN, 0, 0};
+    im_layout_info info;
+    char png[300], svg[300];
+    snprintf(png, sizeof png, "%s/a.png", dir);
+    snprintf(svg, sizeof svg, "%s/a.svg", dir);
+    im_out out = {png, svg, 0, 0};
+    int rc = D->layout(&L, &out, &info, err, sizeof err);
+    char *t = rc == IM_OK ? slurp(svg) : NULL;
+    const char *key = "stroke=\"#283c64\" stroke-width=\"1.5\" points=\"";
+    char *p = t ? strstr(t, key) : NULL;
+    double x = NAN, y = NAN;
+    if (p) sscanf(p + strlen(key), "%lf,%lf", &x, &y);
+    double sag = semi * semi / 20 + a4 * pow(semi, 4);
+    double ex = info.x0 + info.px_per_unit * sag, ey = info.y0 + info.px_per_unit * semi;
+    CHECK(p && fabs(x - ex) < 0.01 && fabs(y - ey) < 0.01,
+          "layout: the asphere's edge at its sag (%.2f, %.2f), want (%.2f, %.2f)", x, y, ex, ey);
+}
+
 int main(void)
 {
     const imaging_api *im = imaging_get_api(IMAGING_ABI);
@@ -161,6 +186,7 @@ int main(void)
     plot_ranges();
     layout_geometry();
     layout_bad();
+    asphere_profile();
     /* nothing but the pictures: no temporary file left */
     char cmd[400];
     snprintf(cmd, sizeof cmd, "ls %s | grep -q part", dir);
