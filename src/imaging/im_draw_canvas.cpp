@@ -115,9 +115,31 @@ void Canvas::run(const std::vector<Pt> &p, Rgb c, double width, double dash)
     if (p.size() < 2) return;
     for (const Pt &q : p) if (!finite(q)) return;
     double phase = 0;
-    for (size_t i = 0; i + 1 < p.size(); i++) {
+    if (dash <= 0) {   /* one path: joints are not painted twice (no beads on curves) */
+        /* points in line with their neighbours dropped: OpenCV paints each joint
+         * of a thick anti-aliased line twice (beads along a flat surface) */
+        std::vector<cv::Point> q;
+        size_t kept = 0;   /* the last point kept: the chord is measured from it */
+        for (size_t i = 0; i < p.size(); i++) {
+            if (i > 0 && i + 1 < p.size()) {   /* every point since `kept` near the chord? */
+                const Pt &a = p[kept], &e = p[i + 1];
+                double len = hypot(e.x - a.x, e.y - a.y);
+                bool near = len > 0;
+                for (size_t j = kept + 1; j <= i && near; j++) {
+                    const Pt &b = p[j];
+                    double cross = (b.x - a.x) * (e.y - a.y) - (b.y - a.y) * (e.x - a.x);
+                    near = fabs(cross) / len < 0.02;
+                }
+                if (near) continue;
+            }
+            kept = i;
+            q.push_back(fix(p[i]));
+        }
+        int t = width < 1.5 ? 1 : (int)lround(width);
+        cv::polylines(img_, q, false, bgr(c), t, cv::LINE_AA, SHIFT);
+    }
+    for (size_t i = 0; i + 1 < p.size() && dash > 0; i++) {
         Pt a = p[i], b = p[i + 1];
-        if (dash <= 0) { seg(a, b, c, width); continue; }
         double len = hypot(b.x - a.x, b.y - a.y), s = 0;
         while (s < len) {
             double per = fmod(phase, 2 * dash), run = per < dash ? dash - per : 2 * dash - per;

@@ -155,7 +155,7 @@ static int draw_layout(const im_layout *l, const im_out *out, im_layout_info *in
         cv.polyline(poly, GLASS_EDGE, 1.2);
     }
     /* the optic axis */
-    cv.line(m(zlo, 0), m(zhi, 0), AXIS, 1, 0);
+    cv.line({left, m.y0}, {W - right, m.y0}, AXIS, 1, 0);   /* across the picture */
     /* rays */
     for (int i = 0; i < l->nray; i++) {
         std::vector<Pt> p;
