@@ -141,6 +141,13 @@ check "draw bad: a missing lens file" bad_answer nofile "in:1: .*nothere.rx" not
 check "draw bad: a semi-diameter beyond a sphere's radius" bad_answer big \
     "in:2: .*surface 1 has radius 22.01359" "$RX" 30
 check "draw bad: three semi-diameters for six surfaces" bad_answer count "in:2: .*6 positive" "$RX" 1,2,3
+semis_refused() {
+    for sd in '8,,8,8,8,8,8' '8,' ',8' nan -1 0 1e999 inf '8;8' '8,8,8,8,8,8,8'; do
+        bad_answer "semi$(printf '%s' "$sd" | tr -c 'a-z0-9' _)" "in:2: .*6 positive" "$RX" "$sd" ||
+            { echo "semi-diameters '$sd' not refused"; return 1; }
+    done
+}
+check "draw bad: malformed semi-diameter lists" semis_refused
 check "draw bad: a field angle of 85 degrees" bad_answer angle "in:5: .*under 80\|in:5: .*less than 80" \
     "$RX" 8 mm inf 85
 check "draw bad: a picture name without .png" bad_answer nopng "in:8: .*must end in .png" \
