@@ -242,3 +242,18 @@ PYEOF
 if command -v python3 > /dev/null; then
     check "draw tty: a bad semi-diameter and picture name are asked again" tty_draw
 fi
+
+# SIGINT while the table is being traced: exit 130, no picture under its name and no
+# temporary file.
+interrupted() {
+    d=$DW/sigint; rm -rf "$d"; mkdir -p "$d"
+    printf '%s\n' "$RX" 8,8,5.5,5.5,7.5,7.5 mm inf 0 1 table tab.png done > "$d/in"
+    (cd "$d" && exec "$BIN" --draw -i in r.rec > out 2> err) &
+    pid=$!
+    sleep 0.4
+    kill -INT "$pid"
+    wait "$pid"; rc=$?
+    [ "$rc" -eq 130 ] || { echo "exit $rc"; return 1; }
+    ! ls "$d" | grep -q 'tab\|part' || { ls "$d"; return 1; }
+}
+check "draw: SIGINT during a picture exits 130 and leaves no picture" interrupted

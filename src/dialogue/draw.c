@@ -333,6 +333,8 @@ static void report_table(dsess *d, const sc_tess_row *rows)
     }
 }
 
+static int stop_asked(void *ctx) { (void)ctx; return lm_stop_requested(); }
+
 /* One picture: its questions, drawing, report. */
 static int picture(dsess *d, int what)
 {
@@ -360,7 +362,7 @@ static int picture(dsess *d, int what)
     }
     d->sc.lens = &d->lens;
     d->sc.wavelength = lens_wavelength(d, nm);
-    im_out out = {png, p.svg, 0, 0};
+    im_out out = {png, p.svg, 0, 0, stop_asked, NULL};
     t0 = now_ms();
     if (what == 0) {
         const char *base = strrchr(d->name, '/');
@@ -379,7 +381,7 @@ static int picture(dsess *d, int what)
         lm_say(io, LM_BOTH, P(TABLE_INTRO), TABLE_GRID, TABLE_GRID);
         rc = dw_table(d->sa, d->im, &d->sc, TABLE_GRID, title, &out, rows, err, sizeof err);
     }
-    if (lm_stop_requested()) return LM_FAIL;   /* the pictures are whole (atomic writes) */
+    if (lm_stop_requested()) return LM_FAIL;   /* nothing written (im_out.stop) */
     if (rc) {
         lm_say(io, LM_BOTH, P(FAILED), err);
         return io->interactive ? LM_GO : LM_FAIL;

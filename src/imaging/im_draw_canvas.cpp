@@ -254,6 +254,10 @@ double Canvas::text(Pt at, const std::string &s, Rgb c, double size, Anchor a)
 int Canvas::write(const im_out *out, char *err, size_t cap) const
 {
     std::vector<unsigned char> png;
+    if (out->stop && out->stop(out->stop_ctx)) {
+        set_err(err, cap, "%s: stopped before it was written", out->png);
+        return IM_ESTOP;
+    }
     try {
         if (!cv::imencode(".png", img_, png)) {
             set_err(err, cap, "%s: the PNG encoder failed", out->png);

@@ -36,6 +36,9 @@ typedef struct im_out {
     const char *png;           /* required */
     const char *svg;           /* NULL: no SVG */
     int width, height;         /* pixels; 0: the picture's default */
+    im_stop_fn stop;           /* asked before anything is written (NULL: never):
+                                  non-zero -> IM_ESTOP, no file written */
+    void *stop_ctx;
 } im_out;
 
 /* A place the drawing code put something, for tests and logs. */
