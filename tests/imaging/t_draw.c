@@ -50,7 +50,7 @@ static void spot_bad(void)
     im_sd_point p[2] = {{0, 0, 0}, {1, 1, 3}};
     char png[300];
     snprintf(png, sizeof png, "%s/s.png", dir);
-    im_out out = {png, NULL, 0, 0};
+    im_out out = {png, NULL, 0, 0, NULL, NULL};
     im_spotdiag s = {"t", "mm", 2, p, 2, NULL, 0, 0};
     im_sd_info info;
     CHECK(D->spot(&s, &out, &info, err, sizeof err) == IM_EINVAL && strstr(err, "group 3"),
@@ -72,7 +72,7 @@ static void plot_ranges(void)
     char png[300], svg[300];
     snprintf(png, sizeof png, "%s/p.png", dir);
     snprintf(svg, sizeof svg, "%s/p.svg", dir);
-    im_out out = {png, svg, 0, 0};
+    im_out out = {png, svg, 0, 0, NULL, NULL};
     int rc = D->plot(&p, &out, &info, err, sizeof err);
     CHECK(rc == IM_OK, "plot: log-log drawn (%s)", rc ? err : "");
     CHECK(info.skipped == 3, "plot: 0, -1 and NaN left off log axes (%d)", info.skipped);
@@ -100,7 +100,7 @@ static void layout_geometry(void)
     char png[300], svg[300];
     snprintf(png, sizeof png, "%s/l.png", dir);
     snprintf(svg, sizeof svg, "%s/l.svg", dir);
-    im_out out = {png, svg, 0, 0};
+    im_out out = {png, svg, 0, 0, NULL, NULL};
     int rc = D->layout(&L, &out, &info, err, sizeof err);
     CHECK(rc == IM_OK && exists(png) && exists(svg), "layout: drawn (%s)", rc ? err : "");
     const im_mark *f2 = NULL, *h2m = NULL, *n2m = NULL;
@@ -123,13 +123,15 @@ static void layout_geometry(void)
           "layout: SVG text escaped, labels present");
 }
 
+static int always(void *ctx) { (void)ctx; return 1; }
+
 static void layout_bad(void)
 {
     im_surface s[1] = {{0, 10, 0, {0}, 0, NAN, 1.5}};
     im_layout L = {NULL, NULL, 1, 1, s, 0, NULL, NAN, NAN, NAN, NAN, NAN, NAN, NAN, 0, NAN, 0, 0};
     char png[300];
     snprintf(png, sizeof png, "%s/bad.png", dir);
-    im_out out = {png, NULL, 0, 0};
+    im_out out = {png, NULL, 0, 0, NULL, NULL};
     CHECK(D->layout(&L, &out, NULL, err, sizeof err) == IM_EINVAL && strstr(err, "surface 1"),
           "layout: a NaN semi-diameter is refused (%s)", err);
     L.nsurf = 0;
@@ -144,6 +146,13 @@ static void layout_bad(void)
     out.png = "/proc/nothere/x.png";
     CHECK(D->layout(&L, &out, NULL, err, sizeof err) == IM_EIO && strstr(err, "/proc/nothere/x.png"),
           "layout: an unwritable picture is an error naming it (%s)", err);
+    char stopped[300];
+    snprintf(stopped, sizeof stopped, "%s/stopped.png", dir);
+    out.png = stopped;
+    out.stop = always;
+    CHECK(D->layout(&L, &out, NULL, err, sizeof err) == IM_ESTOP && !exists(stopped),
+          "layout: a stop asked before writing writes nothing");
+    out.stop = NULL;
     out.png = png;
     out.width = 50;
     CHECK(D->layout(&L, &out, NULL, err, sizeof err) == IM_EINVAL, "layout: a 50-pixel picture is refused");
@@ -161,7 +170,7 @@ static void asphere_profile(void)
     char png[300], svg[300];
     snprintf(png, sizeof png, "%s/a.png", dir);
     snprintf(svg, sizeof svg, "%s/a.svg", dir);
-    im_out out = {png, svg, 0, 0};
+    im_out out = {png, svg, 0, 0, NULL, NULL};
     int rc = D->layout(&L, &out, &info, err, sizeof err);
     char *t = rc == IM_OK ? slurp(svg) : NULL;
     const char *key = "stroke=\"#283c64\" stroke-width=\"1.5\" points=\"";
