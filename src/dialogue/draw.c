@@ -53,10 +53,10 @@ static double now_ms(void)
 }
 
 /* The engines, loaded on the first picture.  0, or -1 (said on stderr). */
-static int need_engines(dsess *d, double *load_ms)
+static int need_engines(dsess *d, double *load_ms, double *trace_ms)
 {
     double t0 = now_ms();
-    *load_ms = 0;
+    *load_ms = *trace_ms = 0;
     if (!d->im) {
         imaging_get_api_fn get = (imaging_get_api_fn)lm_engine_symbol("imaging",
                                                                       IMAGING_API_SYMBOL);
@@ -65,9 +65,11 @@ static int need_engines(dsess *d, double *load_ms)
         *load_ms = now_ms() - t0;
     }
     if (!d->tr) {
+        t0 = now_ms();
         trace_get_api_fn get = (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
         d->tr = get ? get(TRACE_ABI) : NULL;
         if (!d->tr) { fputs(P(NO_TRACE), stderr); return -1; }
+        *trace_ms = now_ms() - t0;
     }
     return 0;
 }
@@ -342,7 +344,7 @@ static int picture(dsess *d, int what)
     lm_numspec wl = {P(WAVELENGTH_WHAT), LM_NONNEG, 0};
     pic p = {d, ""};
     char png[WORD], err[1024], title[256];
-    double nm = 0, load_ms, t0, airy = 0;
+    double nm = 0, load_ms, trace_ms, t0, airy = 0;
     im_layout_info li;
     im_sd_info si;
     im_plot_info pi;
@@ -355,7 +357,7 @@ static int picture(dsess *d, int what)
     if ((rc = lm_ask_word(io, P(PICTURE), P(PICTURE), P(PICTURE_WHAT), check_picture, &p, png,
                           sizeof png)))
         return rc;
-    if (need_engines(d, &load_ms)) return LM_FAIL;
+    if (need_engines(d, &load_ms, &trace_ms)) return LM_FAIL;
     if (what == W_TABLE && !d->sa) {
         scene_api_fn get = (scene_api_fn)lm_engine_symbol("trace", SC_API_SYMBOL);
         if (!get || !(d->sa = get(SC_API_ABI))) { fputs(P(NO_TRACE), stderr); return LM_FAIL; }
@@ -386,7 +388,7 @@ static int picture(dsess *d, int what)
         lm_say(io, LM_BOTH, P(FAILED), err);
         return io->interactive ? LM_GO : LM_FAIL;
     }
-    lm_say(io, LM_OUT, P(TIMING_OUT), now_ms() - t0, load_ms);
+    lm_say(io, LM_OUT, P(TIMING_OUT), now_ms() - t0, load_ms, trace_ms);
     lm_say(io, LM_BOTH, P(WRITTEN), png, p.svg,
            what == W_LAYOUT ? P(WRITTEN_LAYOUT) : what == W_SPOT ? P(WRITTEN_SPOT)
            : what == W_FAN ? P(WRITTEN_FAN) : P(WRITTEN_TABLE));
