@@ -1,5 +1,5 @@
 # t_76_draw.sh -- pictures (lensmat --draw, the imaging engine's drawing half):
-# golden images of the document's Figures 4-6 and of the Cooke triplet (layout, spot
+# golden images of the document's Figures 4-7 and of the Cooke triplet (layout, spot
 # diagram, ray fan), compared with a per-pixel threshold and a count of differing
 # pixels; the comparison itself must catch a ray moved by a small field change; the
 # drawn F2 tick sits at the paraxial F2 of the classic dialogue within one pixel;
@@ -28,16 +28,18 @@ draw_session() {
 }
 
 # The sessions behind the golden images: Figures 4, 5, 6 (the golden classic cases,
-# object 10 left of the lens, height 0.5) and the triplet at infinity, 14 degrees.
+# object 10 left of the lens, height 0.5), one refracting surface as Figure 7 (glass
+# to the right edge) and the triplet at infinity, 14 degrees.
 golden_sessions() {
     bin=$1; d=$2
     draw_session "$bin" "$d/f4" "$GOLDEN/cases/thick_r3_r4.in" 2.8 mm 10 0.5 0.8 layout fig4_layout.png done &&
     draw_session "$bin" "$d/f5" "$GOLDEN/cases/diverging_rm3_r3.in" 2.5 mm 10 0.5 0.5 layout fig5_layout.png done &&
     draw_session "$bin" "$d/f6" "$GOLDEN/cases/reversed_r1_rm3.in" 0.9 mm 10 0.5 0.8 layout fig6_layout.png done &&
+    draw_session "$bin" "$d/f7" "$GOLDEN/cases/single_surface_gauss.in" 2.5 mm 14 1 0.6 layout fig7_layout.png done &&
     draw_session "$bin" "$d/tri" "$RX" 8,8,5.5,5.5,7.5,7.5 mm inf 14 1 \
         layout triplet_layout.png spot 587.6 triplet_spot.png fan triplet_fan.png done
 }
-GOLDEN_PICS="f4/fig4_layout f5/fig5_layout f6/fig6_layout tri/triplet_layout tri/triplet_spot tri/triplet_fan"
+GOLDEN_PICS="f4/fig4_layout f5/fig5_layout f6/fig6_layout f7/fig7_layout tri/triplet_layout tri/triplet_spot tri/triplet_fan"
 
 if [ -n "$GOLDEN_UPDATE" ]; then
     golden_sessions "$BIN" "$DW/g" && mkdir -p "$GI" &&

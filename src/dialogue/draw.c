@@ -369,8 +369,8 @@ static int picture(dsess *d, int what)
     if (what == 0) {
         const char *base = strrchr(d->name, '/');
         base = base ? base + 1 : d->name[0] ? d->name : "the lens traced";
-        snprintf(title, sizeof title, "%.120s: %d surfaces, real rays, cardinal points", base,
-                 d->lens.nsurf);
+        snprintf(title, sizeof title, "%.120s: %d surface%s, real rays, cardinal points", base,
+                 d->lens.nsurf, d->lens.nsurf == 1 ? "" : "s");
         rc = dw_layout(d->tr, d->im, &d->sc, title, &out, &li, err, sizeof err);
     } else if (what == 1) {
         snprintf(title, sizeof title, "Spot diagram at the paraxial image plane");

@@ -154,6 +154,17 @@ static int draw_layout(const im_layout *l, const im_out *out, im_layout_info *in
         if (!poly.empty()) poly.push_back(poly.front());
         cv.polyline(poly, GLASS_EDGE, 1.2);
     }
+    /* a medium that is not air before the first or after the last surface (a single
+     * refracting surface, an eye, water): shaded out to the picture's edge */
+    auto medium = [&](const im_surface *f, double zedge) {
+        std::vector<Pt> poly;
+        profile(f, -f->semi, f->semi, 96, m, poly);
+        poly.push_back(m(zedge, f->semi));
+        poly.push_back(m(zedge, -f->semi));
+        cv.fill(poly, GLASS);
+    };
+    if (glass(l->n_object)) medium(&l->surf[0], zlo);
+    if (glass(l->surf[l->nsurf - 1].n_right)) medium(&l->surf[l->nsurf - 1], zhi);
     /* the optic axis */
     cv.line({left, m.y0}, {W - right, m.y0}, AXIS, 1, 0);   /* across the picture */
     /* rays */
