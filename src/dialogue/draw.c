@@ -351,7 +351,7 @@ static int picture(dsess *d, int what)
     sc_tess_row rows[1 + 3 * DW_TESS_LEVELS];
     int rc;
 
-    if (what == 1 && d->sc.unit &&
+    if (what == W_SPOT && d->sc.unit &&
         (rc = lm_ask_number(io, P(WAVELENGTH), P(WAVELENGTH), &wl, &nm)))
         return rc;
     if ((rc = lm_ask_word(io, P(PICTURE), P(PICTURE), P(PICTURE_WHAT), check_picture, &p, png,
@@ -366,13 +366,13 @@ static int picture(dsess *d, int what)
     d->sc.wavelength = lens_wavelength(d, nm);
     im_out out = {png, p.svg, 0, 0, stop_asked, NULL};
     t0 = now_ms();
-    if (what == 0) {
+    if (what == W_LAYOUT) {
         const char *base = strrchr(d->name, '/');
         base = base ? base + 1 : d->name[0] ? d->name : "the lens traced";
         snprintf(title, sizeof title, "%.120s: %d surface%s, real rays, cardinal points", base,
                  d->lens.nsurf, d->lens.nsurf == 1 ? "" : "s");
         rc = dw_layout(d->tr, d->im, &d->sc, title, &out, &li, err, sizeof err);
-    } else if (what == 1) {
+    } else if (what == W_SPOT) {
         snprintf(title, sizeof title, "Spot diagram at the paraxial image plane");
         rc = dw_spot(d->tr, d->im, &d->sc, title, &out, &si, &airy, err, sizeof err);
     } else if (what == W_FAN) {
@@ -393,8 +393,8 @@ static int picture(dsess *d, int what)
            what == W_LAYOUT ? P(WRITTEN_LAYOUT) : what == W_SPOT ? P(WRITTEN_SPOT)
            : what == W_FAN ? P(WRITTEN_FAN) : P(WRITTEN_TABLE));
     if (what == W_TABLE) report_table(d, rows);
-    if (what == 0) report_layout(d, &li);
-    if (what == 1) {
+    if (what == W_LAYOUT) report_layout(d, &li);
+    if (what == W_SPOT) {
         int ng = d->sc.field != 0 ? 2 : 1;
         for (int g = 0; g < ng; g++)
             lm_say(io, LM_BOTH, P(SPOT_STATS), g ? "off the axis" : "on the axis", si.group[g].n,
@@ -402,7 +402,7 @@ static int picture(dsess *d, int what)
                    si.group[g].rmax);
         if (airy > 0) lm_say(io, LM_BOTH, P(SPOT_AIRY), airy, nm);
     }
-    if (what == 2 && pi.skipped) lm_say(io, LM_BOTH, P(FAN_SKIPPED), pi.skipped);
+    if (what == W_FAN && pi.skipped) lm_say(io, LM_BOTH, P(FAN_SKIPPED), pi.skipped);
     return LM_GO;
 }
 
