@@ -259,3 +259,20 @@ interrupted() {
     ! ls "$d" | grep -q 'tab\|part' || { ls "$d"; return 1; }
 }
 check "draw: SIGINT during a picture exits 130 and leaves no picture" interrupted
+
+# The Airy radius of a small axial bundle (h = 0.3 x 8 mm) agrees with the paraxial
+# 0.61 lambda f / h, f the classic dialogue's focal distance, to 1 %; and a bundle of
+# 1 % of the aperture has a spot far under the Airy disc (spherical aberration ~ h^3).
+airy_paraxial() {
+    f=$(sed -n 's/^Second focal distance: \([^ ]*\).*/\1/p' "$DW/classic.rec")
+    draw_session "$BIN" "$DW/airy" "$RX" 8 mm inf 0 0.3 spot 587.6 a.png done || return 1
+    draw_session "$BIN" "$DW/tiny" "$RX" 8 mm inf 0 0.01 spot 587.6 a.png done || return 1
+    a=$(sed -n 's/^Airy radius \([^ ]*\) .*/\1/p' "$DW/airy/r.rec")
+    r=$(sed -n 's/^Spot on the axis: .* RMS radius \([^,]*\),.*/\1/p' "$DW/tiny/r.rec")
+    t=$(sed -n 's/^Airy radius \([^ ]*\) .*/\1/p' "$DW/tiny/r.rec")
+    awk -v a="$a" -v f="$f" -v r="$r" -v t="$t" 'BEGIN {
+        p = 0.61 * 587.6e-6 * f / 2.4; d = (a - p) / p; if (d < 0) d = -d
+        printf "Airy %s, paraxial %.6g (%.2g); tiny bundle RMS %s vs Airy %s\n", a, p, d, r, t
+        exit !(d < 0.01 && r > 0 && r < 1e-3 * t) }'
+}
+check "draw: the Airy radius matches the paraxial 0.61 lambda f/h, tiny bundles spot inside it" airy_paraxial
