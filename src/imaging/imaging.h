@@ -112,7 +112,8 @@ enum im_centroid_method {
     IM_CM_GAUSS = 0,            /* moments start, refined by a 2-D Gaussian least-squares
                                    fit (GSL multifit_nlinear, trust region LM) */
     IM_CM_MOMENTS,              /* intensity-weighted centre of the window, raw counts */
-    IM_CM_MOMENTS_BG            /* the same after subtracting the estimated background */
+    IM_CM_MOMENTS_BG            /* background-subtracted centre of gravity of the spot's
+                                   connected pixels above threshold */
 };
 typedef struct im_centroid_opt {
     int method;                 /* enum im_centroid_method */
