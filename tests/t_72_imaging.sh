@@ -90,3 +90,20 @@ spot_asan() {
     [ $rc -eq 0 ] && cmp "$SP/asan/r.rec" "$SP/ex/r.rec"
 }
 check "--spot under ASan/UBSan (lensmat and the imaging module): the same record" spot_asan
+spot_stream() {
+    for i in 1 2 3; do
+        spot_session s$i synth 64 48 16 2$i.5 20 2.5 2000 100 20 $i y "$SP/seq$(printf %04d $i).png" 5 n || return 1
+    done
+    spot_session st stream "$SP/seq%04d.png" 1 10 5 n || return 1
+    grep -q '^Frame 3 (64x48, t = 3.000): x = 23\.[45]' "$SP/st/r.rec" && grep -q '^3 frames read $' "$SP/st/r.rec" ||
+        { cat "$SP/st/r.rec"; return 1; }
+    grep input: "$SP/st/r.rec" > "$SP/st/in2"
+    (cd "$SP/st" && "$BIN" --spot -i in2 r2.rec > /dev/null) && cmp "$SP/st/r.rec" "$SP/st/r2.rec" || return 1
+    spot_session st2 stream "$SP/seq%04d.png" 2 1 5 n && grep -q '^1 frames read, the source has more' "$SP/st2/r.rec" || return 1
+    ! spot_session st3 stream "$SP/seq%04d.png" 7 2 5 n && grep -q 'in:3:.*no frame number 7' "$SP/st3/err" || return 1
+    ! spot_session st4 stream cam:57 2 5 n && grep -q 'in:2:.*cam:57: no such camera' "$SP/st4/err" || return 1
+    "$TOP/build/obj/imaging_tests/bench_load" "$TOP/build/lib" --make-avi "$SP/v.avi" || return 1
+    spot_session st5 stream "$SP/v.avi" 3 5 n && grep -q '^Frame 3 (640x480' "$SP/st5/r.rec" &&
+        grep -q '^3 frames read, the source has more' "$SP/st5/r.rec"
+}
+check "--spot stream: a numbered sequence, a video (through lensmat-camera.so), an absent camera" spot_stream

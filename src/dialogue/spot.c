@@ -171,9 +171,104 @@ static int locate(sdlg *d)
     return LM_GO;
 }
 
+static int check_source(void *ctx, const char *w, char *msg, size_t cap)
+{
+    sdlg *d = ctx;
+    im_source *s;
+    int rc = d->fa->source_open(w, d->width, 0, &s, msg, cap);
+    if (rc == IM_OK) { d->fa->source_close(s); return 0; }
+    /* A sequence's pattern is checked here; its first number comes next. */
+    return rc == IM_EIO && strchr(w, '%') && !d->width ? 0 : -1;
+}
+
+/* The first number of a sequence: a whole number whose frame is there. */
+struct firstctx { sdlg *d; const char *pattern; };
+static int check_first(void *ctx, const char *w, char *msg, size_t cap)
+{
+    struct firstctx *fc = ctx;
+    long range[2] = {0, 1000000000L};
+    im_source *s;
+    if (check_int(range, w, msg, cap)) return -1;
+    if (fc->d->fa->source_open(fc->pattern, (int)strtol(w, NULL, 10), 0, &s, msg, cap)) return -1;
+    fc->d->fa->source_close(s);
+    return 0;
+}
+
+/* A sequence, a video or a camera: one line per frame. */
+static int stream(sdlg *d)
+{
+    char name[WORD], err[512];
+    long first = 0, count;
+    double thr;
+    im_source *src;
+    im_centroider *c;
+    int rc, n = 0, more = 0;
+    d->width = 0;
+    if ((rc = lm_ask_word(d->io, P(STREAM), P(STREAM), P(STREAM_WHAT), check_source, d,
+                          name, sizeof name)))
+        return rc;
+    if (strchr(name, '%')) {
+        struct firstctx fc = {d, name};
+        char w[64];
+        if ((rc = lm_ask_word(d->io, P(FIRST), P(FIRST), P(FIRST_WHAT), check_first, &fc, w,
+                              sizeof w)))
+            return rc;
+        first = strtol(w, NULL, 10);
+    }
+    if ((rc = ask_int(d, P(COUNT), P(COUNT_WHAT), 1, 1000000, &count)) ||
+        (rc = ask_num(d, P(THRESHOLD), P(THRESHOLD_WHAT), LM_POSITIVE, &thr)))
+        return rc;
+    if (d->fa->source_open(name, (int)first, 0, &src, err, sizeof err)) {
+        lm_say(d->io, LM_BOTH, P(STREAM_FAILED), err);
+        return LM_FAIL;
+    }
+    c = d->fa->centroider_new();
+    im_centroid_opt o;
+    memset(&o, 0, sizeof o);
+    o.threshold = thr;
+    rc = LM_GO;
+    while (n < count) {
+        im_frame *f;
+        im_spot s[4];
+        im_centroid_result r;
+        int got = d->fa->source_next(src, &f, err, sizeof err);
+        if (got == 0) break;
+        if (got < 0 || d->fa->centroid(c, f, &o, s, 4, &r, err, sizeof err)) {
+            if (got == 1) d->fa->frame_free(f);
+            lm_say(d->io, LM_BOTH, P(STREAM_FAILED), err);
+            rc = LM_FAIL;
+            break;
+        }
+        char fl[64] = "";
+        if (r.nspots > 0 && (s[0].flags & (IM_SF_SATURATED | IM_SF_EDGE | IM_SF_FIT_FAILED)))
+            snprintf(fl, sizeof fl, P(SFLAGS), s[0].flags & IM_SF_SATURATED ? "saturated " : "",
+                     s[0].flags & IM_SF_EDGE ? "edge " : "",
+                     s[0].flags & IM_SF_FIT_FAILED ? "moments" : "");
+        lm_say(d->io, LM_BOTH, P(SFRAME), n + 1, f->width, f->height, f->t);
+        if (r.outcome == IM_FOUND_NONE)
+            lm_say(d->io, LM_BOTH, P(SNONE), r.best_snr);
+        else if (r.outcome == IM_FOUND_ONE)
+            lm_say(d->io, LM_BOTH, P(SONE), s[0].x, s[0].sx, s[0].y, s[0].sy, s[0].snr, fl);
+        else
+            lm_say(d->io, LM_BOTH, P(SSEVERAL), r.ndetected, s[0].x, s[0].sx, s[0].y, s[0].sy,
+                   s[0].snr, fl);
+        d->fa->frame_free(f);
+        n++;
+        if (lm_stop_requested()) { rc = LM_FAIL; break; }
+    }
+    if (rc == LM_GO && n == count) {
+        im_frame *f;
+        if (d->fa->source_next(src, &f, err, sizeof err) == 1) { more = 1; d->fa->frame_free(f); }
+    }
+    if (rc == LM_GO) lm_say(d->io, LM_BOTH, P(SEND), n, more ? P(SEND_MORE) : "");
+    d->fa->centroider_free(c);
+    d->fa->source_close(src);
+    return rc;
+}
+
 int lm_spot(lm_io *io)
 {
-    static const char *const src[] = {"file", "raw", "synth", NULL};
+    static const char *const src[] = {"file", "raw", "synth", "stream", NULL};
     sdlg d = {io, NULL, NULL, 0, 0, 0, 0};
     char name[WORD];
     int rc = LM_GO, k, again = 1;
@@ -194,10 +289,11 @@ int lm_spot(lm_io *io)
                 rc = lm_ask_word(io, P(RAW_FILE), P(RAW_FILE), P(FILE_WHAT), check_read, &d,
                                  name, sizeof name);
             }
-        } else {
+        } else if (k == 2) {
             rc = synthesise(&d);
         }
-        if (rc == LM_GO) rc = locate(&d);
+        if (k == 3) rc = stream(&d);
+        else if (rc == LM_GO) rc = locate(&d);
         d.fa->frame_free(d.f);
         d.f = NULL;
         if (rc == LM_GO) rc = lm_ask_yn(io, P(AGAIN), P(AGAIN), P(AGAIN_WHAT), &again);
