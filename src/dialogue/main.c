@@ -35,6 +35,7 @@ static const dialogue dialogues[] = {
     {"--vision", "spectacle power for a near or far point (41, 57)", lm_vision, lm_vision_example},
     {"--cornea", "corneal radius <-> power, measuring accuracy (section 37)", lm_cornea, lm_cornea_example},
     {"--fit", "lens matrix from measurements (lsq), cardinal or nodal points (14, 24, 26)", lm_fit, lm_fit_example},
+    {"--spot", "laser-spot centroids in a detector frame: file, raw or synthetic (36, 46)", lm_spot, lm_spot_example},
     {"--prescription", "run the classic dialogue from a prescription file (-i FILE)", lm_prescription, lm_prescription_example},
     {"--to-prescription", "write a classic record or answers (-i FILE) as a prescription", lm_to_prescription, lm_to_prescription_example},
 };

@@ -57,8 +57,11 @@ void *cam_open(const char *spec, int kind, int index, int timeout_ms, char *err,
         std::vector<int> params;
         if (timeout_ms > 0) params = {cv::CAP_PROP_OPEN_TIMEOUT_MSEC, timeout_ms,
                                       cv::CAP_PROP_READ_TIMEOUT_MSEC, timeout_ms};
-        bool ok = kind == 1 ? c->cap.open(path, cv::CAP_V4L2, params)
-                            : c->cap.open(path, cv::CAP_ANY, params);
+        int api = kind == 1 ? cv::CAP_V4L2 : cv::CAP_ANY;
+        bool ok = c->cap.open(path, api, params);
+        // A backend that does not take the timeouts refuses the open: try without
+        // (V4L2 then waits for a frame up to its own select timeout, 10 s).
+        if (!ok && !params.empty()) ok = c->cap.open(path, api);
         if (!ok || !c->cap.isOpened()) {
             delete c;
             say(err, cap, -3, kind ? "%s: the camera does not open (busy, or not a "

@@ -5,7 +5,9 @@
  * Levenberg-Marquardt, Cholesky).  Weights come from the noise model (read noise sigma
  * and, when the gain is known, shot noise), so the covariance (J'J)^-1 is the
  * uncertainty of the centre.  Saturated pixels are left out (the fit uses the wings);
- * pixels beyond the frame are simply absent (the spot is flagged as cut). */
+ * pixels beyond the frame are simply absent (the spot is flagged as cut).
+ * The two baselines: raw moments over the window (IM_CM_MOMENTS) and background-
+ * subtracted moments of the connected pixels above threshold (IM_CM_MOMENTS_BG). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -107,6 +109,33 @@ static void moments(const fitdata *d, double bg, im_spot *o)
     o->power = s;
 }
 
+/* Background-subtracted moments over the spot's connected pixels above threshold (the
+ * classic thresholded centre of gravity); variances from the noise model. */
+static void moments_above(const im_spot_in *in, im_spot *o)
+{
+    const im_frame *f = in->f;
+    double s = 0, sx = 0, sy = 0, var0 = in->noise * in->noise, vx = 0, vy = 0;
+    int W = f->width;
+    for (int k = 0; k < in->npix; k++) {
+        int p = in->list[k];
+        double v = f->px[p] - in->bg;
+        s += v; sx += v * (p % W); sy += v * (p / W);
+    }
+    if (!(s > 0)) return;
+    o->x = sx / s;
+    o->y = sy / s;
+    for (int k = 0; k < in->npix; k++) {
+        int p = in->list[k];
+        double v = f->px[p], ax = p % W - o->x, ay = p / W - o->y;
+        double var = var0 + (in->gain > 0 && v > in->bg ? (v - in->bg) / in->gain : 0);
+        vx += ax * ax * var;
+        vy += ay * ay * var;
+    }
+    o->sx = sqrt(vx) / s;
+    o->sy = sqrt(vy) / s;
+    o->power = s;
+}
+
 static fitdata *scratch(void)
 {
     static __thread fitdata *d;
@@ -163,7 +192,8 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
     if (o->nsat) o->flags |= IM_SF_SATURATED;
 
     if (in->method == IM_CM_MOMENTS || in->method == IM_CM_MOMENTS_BG || d->n <= NPAR + 2) {
-        moments(d, in->method == IM_CM_MOMENTS ? 0 : in->bg, o);
+        if (in->method == IM_CM_MOMENTS) moments(d, 0, o);
+        else moments_above(in, o);
         o->w = w0;
         o->flags |= IM_SF_MOMENTS;
         if (in->method == IM_CM_GAUSS) o->flags |= IM_SF_FIT_FAILED;

@@ -237,7 +237,8 @@ enum im_centroid_method {
     IM_CM_GAUSS = 0,            /* moments start, refined by a 2-D Gaussian least-squares
                                    fit (GSL multifit_nlinear, trust region LM) */
     IM_CM_MOMENTS,              /* intensity-weighted centre of the window, raw counts */
-    IM_CM_MOMENTS_BG            /* the same after subtracting the estimated background */
+    IM_CM_MOMENTS_BG            /* background-subtracted centre of gravity of the spot's
+                                   connected pixels above threshold */
 };
 typedef struct im_centroid_opt {
     int method;                 /* enum im_centroid_method */
@@ -326,7 +327,8 @@ struct im_frame_api {
      * file (.avi .mp4 .mkv .mov .mjpg), "cam:N" or "/dev/videoN" (a live camera).
      * Video and cameras load build/lib/lensmat-camera.so (beside this module) on
      * first use.  next: 1 and a frame (caller frees), 0 at the end, < 0 on error
-     * (a camera that stops delivering is an error after timeout_ms, 0: 2000). */
+     * (a camera that stops delivering is an error after timeout_ms, 0: 2000, where the
+     * backend takes a timeout -- FFmpeg, GStreamer; V4L2 waits its own 10 s). */
     int (*source_open)(const char *spec, int first, int timeout_ms, im_source **out,
                        char *err, size_t cap);
     int (*source_next)(im_source *src, im_frame **out, char *err, size_t cap);

@@ -84,21 +84,24 @@ build/obj/imaging_tests/bench_load: tests/imaging/bench_load.c $(IM_HDR) | $(DEP
 
 # libFuzzer target for the frame readers (PNG, TIFF, raw): our decoding and checking
 # code instrumented by clang, OpenCV's decoders as they ship.
-IM_FUZZSRC := src/imaging/im_frame_io.cpp src/imaging/im_frame.c
+IM_FUZZSRC := src/imaging/im_frame_io.cpp src/imaging/im_frame.c src/imaging/im_centroid.c \
+              src/imaging/im_fit.c
+IM_FUZZC   := $(filter %.c,$(IM_FUZZSRC))
 build/fuzz_frame: tests/imaging/fuzz_frame.c $(IM_FUZZSRC) $(IM_HDR) | $(DEPS)
 	@mkdir -p $(@D)/fuzz_frame.d
-	$(CLANG) $(BASE) -D_DEFAULT_SOURCE -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION \
+	for f in $(IM_FUZZC); do \
+	  $(CLANG) $(BASE) -D_DEFAULT_SOURCE -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION \
 	    -O1 -g -fsanitize=fuzzer-no-link,address,undefined \
-	    -c src/imaging/im_frame.c -o $(@D)/fuzz_frame.d/im_frame.o
+	    -c $$f -o $(@D)/fuzz_frame.d/$$(basename $$f .c).o || exit 1; done
 	$(CLANG)++ -std=c++17 -Isrc -O1 -g -fsanitize=fuzzer-no-link,address,undefined \
 	    $(IM_CVFLAGS) -c src/imaging/im_frame_io.cpp -o $(@D)/fuzz_frame.d/im_frame_io.o
 	$(CLANG)++ -O1 -g -fsanitize=fuzzer,address,undefined -Isrc -x c++ \
-	    tests/imaging/fuzz_frame.c -x none $(@D)/fuzz_frame.d/im_frame.o \
-	    $(@D)/fuzz_frame.d/im_frame_io.o -o $@ $(IM_CVLIBS) -lz -ldl -lm
+	    tests/imaging/fuzz_frame.c -x none $(patsubst src/imaging/%.c,$(@D)/fuzz_frame.d/%.o,$(IM_FUZZC)) \
+	    $(@D)/fuzz_frame.d/im_frame_io.o -o $@ $(IM_CVLIBS) -lgsl -lgslcblas -lz -ldl -lm
 
 all: build/lib/lensmat-imaging.so build/lib/lensmat-camera.so
 MODULE_TEST_BINS  += build/lib/lensmat-imaging.so build/asan/lib/lensmat-imaging.so \
                      build/lib/lensmat-camera.so build/asan/lib/lensmat-camera.so \
-                     build/fuzz_frame $(IM_TBIN)
+                     build/fuzz_frame $(IM_TBIN) build/obj/imaging_tests/bench_load
 MODULE_BENCH_BINS += build/lib/lensmat-imaging.so build/lib/lensmat-camera.so $(IM_BBIN)
 -include $(IM_OBJ:.o=.d) $(IM_SOBJ:.o=.d)

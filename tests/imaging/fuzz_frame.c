@@ -1,6 +1,7 @@
 /* fuzz_frame.c -- libFuzzer target for the frame readers: the by-content front (PNG
  * structure and image-data checks, then OpenCV's PNG/TIFF decoders) and the raw reader
- * with a size taken from the first bytes.  Built as C++ (it links the OpenCV shim). */
+ * with a size taken from the first bytes; every frame that decodes is then handed to
+ * the centroid (detection, moments, the GSL fit).  Built as C++ (it links the OpenCV shim). */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +16,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         unsigned long s = 0;
         for (size_t i = 0; i < (size_t)f->width * f->height; i++) s += f->px[i];
         (void)s;
+        /* and the centroid on whatever decoded (spots, edges, saturation, flat frames) */
+        im_spot spots[4];
+        im_centroid_result r;
+        if (im_centroid(NULL, f, NULL, spots, 4, &r, err, sizeof err) == IM_OK &&
+            (r.nspots < 0 || r.nspots > 4 || r.nspots > r.ndetected))
+            abort();
         im_frame_free(f);
     } else if (f) {
         abort();                       /* a failure must not hand back a frame */
