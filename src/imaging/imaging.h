@@ -128,6 +128,8 @@ typedef struct im_centroid_opt {
                                    noise model (0: additive noise only) */
     double read_noise;          /* noise sigma in counts (0: measured from the frame) */
     double window;              /* fit window half-width in pixels (0: 2w+1, 3..25) */
+    int plane;                  /* 1: fit the background as a tilted plane (a steep
+                                   gradient under the spot), 0: a constant */
 } im_centroid_opt;
 
 enum im_spot_flags {

@@ -253,6 +253,24 @@ static void extremes(void)
     CHECK(r.outcome == IM_FOUND_ONE && fabs(o[0].x - 123.456) < 0.2 && fabs(o[0].y - 78.9) < 0.2,
           "steep background ramp: one spot at (%.3f, %.3f), no false ones (%d)", o[0].x, o[0].y,
           r.ndetected);
+    /* The bias a ramp leaves in a constant-background fit, and the tilted fit without
+     * it: mean x error over 40 frames (noise alone: 0.04 / sqrt(40) = 0.006 px). */
+    double bias[2] = {0, 0};
+    for (int k = 0; k < 40; k++) {
+        im_frame *g = frame_of(&s, &sp, 1, 100 + (uint64_t)k);
+        for (int y = 0; y < g->height; y++)
+            for (int x = 0; x < g->width; x++) g->px[y * g->width + x] += (uint16_t)(x * 3000 / 640);
+        for (int m = 0; m < 2; m++) {
+            im_centroid_opt po = {0};
+            po.plane = m;
+            fa->centroid(NULL, g, &po, o, 4, &r, err, sizeof err);
+            bias[m] += (o[0].x - 123.456) / 40;
+        }
+        fa->frame_free(g);
+    }
+    CHECK(fabs(bias[1]) < 0.02 && fabs(bias[0]) > 0.04,
+          "ramp: x bias %.4f px with a tilted background in the fit, %.4f with a constant",
+          bias[1], bias[0]);
     for (int i = 0; i < f->width * f->height; i++) f->px[i] = 65535;
     int rc = fa->centroid(NULL, f, NULL, o, 4, &r, err, sizeof err);
     CHECK(rc == 0 && r.outcome == IM_FOUND_NONE, "a frame saturated everywhere: no spot, no crash");
