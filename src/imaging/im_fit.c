@@ -10,6 +10,7 @@
  * The two baselines: raw moments over the window (IM_CM_MOMENTS) and background-
  * subtracted moments of the connected pixels above threshold (IM_CM_MOMENTS_BG). */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <gsl/gsl_blas.h>
@@ -146,6 +147,12 @@ static void moments_above(const im_spot_in *in, im_spot *o)
     o->power = s;
 }
 
+/* GSL's default error handler aborts the process; every GSL result here is checked,
+ * so the handler is turned off, once (it is process-wide: switching it off and back
+ * around each fit would race between threads). */
+static pthread_once_t gsl_quiet = PTHREAD_ONCE_INIT;
+static void quiet_gsl(void) { gsl_set_error_handler_off(); }
+
 static fitdata *scratch(void)
 {
     static __thread fitdata *d;
@@ -244,7 +251,7 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
     }
     gsl_multifit_nlinear_fdf fdf = {model_f, model_df, NULL, (size_t)d->n, (size_t)np, d, 0, 0, 0};
     gsl_vector_view x = gsl_vector_view_array(start, (size_t)np);
-    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    pthread_once(&gsl_quiet, quiet_gsl);
     int info = 0, st = gsl_multifit_nlinear_init(&x.vector, &fdf, w);
     if (st == GSL_SUCCESS) st = gsl_multifit_nlinear_driver(50, 1e-6, 1e-8, 0, NULL, NULL, &info, w);
     gsl_vector *p = gsl_multifit_nlinear_position(w);
@@ -256,7 +263,6 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
         gsl_matrix *J = gsl_multifit_nlinear_jac(w);
         ok = gsl_multifit_nlinear_covar(J, 0.0, ws->covar) == GSL_SUCCESS;
     }
-    gsl_set_error_handler(old);
     if (!ok) {
         moments(d, in->bg, o);
         o->flags |= IM_SF_FIT_FAILED | IM_SF_MOMENTS;
