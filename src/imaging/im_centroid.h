@@ -8,7 +8,8 @@
 typedef struct im_fit_ws {
     void *w;                   /* gsl_multifit_nlinear_workspace * */
     size_t n, p;               /* its numbers of residuals and parameters */
-    void *covar;               /* gsl_matrix * (5x5) */
+    void *covar;               /* gsl_matrix * (p x p) */
+    void *data;                /* the window's pixels (im_fit.c's fitdata, ~100 kB) */
 } im_fit_ws;
 void im_fit_ws_free(im_fit_ws *ws);
 

@@ -28,6 +28,7 @@ void im_fit_ws_free(im_fit_ws *ws)
 {
     if (ws->w) gsl_multifit_nlinear_free(ws->w);
     if (ws->covar) gsl_matrix_free(ws->covar);
+    free(ws->data);
     memset(ws, 0, sizeof *ws);
 }
 
@@ -153,17 +154,17 @@ static void moments_above(const im_spot_in *in, im_spot *o)
 static pthread_once_t gsl_quiet = PTHREAD_ONCE_INIT;
 static void quiet_gsl(void) { gsl_set_error_handler_off(); }
 
-static fitdata *scratch(void)
+/* The window's scratch lives in the centroider: one per caller, no per-thread state. */
+static fitdata *scratch(im_fit_ws *ws)
 {
-    static __thread fitdata *d;
-    if (!d) d = malloc(sizeof *d);
-    return d;
+    if (!ws->data) ws->data = malloc(sizeof(fitdata));
+    return ws->data;
 }
 
 void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
 {
     const im_frame *f = in->f;
-    fitdata *d = scratch();
+    fitdata *d = scratch(ws);
     int W = f->width, H = f->height, px = in->peak_i % W, py = in->peak_i / W;
     double A0 = in->peak - in->bg, T = in->thr - in->bg, w0, h;
 

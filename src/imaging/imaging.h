@@ -167,7 +167,9 @@ typedef struct im_centroid_result {
     double best_x, best_y;      /* where that candidate or spot is (pixels) */
 } im_centroid_result;
 
-typedef struct im_centroider im_centroider;   /* scratch kept between frames */
+/* Scratch kept between frames (about 100 kB plus a byte per pixel); one per thread:
+ * calls with different centroiders may run at the same time. */
+typedef struct im_centroider im_centroider;
 
 /* -- sources: files, sequences, video, cameras ----------------------------------- */
 typedef struct im_source im_source;

@@ -1,6 +1,7 @@
 /* t_centroid.c -- laser-spot centroids against the synthetic truth: accuracy near the
  * Cramer-Rao bound, honest uncertainties, and every outcome (none with the best
  * candidate's SNR, one, several sorted by power, saturated, cut by the edge). */
+#include <pthread.h>
 #include "it.h"
 
 static const im_frame_api *fa;
@@ -292,6 +293,42 @@ static void extremes(void)
     fa->frame_free(f);
 }
 
+/* Two threads, each with its own centroider, locate the same frames as one thread. */
+typedef struct job { im_frame **f; int n; double x[16]; } job;
+static void *run_job(void *arg)
+{
+    job *j = arg;
+    im_centroider *c = fa->centroider_new();
+    char e[128];
+    for (int k = 0; k < j->n; k++) {
+        im_spot o[2];
+        im_centroid_result r;
+        j->x[k] = fa->centroid(c, j->f[k], NULL, o, 2, &r, e, sizeof e) || r.nspots != 1 ? -1 : o[0].x;
+    }
+    fa->centroider_free(c);
+    return NULL;
+}
+static void threads(void)
+{
+    im_sensor s = it_sensor();
+    im_frame *f[16];
+    for (int k = 0; k < 16; k++) {
+        im_spot_src sp = it_spot(50 + 30 * k + 0.37, 100 + 10 * k);
+        f[k] = frame_of(&s, &sp, 1, 300 + (uint64_t)k);
+    }
+    job one = {f, 16, {0}}, a = {f, 16, {0}}, b = {f, 16, {0}};
+    run_job(&one);
+    pthread_t ta, tb;
+    pthread_create(&ta, NULL, run_job, &a);
+    pthread_create(&tb, NULL, run_job, &b);
+    pthread_join(ta, NULL);
+    pthread_join(tb, NULL);
+    int same = 1;
+    for (int k = 0; k < 16; k++) same &= one.x[k] >= 0 && one.x[k] == a.x[k] && one.x[k] == b.x[k];
+    CHECK(same, "two threads at once locate 16 frames exactly as one thread does");
+    for (int k = 0; k < 16; k++) fa->frame_free(f[k]);
+}
+
 int main(void)
 {
     fa = it_api();
@@ -300,5 +337,6 @@ int main(void)
     outcomes();
     hits_to_centroid();
     extremes();
+    threads();
     return it_failed != 0;
 }
