@@ -33,6 +33,8 @@ const lm_dialogue lm_dialogues[] = {
      lm_cornea_example, NULL, 0},
     {"--fit", "lens matrix from measurements (lsq), cardinal or nodal points (14, 24, 26)",
      lm_fit, lm_fit_example, "fit", 0},
+    {"--spot", "laser-spot centroids in a detector frame: file, raw, synthetic or a stream (36, 46)",
+     lm_spot, lm_spot_example, "imaging", 0},
     {"--prescription", "run the classic dialogue from a prescription file (-i FILE)",
      lm_prescription, lm_prescription_example, NULL, 1},
     {"--to-prescription", "write a classic record or answers (-i FILE) as a prescription",

@@ -341,6 +341,7 @@ int im_centroid(im_centroider *ctx, const im_frame *f, const im_centroid_opt *op
             .f = f, .list = c->list + k->start, .npix = k->npix, .peak_i = k->peak_i,
             .peak = k->peak, .bg = k->bg, .thr = k->thr, .noise = noise, .gain = opt.gain,
             .sat = sat, .window = opt.window, .method = opt.method, .edge = k->edge,
+            .plane = opt.plane,
         };
         im_spot_locate(&c->fit, &in, &spots[s]);
         if (ncomp > 1) spots[s].flags |= IM_SF_SEVERAL;

@@ -7,8 +7,9 @@
 /* A GSL workspace kept between spots of the same window size. */
 typedef struct im_fit_ws {
     void *w;                   /* gsl_multifit_nlinear_workspace * */
-    size_t n;                  /* its number of residuals */
-    void *covar;               /* gsl_matrix * (5x5) */
+    size_t n, p;               /* its numbers of residuals and parameters */
+    void *covar;               /* gsl_matrix * (p x p) */
+    void *data;                /* the window's pixels (im_fit.c's fitdata, ~100 kB) */
 } im_fit_ws;
 void im_fit_ws_free(im_fit_ws *ws);
 
@@ -17,7 +18,7 @@ typedef struct im_spot_in {
     const int *list;           /* the spot's connected pixels above threshold */
     int npix, peak_i;
     double peak, bg, thr, noise, gain, sat, window;
-    int method, edge;
+    int method, edge, plane;
 } im_spot_in;
 
 void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *out);

@@ -2,13 +2,15 @@
  * moments (raw, or above the background), and the 2-D Gaussian
  *     I(x, y) = B + A exp(-2 ((x-x0)^2 + (y-y0)^2) / w^2)
  * fitted by weighted least squares with GSL's multifit_nlinear (trust region,
- * Levenberg-Marquardt, Cholesky).  Weights come from the noise model (read noise sigma
+ * Levenberg-Marquardt, Cholesky), optionally on a tilted background
+ * B + Bx (x - xc) + By (y - yc).  Weights come from the noise model (read noise sigma
  * and, when the gain is known, shot noise), so the covariance (J'J)^-1 is the
  * uncertainty of the centre.  Saturated pixels are left out (the fit uses the wings);
  * pixels beyond the frame are simply absent (the spot is flagged as cut).
  * The two baselines: raw moments over the window (IM_CM_MOMENTS) and background-
  * subtracted moments of the connected pixels above threshold (IM_CM_MOMENTS_BG). */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <gsl/gsl_blas.h>
@@ -19,17 +21,21 @@
 #include "im_centroid.h"
 
 #define MAXWIN 51              /* window side at most 2*25+1 */
-#define NPAR 5
+#define NPAR 5                 /* x0 y0 A w B; with a tilted background also Bx By */
+#define MAXPAR 7
 
 void im_fit_ws_free(im_fit_ws *ws)
 {
     if (ws->w) gsl_multifit_nlinear_free(ws->w);
     if (ws->covar) gsl_matrix_free(ws->covar);
+    free(ws->data);
     memset(ws, 0, sizeof *ws);
 }
 
 typedef struct fitdata {
     int nx, ny, x0, y0;        /* window origin and size */
+    int np;                    /* parameters: 5, or 7 with the background's slopes */
+    double xc, yc;             /* the slopes' origin: the window's centre */
     int n;                     /* pixels used */
     uint8_t ix[MAXWIN * MAXWIN], iy[MAXWIN * MAXWIN];  /* window column and row of each */
     double v[MAXWIN * MAXWIN], iw[MAXWIN * MAXWIN];    /* value, 1/sigma */
@@ -55,11 +61,13 @@ static int model_f(const gsl_vector *p, void *vd, gsl_vector *f)
 {
     fitdata *d = vd;
     double A = gsl_vector_get(p, 2), B = gsl_vector_get(p, 4), *out = f->data;
+    double bx = d->np > NPAR ? gsl_vector_get(p, 5) : 0, by = d->np > NPAR ? gsl_vector_get(p, 6) : 0;
     size_t st = f->stride;
     axes(d, p);
     for (int k = 0; k < d->n; k++) {
         int i = d->ix[k], j = d->iy[k];
-        out[k * st] = (B + A * d->ex[i] * d->ey[j] - d->v[k]) * d->iw[k];
+        double b = B + bx * (d->x0 + i - d->xc) + by * (d->y0 + j - d->yc);
+        out[k * st] = (b + A * d->ex[i] * d->ey[j] - d->v[k]) * d->iw[k];
     }
     return GSL_SUCCESS;
 }
@@ -79,6 +87,10 @@ static int model_df(const gsl_vector *p, void *vd, gsl_matrix *J)
         row[2] = E * s;
         row[3] = aE * k3 * (d->dx[i] * d->dx[i] + d->dy[j] * d->dy[j]);
         row[4] = s;
+        if (d->np > NPAR) {
+            row[5] = s * (d->x0 + i - d->xc);
+            row[6] = s * (d->y0 + j - d->yc);
+        }
     }
     return GSL_SUCCESS;
 }
@@ -136,17 +148,23 @@ static void moments_above(const im_spot_in *in, im_spot *o)
     o->power = s;
 }
 
-static fitdata *scratch(void)
+/* GSL's default error handler aborts the process; every GSL result here is checked,
+ * so the handler is turned off, once (it is process-wide: switching it off and back
+ * around each fit would race between threads). */
+static pthread_once_t gsl_quiet = PTHREAD_ONCE_INIT;
+static void quiet_gsl(void) { gsl_set_error_handler_off(); }
+
+/* The window's scratch lives in the centroider: one per caller, no per-thread state. */
+static fitdata *scratch(im_fit_ws *ws)
 {
-    static __thread fitdata *d;
-    if (!d) d = malloc(sizeof *d);
-    return d;
+    if (!ws->data) ws->data = malloc(sizeof(fitdata));
+    return ws->data;
 }
 
 void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
 {
     const im_frame *f = in->f;
-    fitdata *d = scratch();
+    fitdata *d = scratch(ws);
     int W = f->width, H = f->height, px = in->peak_i % W, py = in->peak_i / W;
     double A0 = in->peak - in->bg, T = in->thr - in->bg, w0, h;
 
@@ -191,7 +209,7 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
         }
     if (o->nsat) o->flags |= IM_SF_SATURATED;
 
-    if (in->method == IM_CM_MOMENTS || in->method == IM_CM_MOMENTS_BG || d->n <= NPAR + 2) {
+    if (in->method == IM_CM_MOMENTS || in->method == IM_CM_MOMENTS_BG || d->n <= MAXPAR + 2) {
         if (in->method == IM_CM_MOMENTS) moments(d, 0, o);
         else moments_above(in, o);
         o->w = w0;
@@ -206,18 +224,25 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
         double v = f->px[p] - in->bg;
         s += v; sx += v * (p % W); sy += v * (p / W);
     }
-    double start[NPAR] = {s > 0 ? sx / s : px, s > 0 ? sy / s : py,
-                          o->nsat ? 2 * A0 : A0, w0, in->bg};
+    double start[MAXPAR] = {s > 0 ? sx / s : px, s > 0 ? sy / s : py,
+                            o->nsat ? 2 * A0 : A0, w0, in->bg, 0, 0};
+    int np = in->plane ? MAXPAR : NPAR;
+    d->np = np;
+    d->xc = px;
+    d->yc = py;
 
-    if (!ws->w || ws->n != (size_t)d->n) {
+    if (!ws->w || ws->n != (size_t)d->n || ws->p != (size_t)np) {
         if (ws->w) gsl_multifit_nlinear_free(ws->w);
         gsl_multifit_nlinear_parameters par = gsl_multifit_nlinear_default_parameters();
         par.trs = gsl_multifit_nlinear_trs_lm;
         par.solver = gsl_multifit_nlinear_solver_cholesky;
         par.scale = gsl_multifit_nlinear_scale_more;
-        ws->w = gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &par, (size_t)d->n, NPAR);
+        ws->w = gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &par, (size_t)d->n,
+                                           (size_t)np);
         ws->n = ws->w ? (size_t)d->n : 0;
-        if (!ws->covar) ws->covar = gsl_matrix_alloc(NPAR, NPAR);
+        ws->p = (size_t)np;
+        if (ws->covar) gsl_matrix_free(ws->covar);
+        ws->covar = gsl_matrix_alloc((size_t)np, (size_t)np);
     }
     gsl_multifit_nlinear_workspace *w = ws->w;
     if (!w || !ws->covar) {
@@ -225,9 +250,9 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
         o->flags |= IM_SF_FIT_FAILED | IM_SF_MOMENTS;
         return;
     }
-    gsl_multifit_nlinear_fdf fdf = {model_f, model_df, NULL, (size_t)d->n, NPAR, d, 0, 0, 0};
-    gsl_vector_view x = gsl_vector_view_array(start, NPAR);
-    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    gsl_multifit_nlinear_fdf fdf = {model_f, model_df, NULL, (size_t)d->n, (size_t)np, d, 0, 0, 0};
+    gsl_vector_view x = gsl_vector_view_array(start, (size_t)np);
+    pthread_once(&gsl_quiet, quiet_gsl);
     int info = 0, st = gsl_multifit_nlinear_init(&x.vector, &fdf, w);
     if (st == GSL_SUCCESS) st = gsl_multifit_nlinear_driver(50, 1e-6, 1e-8, 0, NULL, NULL, &info, w);
     gsl_vector *p = gsl_multifit_nlinear_position(w);
@@ -239,7 +264,6 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
         gsl_matrix *J = gsl_multifit_nlinear_jac(w);
         ok = gsl_multifit_nlinear_covar(J, 0.0, ws->covar) == GSL_SUCCESS;
     }
-    gsl_set_error_handler(old);
     if (!ok) {
         moments(d, in->bg, o);
         o->flags |= IM_SF_FIT_FAILED | IM_SF_MOMENTS;
@@ -255,7 +279,7 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
     o->sy = sqrt(gsl_matrix_get(ws->covar, 1, 1));
     o->power = A * M_PI * Wd * Wd / 2;
     o->snr = A / in->noise;
-    o->chi2 = chi * chi / (d->n - NPAR);
+    o->chi2 = chi * chi / (d->n - np);
     o->iter = (int)gsl_multifit_nlinear_niter(w);
     /* Cut by the edge: the 1/e^2 disc reaches beyond the frame. */
     if (X - Wd < -0.5 || Y - Wd < -0.5 || X + Wd > W - 0.5 || Y + Wd > H - 0.5)

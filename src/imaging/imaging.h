@@ -253,6 +253,8 @@ typedef struct im_centroid_opt {
                                    noise model (0: additive noise only) */
     double read_noise;          /* noise sigma in counts (0: measured from the frame) */
     double window;              /* fit window half-width in pixels (0: 2w+1, 3..25) */
+    int plane;                  /* 1: fit the background as a tilted plane (a steep
+                                   gradient under the spot), 0: a constant */
 } im_centroid_opt;
 
 enum im_spot_flags {
@@ -290,7 +292,9 @@ typedef struct im_centroid_result {
     double best_x, best_y;      /* where that candidate or spot is (pixels) */
 } im_centroid_result;
 
-typedef struct im_centroider im_centroider;   /* scratch kept between frames */
+/* Scratch kept between frames (about 100 kB plus a byte per pixel); one per thread:
+ * calls with different centroiders may run at the same time. */
+typedef struct im_centroider im_centroider;
 
 /* -- sources: files, sequences, video, cameras ----------------------------------- */
 typedef struct im_source im_source;
