@@ -282,3 +282,43 @@ if [ -x "$TOP/build/fuzz_trace_scene" ]; then
 else
     fail "build/fuzz_trace_scene not built"
 fi
+
+# ---- wrong lenses refused at their question (issue 8) --------------------------------
+# lens_refused ANSWERS MESSAGE: a replay stops with MESSAGE (exit 2) and the refused
+# answer is not recorded (the last answer given is the refused one).
+lens_refused() {
+    d=$TW/refuse; rm -rf "$d"; mkdir -p "$d"
+    printf "$1" > "$d/in"
+    (cd "$d" && "$BIN" --trace -i in r.rec > out 2> err); rc=$?
+    [ "$rc" -eq 2 ] || { echo "exit $rc"; cat "$d/err"; return 1; }
+    grep -qF "$2" "$d/err" || { echo "want: $2"; cat "$d/err"; return 1; }
+    n=$(grep -c '^input: ' "$d/r.rec"); want=$(($(printf "$1" | wc -l) - 1))
+    [ "$n" -eq "$want" ] || { echo "$n answers recorded, want $want"; return 1; }
+}
+check "lens: both surfaces at z = 0 refused at the location" lens_refused \
+    'lens\n1\n50\n0\n1.5\n12\ny\n-50\n0\n' \
+    "in:9: the location of the lens surface: '0': surface 2 would touch surface 1 on the axis and cross it (edge thickness -2.92271 at height 12)"
+check "lens: crossing surfaces refused at the semi-diameter" lens_refused \
+    'lens\n1\n50\n0\n1.5\n12\ny\n-50\n1\n1\n12\n' \
+    "in:11: the semi-diameter of the lens surface: '12': surfaces 1 and 2 would cross at height 7.05337 (edge thickness -1.92271 at the semi-diameter 12): give at most 7.05337"
+check "lens: a semi-diameter beyond |radius| refused at its question" lens_refused \
+    'lens\n1\n50\n0\n1.5\n60\n' \
+    "in:6: the semi-diameter of the lens surface: '60' is larger than 50, the |radius| of this surface"
+check "table: crossing surfaces refused at the semi-diameter" lens_refused \
+    'table\n50\n-50\n1\n1.5\n12\n' \
+    "in:6: the semi-diameter: '12': surfaces 1 and 2 would cross at height 7.05337"
+lens_cross_ok() {   # the same lens with semi-diameter 7 traces
+    d=$TW/crossok; rm -rf "$d"
+    trace_session "$BIN" "$d" lens 1 50 0 1.5 12 y -50 1 1 7 n inf 1 n n || { cat "$d/err"; return 1; }
+    grep -q 'meets the paraxial image' "$d/r.rec"
+}
+check "lens: the crossing lens with a semi-diameter under the crossing traces" lens_cross_ok
+
+# Fraction 1 is the rim of surface 1: from an object at 200 the edge ray is traced and
+# met surface 1 at 12 (the heights were once aimed at the vertex plane: vignetted).
+fan_rim() {
+    grep -A16 '^Object point on the axis at z= -200' "$TW/lens/e.rec" > "$TW/lens/e200"
+    grep -q '^  12  *64\.87' "$TW/lens/e200" || { cat "$TW/lens/e200"; return 1; }
+    ! grep -q vignetted "$TW/lens/e200"
+}
+check "lens fan: fraction 1 reaches the rim of surface 1 from a near object" fan_rim
