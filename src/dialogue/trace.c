@@ -95,6 +95,13 @@ static void report_summary(tdlg *t, const trace_summary *s)
            s->trace_ms > 0 ? (double)s->rays / (s->trace_ms / 1e3) : 0.0);
 }
 
+/* The stop callback long traces poll: a signal arrived (ask.h). */
+static int stop_requested(void *ctx)
+{
+    (void)ctx;
+    return lm_stop_requested() != 0;
+}
+
 /* Returns LM_GO, LM_QUIT or LM_FAIL (a trace that fails is an error in a replay). */
 static int do_scene(tdlg *t)
 {
@@ -109,10 +116,13 @@ static int do_scene(tdlg *t)
         return rc;
     lm_say(t->io, LM_BOTH, P(SCENE_LOADED), sc->name, sc->nsurf, sc->nsource, sc->depth,
            sc->cutoff);
+    t->scene.stop = stop_requested;
+    t->scene.stop_ctx = NULL;
     rc = t->api->run(sc, &res, err);
     if (rc) {
         lm_say(t->io, LM_REC, P(TRACE_FAILED_OUT), err);
         fprintf(stderr, "lensmat: %s\n", err);
+        if (res.stopped) return LM_FAIL;     /* main exits with 128 + the signal */
         if (!t->io->interactive) return LM_FAIL;
         return LM_GO;
     }
