@@ -370,3 +370,62 @@ if command -v python3 > /dev/null; then
     check "stop: SIGTERM mid-trace ends within 1 s, exit 143, outputs .part, record intact" trace_stopped "$BIN" 15
     check "stop asan: SIGINT mid-trace ends within 1 s, exit 130" trace_stopped "$ASAN" 2
 fi
+
+# ---- caps that cross, media that disagree, outputs over inputs (issue 8) -------------
+CAP1='cap refract 1 1.5168 vertex 0 0 0 radius 50 aperture 12'
+mk crosscap.scene "$CAP1" 'cap refract 1.5168 1 vertex 0 0 1 radius -50 aperture 12' "$DET" "$SRC"
+mk touchcap.scene 'cap refract 1.5168 1 vertex 0 0 0 axis 0 0 -1 radius 50 aperture 12' \
+    'cap refract 1 1.5168 vertex 0 0 0 axis 0 0 -1 radius -50 aperture 12' "$DET" "$SRC"
+mk outscene.scene "$DET" "$SRC" 'output hits outscene.scene'
+mk outmesh.scene 'mesh absorb file good.t' "$SRC" 'output segments good.t'
+mk g.n.part '1 1.5' '1 1.5'
+mk outmedia.scene 'mesh media g.n.part file good.t' "$SRC" 'output summary g.n'
+mk outtwice.scene "$DET" "$SRC" 'output hits same.txt' 'output summary same.txt'
+mk outrec.scene "$DET" "$SRC" 'output summary outrec.rec'
+mk outin.scene "$DET" "$SRC" 'output segments outin.in'
+mk mmbad.scene 'mismatch maybe' "$DET" "$SRC"
+check "bad: caps whose sags cross within the apertures" bad_case crosscap \
+    "crosscap.scene:1: and crosscap.scene:2: the surfaces cross at height 7.05337 from their axis (edge thickness -1.92271 at 12): negative edge thickness"
+check "bad: caps on a reversed axis touching at the vertex and crossing" bad_case touchcap \
+    "touchcap.scene:1: and touchcap.scene:2: the surfaces cross at height 0 from their axis"
+check "bad: an output over the scene file" bad_case outscene \
+    "outscene.scene: output hits outscene.scene would overwrite the scene file outscene.scene"
+check "bad: an output over a mesh file" bad_case outmesh \
+    "output segments good.t would overwrite the mesh file good.t"
+check "bad: an output's .part over a media file" bad_case outmedia \
+    "output summary g.n would overwrite the media file g.n.part"
+check "bad: two outputs in one file" bad_case outtwice \
+    "output summary same.txt would overwrite output same.txt"
+check "bad: an output over the record" bad_case outrec "outrec.scene: output outrec.rec: "
+check "bad: an output over the answers" bad_case outin "outin.scene: output outin.in: "
+check "bad: mismatch takes warn or error" bad_case mmbad "mmbad.scene:1: mismatch: expected warn or error"
+good_t_intact() { [ "$(wc -l < "$TW/bad/good.t")" -eq 6 ] && [ ! -e "$TW/bad/good.t.part" ]; }
+check "bad: the refused outputs left the inputs as they were" good_t_intact
+
+# A cap declared 'refract 1.6 1' after '1 1.5168': said after the trace with the
+# surfaces' lines and the count; 'mismatch error' makes it an error (outputs .part).
+MM2='cap refract 1.6 1 vertex 0 0 8 radius -50 aperture 12'
+MMDET='plane detect at 0 0 55 normal 0 0 1 disc 30'
+MMSRC='source collimated from 0 0 -10 dir 0 0 1 radius 10 grid 21'
+mismatch_warn() {
+    d=$TW/mm; rm -rf "$d"; mkdir -p "$d"
+    printf '%s\n' "$CAP1" "$MM2" "$MMDET" "$MMSRC" > "$d/mm.scene"
+    trace_session "$BIN" "$d" scene mm.scene n || { cat "$d/err"; return 1; }
+    grep -q '^Warning: [1-9][0-9]* rays met a surface whose index' "$d/r.rec" &&
+    grep -q "the first: mm.scene:1: gives 1.5168 after it, mm.scene:2: expects 1.6 before it" "$d/r.rec" &&
+    grep -q 'mismatch error' "$d/out" || { cat "$d/out"; return 1; }
+}
+check "mismatch: media that disagree are said on screen with file:line and the count" mismatch_warn
+mismatch_error() {
+    d=$TW/mm; printf '%s\n' 'mismatch error' 'output hits h.csv' >> "$d/mm.scene"
+    (cd "$d" && printf 'scene\nmm.scene\nn\n' | "$BIN" --trace e.rec > e.out 2> e.err); rc=$?
+    [ "$rc" -eq 2 ] && [ ! -e "$d/h.csv" ] && [ -e "$d/h.csv.part" ] &&
+    grep -q "rays met a surface .*first mm.scene:1: .*(the scene says .mismatch error.)" "$d/e.err" ||
+        { echo "exit $rc"; cat "$d/e.err"; return 1; }
+}
+check "mismatch error: the trace fails, outputs left as .part" mismatch_error
+consistent_quiet() {   # the consistent singlet says nothing of media
+    trace_session "$BIN" "$TW/mmok" scene "$SCENES/singlet.scene" n &&
+        ! grep -qi 'media\|mismatch' "$TW/mmok/out"
+}
+check "mismatch: a consistent scene says nothing about media" consistent_quiet

@@ -65,6 +65,21 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
         return -1;
     }
     t->have_scene = 1;
+    /* its outputs (and the .part files written first) must not be the answers or
+     * the record (the scene's own inputs the loader checked) */
+    const char *out[3] = {t->scene.out_segments, t->scene.out_hits, t->scene.out_summary};
+    for (int i = 0; i < 3; i++) {
+        char part[WORD + 8], why[512];
+        if (!out[i]) continue;
+        snprintf(part, sizeof part, "%s.part", out[i]);
+        if (lm_check_output(t->io, out[i], why, sizeof why) ||
+            lm_check_output(t->io, part, why, sizeof why)) {
+            snprintf(msg, cap, "%s: output %s: %s", word, out[i], why);
+            t->api->free(&t->scene);
+            t->have_scene = 0;
+            return -1;
+        }
+    }
     return 0;
 }
 
@@ -88,7 +103,14 @@ static void report_summary(tdlg *t, const trace_summary *s)
     lm_say(io, LM_BOTH, P(CUTS), (ull)s->cut_depth, (ull)s->cut_power,
            (ull)s->cut_reflection);
     if (s->failures) lm_say(io, LM_BOTH, P(WARN_FAILURES), (ull)s->failures);
-    if (s->medium_mismatch) lm_say(io, LM_BOTH, P(WARN_MISMATCH), (ull)s->medium_mismatch);
+    if (s->medium_mismatch) {
+        lm_say(io, LM_BOTH, P(WARN_MISMATCH), (ull)s->medium_mismatch);
+        if (t->scene.nmismatch)
+            lm_say(io, LM_BOTH, P(MISMATCH_WHERE), t->scene.nmismatch,
+                   t->scene.mismatch_where);
+        else lm_say(io, LM_BOTH, "%s", P(MISMATCH_UNLOCATED));
+        lm_say(io, LM_BOTH, "%s", P(MISMATCH_ERROR));
+    }
     if (fabs(bal) > 1e-9 * (s->emitted > 1 ? s->emitted : 1))
         lm_say(io, LM_BOTH, P(WARN_BALANCE), bal);
     lm_say(io, LM_OUT, P(TIMING_OUT), s->build_ms, s->trace_ms,
