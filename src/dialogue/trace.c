@@ -609,9 +609,10 @@ static int tess_table(tdlg *t)
     lm_say(io, LM_BOTH, P(T_LENS), sp.r1, sp.r2, sp.thickness, sp.n, sp.aperture,
            sp.z_detector, sp.beam_radius, sp.grid, sp.grid);
     if (need_engine(t)) return LM_FAIL;
+    sp.stop = stop_requested;
     if (t->api->tess_table(&sp, rows, err)) {
         lm_say(io, LM_BOTH, P(T_FAILED), err);
-        return io->interactive ? LM_GO : LM_FAIL;
+        return io->interactive && !lm_stop_requested() ? LM_GO : LM_FAIL;
     }
     table_rows(t, rows, 1 + 3 * NL);
     return LM_GO;

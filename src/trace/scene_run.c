@@ -396,7 +396,21 @@ out:
     return err[0] ? -1 : 0;
 }
 
-static const scene_api api = {SC_API_ABI, sc_load, sc_free, run, sc_tess_table, NULL};
+/* The table refuses a singlet whose surfaces cross within the semi-diameter, as
+ * add_lens does (the dialogue asks again before it gets here). */
+static int tess_table(const sc_tess_spec *sp, sc_tess_row *rows, char *err)
+{
+    trace_lens_surface a = {sp->r1, 0, sp->n, sp->aperture};
+    trace_lens_surface b = {sp->r2, sp->thickness, 1, sp->aperture};
+    double h, rim, edge;
+    if (trace_lens_cross(&a, &b, &h, &rim, &edge))
+        return snprintf(err, SC_ERRMAX, "tessellation table: the surfaces cross at height "
+                        "%.6g: their edge thickness at the semi-diameter %.6g is %.6g", h,
+                        rim, edge), -1;
+    return sc_tess_table(sp, rows, err);
+}
+
+static const scene_api api = {SC_API_ABI, sc_load, sc_free, run, tess_table, NULL};
 
 __attribute__((visibility("default"))) const scene_api *lm_scene_api(int abi)
 {
