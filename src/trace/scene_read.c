@@ -974,15 +974,20 @@ static int axial_pairs(sc_scene *sc, char *err)
         n += sc->surf[i].shape >= SC_CAP && sc->surf[i].shape <= SC_ASPHERE;
     if (n < 2 || n > AXMAX) return 0;
     axm *m = malloc((size_t)n * sizeof *m);
-    char *used = calloc((size_t)sc->nsurf, 1);
-    if (!m || !used) { free(m); free(used); return 0; }
-    for (int i = 0; i < sc->nsurf && !rc; i++) {
-        const sc_surface *a = &sc->surf[i];
-        if (used[i] || a->shape < SC_CAP || a->shape > SC_ASPHERE) continue;
+    char *used = calloc((size_t)n, 1);
+    const sc_surface **ax = malloc((size_t)n * sizeof *ax);
+    if (!m || !used || !ax) { free(m); free(used); free(ax); return 0; }
+    n = 0;
+    for (int i = 0; i < sc->nsurf; i++)
+        if (sc->surf[i].shape >= SC_CAP && sc->surf[i].shape <= SC_ASPHERE)
+            ax[n++] = &sc->surf[i];
+    for (int i = 0; i < n && !rc; i++) {
+        const sc_surface *a = ax[i];
+        if (used[i]) continue;
         int k = 0;
-        for (int j = i; j < sc->nsurf; j++) {       /* the surfaces on a's axis line */
-            const sc_surface *b = &sc->surf[j];
-            if (used[j] || b->shape < SC_CAP || b->shape > SC_ASPHERE) continue;
+        for (int j = i; j < n; j++) {               /* the surfaces on a's axis line */
+            const sc_surface *b = ax[j];
+            if (used[j]) continue;
             double dot = dot3(a->axis, b->axis), w[3], x[3];
             if (!(fabs(dot) > 1 - 1e-12)) continue;
             sub3(b->at, a->at, w);
@@ -1003,6 +1008,7 @@ static int axial_pairs(sc_scene *sc, char *err)
     }
     free(m);
     free(used);
+    free(ax);
     return rc;
 }
 
