@@ -61,6 +61,13 @@ static char *slurp(FILE *in, const char *src, char *err, size_t cap)
         return NULL;
     }
     s[len] = '\0';
+    if ((t = memchr(s, '\0', len))) {   /* every string function would cut there */
+        long line = 1;
+        for (const char *p = s; p < t; p++) line += *p == '\n';
+        snprintf(err, cap, PS(NUL_BYTE), src, line);
+        free(s);
+        return NULL;
+    }
     return s;
 }
 
