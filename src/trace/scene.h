@@ -83,6 +83,14 @@ typedef struct sc_scene {
     char *out_segments, *out_hits, *out_summary;
     char *name;               /* the scene file, for messages */
     char *dir;                /* its folder: mesh files are relative to it */
+    /* Set by the caller before run(): polled between batches and every few thousand
+     * records (a few ms of work); non-zero stops the trace (sc_result.stopped). */
+    int (*stop)(void *ctx);
+    void *stop_ctx;
+    int mismatch_error;       /* `mismatch error`: rays meeting a surface whose index
+                                 on their side differs from theirs fail the trace */
+    int nmismatch;            /* media that disagree, found when the scene is read */
+    char mismatch_where[256]; /* the first such pair: "FILE:LINE and FILE:LINE" ... */
 } sc_scene;
 
 /* One ray as the sources emit it. */
@@ -123,6 +131,8 @@ int  sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, cha
 typedef struct sc_result {
     trace_summary sum;
     int progress_shown;       /* a progress line was drawn on stderr */
+    int stopped;              /* the stop callback stopped it (outputs left as .part) */
+    int mismatch_failed;      /* `mismatch error` and rays met disagreeing media */
 } sc_result;
 
 /* The error-against-run-time table: a spherical singlet modelled analytically and as
@@ -136,6 +146,8 @@ typedef struct sc_tess_spec {
     int nlevels;
     const int *levels;                       /* tessellation levels (rings per cap) */
     int threads;
+    int (*stop)(void *ctx);                  /* polled during the traces (may be NULL) */
+    void *stop_ctx;
 } sc_tess_spec;
 
 enum sc_model { SC_MODEL_ANALYTIC, SC_MODEL_MESH, SC_MODEL_MESH_NORMAL, SC_MODEL_MESH_FULL };
