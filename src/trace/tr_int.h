@@ -1,6 +1,7 @@
 /* tr_int.h -- private to the trace engine's own files (tr_*.c); callers use trace.h.
  * Analytic surfaces in double (tr_geom.c), optics (tr_optics.c), sources
- * (tr_source.c), the scene and the trace loop on Embree (tr_engine.c), sequential
+ * (tr_source.c), the scene on Embree (tr_scene.c), the trace loop (tr_trace.c, tr_lanes.c,
+ * tr_pool.c: tr_eng.h), the table (tr_engine.c), sequential
  * lenses (tr_lens.c). */
 #ifndef TR_INT_H
 #define TR_INT_H
@@ -230,7 +231,7 @@ int tr_add_lens(trace_scene *sc, const trace_lens *lens);
 int tr_lens_fan(const trace_lens *lens, double z_obj, double y_obj, double z_paraxial,
                 int nrays, const double *h, trace_fan_ray *out, char *err, size_t cap);
 
-/* Lens hints (tr_engine.c): after refraction at surface id a forward ray can only
+/* Lens hints (tr_scene.c): after refraction at surface id a forward ray can only
  * meet cand[0..n-1] (-1 entries skipped); valid until another surface is added. */
 void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n);
 int tr_scene_nsurf(const trace_scene *sc);

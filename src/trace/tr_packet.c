@@ -39,7 +39,7 @@ void tr_pk_set_add(tr_pk_set *s, int id, const tr_shape *g, const trace_material
 }
 
 /* Eight doubles make one AVX-512 register: what follows is compiled for AVX-512 (the
- * engine calls it only where the processor has it, see tr_engine.c).  The fused
+ * engine calls it only where the processor has it, see tr_lanes.c).  The fused
  * multiply-add it brings stays unused: -ffp-contract=off forbids it. */
 #pragma GCC target("avx2,avx512f,avx512vl,avx512dq")
 

@@ -1,7 +1,7 @@
 /* tr_packet.h -- private to the trace engine: eight rays side by side through the
  * surfaces a sequential lens names (tr_packet.c), in vector arithmetic that rounds
  * exactly as the one-ray code does (tr_geom.c's fast shapes, tr_optics.c's Fresnel,
- * tr_engine.c's interaction): the same operations in the same order, where a branch
+ * tr_trace.c's interaction): the same operations in the same order, where a branch
  * becomes a select.  The engine keeps the books (counts, records, stacks); a ray the
  * packet cannot take one step further is handed back to the one-ray code unchanged. */
 #ifndef TR_PACKET_H

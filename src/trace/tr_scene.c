@@ -1,0 +1,585 @@
+/* tr_scene.c -- the trace engine's scene on Embree 3.  Owns: surfaces (analytic ones
+ * as Embree user geometry, meshes as robust triangle geometry with double copies of
+ * their vertices), sources, the Embree device (created on the first build, never
+ * before), the lens hints, and the one question the trace loop asks of the scene:
+ * which surface does this ray meet next (in double). */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include "tr_eng.h"
+
+/* The context handed to rtcIntersect1: Embree passes it on to our callbacks. */
+typedef struct tr_ctx {
+    struct RTCIntersectContext ec;   /* must be first */
+    const trace_scene *sc;
+    double o[3], d[3];
+    int last_surf;
+    long last_prim;
+    int float_hits;
+    int best_surf;                   /* nearest analytic hit so far */
+    double best_t, best_n[3];
+} tr_ctx;
+
+static int fail(trace_scene *sc, int code, const char *msg)
+{
+    if (sc && msg) {
+        size_t n = strlen(msg);
+        if (n >= sizeof sc->err) n = sizeof sc->err - 1;
+        memmove(sc->err, msg, n);
+        sc->err[n] = '\0';
+    }
+    return code;
+}
+
+int tr_scene_fail(trace_scene *sc, int code, const char *msg)
+{
+    return fail(sc, code, msg);
+}
+
+int tr_scene_nsurf(const trace_scene *sc) { return sc->nsurf; }
+
+const tr_shape *tr_scene_shape(const trace_scene *sc, int id)
+{
+    return id >= 0 && id < sc->nsurf && !sc->surf[id]->is_mesh ? &sc->surf[id]->shape
+                                                                 : NULL;
+}
+
+void tr_scene_set_entry(trace_scene *sc, const int *cand, int n, double z)
+{
+    sc->nentry = 0;
+    tr_pk_set_clear(&sc->entry_pk);
+    for (int i = 0; i < n && i < 4; i++)
+        if (cand[i] >= 0) {
+            const tr_surf *f = sc->surf[cand[i]];
+            sc->entryg[sc->nentry] = &f->shape;
+            sc->entry[sc->nentry++] = cand[i];
+            tr_pk_set_add(&sc->entry_pk, cand[i], &f->shape, &f->mat, 0);
+        }
+    sc->entry_z = z;
+}
+
+void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
+{
+    tr_surf *f = sc->surf[id];
+    f->nseq = 0;
+    tr_pk_set_clear(&f->pk);
+    for (int i = 0; i < n && i < 4; i++)
+        if (cand[i] >= 0) {
+            const tr_surf *c = sc->surf[cand[i]];
+            f->seqg[f->nseq] = &c->shape;
+            f->seq[f->nseq++] = cand[i];
+            tr_pk_set_add(&f->pk, cand[i], &c->shape, &c->mat, cand[i] == id);
+        }
+    sc->seq_nsurf = sc->nsurf;
+}
+
+/* ---------------- scene ---------------- */
+
+trace_scene *tr_scene_new(void)
+{
+    return calloc(1, sizeof(trace_scene));
+}
+
+static void drop_embree(trace_scene *sc)
+{
+    if (sc->scn) rtcReleaseScene(sc->scn);
+    if (sc->dev) rtcReleaseDevice(sc->dev);
+    sc->scn = NULL;
+    sc->dev = NULL;
+    sc->built = 0;
+}
+
+void tr_scene_free(trace_scene *sc)
+{
+    if (!sc) return;
+    drop_embree(sc);
+    for (int i = 0; i < sc->nsurf; i++) {
+        free(sc->surf[i]->vtx);
+        free(sc->surf[i]->idx);
+        free(sc->surf[i]->media);
+        free(sc->surf[i]);
+    }
+    free(sc->surf);
+    for (int i = 0; i < sc->nsrc; i++) tr_source_free(&sc->src[i]);
+    free(sc->src);
+    free(sc);
+}
+
+const char *tr_scene_error(const trace_scene *sc)
+{
+    return sc ? sc->err : "no scene (out of memory)";
+}
+
+static int check_material(trace_scene *sc, const trace_material *m)
+{
+    if (!m) return fail(sc, TRACE_EINVAL, "no material given");
+    if (m->kind < TRACE_REFRACT || m->kind > TRACE_DETECT)
+        return fail(sc, TRACE_EINVAL, "unknown surface kind");
+    if (!(m->n_front > 0 && isfinite(m->n_front) && m->n_back > 0 && isfinite(m->n_back)))
+        return fail(sc, TRACE_EINVAL, "indices of refraction must be positive numbers");
+    return TRACE_OK;
+}
+
+static tr_surf *new_surf(trace_scene *sc)
+{
+    if (sc->nsurf == sc->capsurf) {
+        int cap = sc->capsurf ? 2 * sc->capsurf : 16;
+        tr_surf **p = realloc(sc->surf, (size_t)cap * sizeof *p);
+        if (!p) return NULL;
+        sc->surf = p;
+        sc->capsurf = cap;
+    }
+    tr_surf *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+    s->id = sc->nsurf;
+    return s;
+}
+
+int tr_add_surface(trace_scene *sc, const trace_surface *s, const trace_material *m)
+{
+    int rc;
+    if (!sc) return TRACE_EINVAL;
+    if (!s) return fail(sc, TRACE_EINVAL, "no surface given");
+    if ((rc = check_material(sc, m))) return rc;
+    tr_surf *f = new_surf(sc);
+    if (!f) return fail(sc, TRACE_ENOMEM, "out of memory");
+    if (tr_shape_init(&f->shape, s, sc->err, sizeof sc->err)) {
+        free(f);
+        return TRACE_EINVAL;
+    }
+    f->mat = *m;
+    sc->surf[sc->nsurf++] = f;
+    drop_embree(sc);
+    return f->id;
+}
+
+/* Distance scale of how far a refined hit may sit off its triangle. */
+static double under_gap(const tr_surf *f)
+{
+    double gap = 0;
+    for (long i = 0; i < f->ntri; i++) {
+        double c[3] = {0, 0, 0}, t, dir[3], o[3];
+        const uint32_t *ix = f->idx + 3 * i;
+        for (int k = 0; k < 3; k++)
+            for (int j = 0; j < 3; j++) c[j] += f->vtx[3 * ix[k] + j] / 3;
+        tr_shape_normal(&f->shape, c, dir);
+        for (int j = 0; j < 3; j++) o[j] = c[j] - dir[j] * f->shape.scale;
+        if (tr_shape_refine(&f->shape, o, dir, f->shape.scale, &t))
+            gap = fmax(gap, fabs(t - f->shape.scale));
+    }
+    return gap;
+}
+
+int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m)
+{
+    char msg[256];
+    int rc;
+    if (!sc) return TRACE_EINVAL;
+    if (!mesh || !mesh->vertex || mesh->ntri < 1 || mesh->ntri > 200000000L)
+        return fail(sc, TRACE_EINVAL, "a mesh needs vertices and 1..2e8 triangles");
+    if ((rc = check_material(sc, m))) return rc;
+    long nv = mesh->index ? mesh->nvertex : 3 * mesh->ntri;
+    if (nv < 3 || nv > 600000000L) return fail(sc, TRACE_EINVAL, "bad vertex count");
+    tr_surf *f = new_surf(sc);
+    if (!f) return fail(sc, TRACE_ENOMEM, "out of memory");
+    f->is_mesh = 1;
+    f->mat = *m;
+    f->nv = nv;
+    f->ntri = mesh->ntri;
+    f->vtx = malloc((size_t)nv * 3 * sizeof(double));
+    f->idx = malloc((size_t)f->ntri * 3 * sizeof(uint32_t));
+    if (mesh->media) f->media = malloc((size_t)f->ntri * 2 * sizeof(double));
+    if (!f->vtx || !f->idx || (mesh->media && !f->media)) {
+        rc = fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
+        goto bad;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (long i = 0; i < nv * 3; i++) {
+        double x = mesh->vertex[i];
+        if (!isfinite(x)) {
+            snprintf(msg, sizeof msg, "vertex %ld is not finite", i / 3 + 1);
+            rc = fail(sc, TRACE_EINVAL, msg);
+            goto bad;
+        }
+        f->vtx[i] = x;
+        if (x < lo[i % 3]) lo[i % 3] = x;
+        if (x > hi[i % 3]) hi[i % 3] = x;
+    }
+    for (long i = 0; i < f->ntri * 3; i++) {
+        uint32_t k = mesh->index ? mesh->index[i] : (uint32_t)i;
+        if ((long)k >= nv) {
+            snprintf(msg, sizeof msg, "triangle %ld: vertex index %u out of range",
+                     i / 3 + 1, k);
+            rc = fail(sc, TRACE_EINVAL, msg);
+            goto bad;
+        }
+        f->idx[i] = k;
+    }
+    for (long i = 0; i < f->ntri; i++) {
+        const double *a = f->vtx + 3 * f->idx[3 * i], *b = f->vtx + 3 * f->idx[3 * i + 1],
+                     *c = f->vtx + 3 * f->idx[3 * i + 2];
+        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]}, n[3];
+        v_cross(e1, e2, n);
+        double l2 = fmax(v_dot(e1, e1), v_dot(e2, e2));
+        if (!(v_norm(n) > 1e-12 * l2)) {
+            snprintf(msg, sizeof msg, "triangle %ld is degenerate (zero area)", i + 1);
+            rc = fail(sc, TRACE_EINVAL, msg);
+            goto bad;
+        }
+        if (mesh->media) {
+            double n1 = mesh->media[2 * i], n2 = mesh->media[2 * i + 1];
+            if (!(n1 > 0 && n2 > 0 && isfinite(n1) && isfinite(n2))) {
+                snprintf(msg, sizeof msg, "triangle %ld: indices must be positive "
+                         "numbers", i + 1);
+                rc = fail(sc, TRACE_EINVAL, msg);
+                goto bad;
+            }
+            f->media[2 * i] = n1;
+            f->media[2 * i + 1] = n2;
+        }
+    }
+    double diag[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    f->eps = 1e-9 * v_norm(diag);
+    if (mesh->underlying) {
+        if (tr_shape_init(&f->shape, mesh->underlying, sc->err, sizeof sc->err)) {
+            rc = TRACE_EINVAL;
+            goto bad;
+        }
+        f->has_under = 1;
+        f->refine = mesh->refine;
+        if (f->refine == TRACE_REFINE_FULL) f->eps = fmax(f->eps, 2.5 * under_gap(f));
+    }
+    sc->surf[sc->nsurf++] = f;
+    drop_embree(sc);
+    return f->id;
+bad:
+    free(f->vtx);
+    free(f->idx);
+    free(f->media);
+    free(f);
+    return rc;
+}
+
+int tr_add_source(trace_scene *sc, const trace_source *s, uint64_t *first)
+{
+    if (!sc) return TRACE_EINVAL;
+    if (!s) return fail(sc, TRACE_EINVAL, "no source given");
+    if (sc->nsrc == sc->capsrc) {
+        int cap = sc->capsrc ? 2 * sc->capsrc : 8;
+        tr_source *p = realloc(sc->src, (size_t)cap * sizeof *p);
+        if (!p) return fail(sc, TRACE_ENOMEM, "out of memory");
+        sc->src = p;
+        sc->capsrc = cap;
+    }
+    tr_source *ts = &sc->src[sc->nsrc];
+    if (tr_source_init(ts, s, sc->err, sizeof sc->err)) {
+        tr_source_free(ts);
+        return TRACE_EINVAL;
+    }
+    ts->first = sc->nrays;
+    if (first) *first = ts->first;
+    sc->nrays += (uint64_t)ts->nrays;
+    sc->nsrc++;
+    return TRACE_OK;
+}
+
+/* ---------------- Embree ---------------- */
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    trace_scene *sc = user;
+    snprintf(sc->err, sizeof sc->err, "Embree error %d: %s", (int)code,
+             str ? str : "(no message)");
+}
+
+static void user_bounds(const struct RTCBoundsFunctionArguments *a)
+{
+    const tr_surf *f = a->geometryUserPtr;
+    struct RTCBounds *b = a->bounds_o;
+    b->lower_x = nextafterf((float)f->shape.lo[0], -INFINITY);
+    b->lower_y = nextafterf((float)f->shape.lo[1], -INFINITY);
+    b->lower_z = nextafterf((float)f->shape.lo[2], -INFINITY);
+    b->upper_x = nextafterf((float)f->shape.hi[0], INFINITY);
+    b->upper_y = nextafterf((float)f->shape.hi[1], INFINITY);
+    b->upper_z = nextafterf((float)f->shape.hi[2], INFINITY);
+}
+
+/* Front-facing unit normal of an analytic surface from tr_shape_hit's. */
+static void front_normal(const tr_shape *g, double n[3])
+{
+    if (g->shape != TRACE_SPHERE) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+}
+
+static void user_intersect(const struct RTCIntersectFunctionNArguments *a)
+{
+    if (a->N != 1 || !a->valid[0]) return;
+    tr_ctx *x = (tr_ctx *)a->context;
+    const tr_surf *f = a->geometryUserPtr;
+    struct RTCRayHit *rh = (struct RTCRayHit *)a->rayhit;
+    double t, n[3];
+    int leaving = x->last_surf == f->id;
+    int ok = x->float_hits ? tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n)
+                           : tr_shape_hit(&f->shape, x->o, x->d, leaving, &t, n);
+    if (!ok || !(t < x->best_t)) return;
+    float tf = (float)t;
+    if (tf > rh->ray.tfar) return;          /* a triangle is clearly nearer */
+    rh->ray.tfar = tf;
+    rh->hit.geomID = a->geomID;
+    rh->hit.primID = 0;
+    rh->hit.u = rh->hit.v = 0;
+    rh->hit.Ng_x = (float)n[0];
+    rh->hit.Ng_y = (float)n[1];
+    rh->hit.Ng_z = (float)n[2];
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    front_normal(&f->shape, n);
+    x->best_surf = f->id;
+    x->best_t = t;
+    v_set(x->best_n, n);
+}
+
+static void user_occluded(const struct RTCOccludedFunctionNArguments *a)
+{
+    (void)a;   /* the engine never asks occlusion queries */
+}
+
+static void tri_normal(const tr_surf *f, long prim, double n[3])
+{
+    const uint32_t *ix = f->idx + 3 * prim;
+    const double *a = f->vtx + 3 * ix[0], *b = f->vtx + 3 * ix[1], *c = f->vtx + 3 * ix[2];
+    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    v_cross(e1, e2, n);
+}
+
+/* Distance along the ray to the triangle's plane, in double. */
+static double tri_plane_t(const tr_surf *f, long prim, const double o[3], const double d[3])
+{
+    double n[3];
+    const double *a = f->vtx + 3 * f->idx[3 * prim];
+    tri_normal(f, prim, n);
+    double den = v_dot(n, d);
+    double q[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
+    return den != 0 ? v_dot(n, q) / den : INFINITY;
+}
+
+/* Leaving a mesh: never its own triangle again, nor another one "here". */
+static void mesh_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    if (a->N != 1 || !a->valid[0]) return;
+    const tr_ctx *x = (const tr_ctx *)a->context;
+    const tr_surf *f = a->geometryUserPtr;
+    if (x->last_surf != f->id) return;
+    long prim = ((const unsigned *)a->hit)[5];    /* RTCHit.primID for N = 1 */
+    if (prim == x->last_prim) { a->valid[0] = 0; return; }
+    if (!x->float_hits && !(tri_plane_t(f, prim, x->o, x->d) > f->eps)) a->valid[0] = 0;
+}
+
+static int attach_mesh(trace_scene *sc, tr_surf *f)
+{
+    RTCGeometry g = rtcNewGeometry(sc->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!g) return -1;
+    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                       3 * sizeof(float), (size_t)f->nv);
+    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), (size_t)f->ntri);
+    if (!v || !ix) { rtcReleaseGeometry(g); return -1; }
+    for (long i = 0; i < 3 * f->nv; i++) v[i] = (float)f->vtx[i];
+    memcpy(ix, f->idx, (size_t)f->ntri * 3 * sizeof(unsigned));
+    rtcSetGeometryUserData(g, f);
+    rtcSetGeometryIntersectFilterFunction(g, mesh_filter);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc->scn, g, (unsigned)f->id);
+    rtcReleaseGeometry(g);
+    return 0;
+}
+
+static int attach_user(trace_scene *sc, tr_surf *f)
+{
+    RTCGeometry g = rtcNewGeometry(sc->dev, RTC_GEOMETRY_TYPE_USER);
+    if (!g) return -1;
+    rtcSetGeometryUserPrimitiveCount(g, 1);
+    rtcSetGeometryUserData(g, f);
+    rtcSetGeometryBoundsFunction(g, user_bounds, NULL);
+    rtcSetGeometryIntersectFunction(g, user_intersect);
+    rtcSetGeometryOccludedFunction(g, user_occluded);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(sc->scn, g, (unsigned)f->id);
+    rtcReleaseGeometry(g);
+    return 0;
+}
+
+int tr_build(trace_scene *sc, double *ms)
+{
+    if (!sc) return TRACE_EINVAL;
+    if (sc->built) { if (ms) *ms = sc->build_ms; return TRACE_OK; }
+    double t0 = tr_now_ms();
+    sc->err[0] = '\0';
+    if (!sc->dev) {
+        sc->dev = rtcNewDevice(NULL);
+        if (!sc->dev) return fail(sc, TRACE_EEMBREE, "cannot create the Embree device");
+        rtcSetDeviceErrorFunction(sc->dev, embree_error, sc);
+    }
+    sc->scn = rtcNewScene(sc->dev);
+    if (!sc->scn) { drop_embree(sc); return fail(sc, TRACE_EEMBREE, "no Embree scene"); }
+    rtcSetSceneFlags(sc->scn, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(sc->scn, RTC_BUILD_QUALITY_MEDIUM);
+    for (int i = 0; i < sc->nsurf; i++) {
+        int rc = sc->surf[i]->is_mesh ? attach_mesh(sc, sc->surf[i])
+                                      : attach_user(sc, sc->surf[i]);
+        if (rc) {
+            drop_embree(sc);
+            return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree geometry failed");
+        }
+    }
+    rtcCommitScene(sc->scn);
+    if (rtcGetDeviceError(sc->dev) != RTC_ERROR_NONE) {
+        drop_embree(sc);
+        return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree build failed");
+    }
+    sc->built = 1;
+    sc->build_ms = tr_now_ms() - t0;
+    if (ms) *ms = sc->build_ms;
+    return TRACE_OK;
+}
+
+/* Nearest hit of the ray (o, d) in double; 0 if none. */
+static int nearest(const trace_scene *sc, int float_hits, const double o[3],
+                   const double d[3], int last_surf, long last_prim, tr_hitrec *h)
+{
+    tr_ctx x;
+    struct RTCRayHit rh;
+    rtcInitIntersectContext(&x.ec);
+    x.sc = sc;
+    v_set(x.o, o);
+    v_set(x.d, d);
+    x.last_surf = last_surf;
+    x.last_prim = last_prim;
+    x.float_hits = float_hits;
+    x.best_surf = -1;
+    x.best_t = INFINITY;
+    rh.ray.org_x = (float)o[0]; rh.ray.org_y = (float)o[1]; rh.ray.org_z = (float)o[2];
+    rh.ray.dir_x = (float)d[0]; rh.ray.dir_y = (float)d[1]; rh.ray.dir_z = (float)d[2];
+    rh.ray.tnear = 0;
+    rh.ray.tfar = INFINITY;
+    rh.ray.time = 0;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(sc->scn, &x.ec, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
+    const tr_surf *f = sc->surf[rh.hit.geomID];
+    if (!f->is_mesh) {
+        h->surf = f->id;
+        h->prim = -1;
+        h->t = x.best_t;
+        v_set(h->n, x.best_n);
+        return 1;
+    }
+    long prim = rh.hit.primID;
+    double t = float_hits ? (double)rh.ray.tfar : tri_plane_t(f, prim, o, d), n[3];
+    if (!(t > 0 && isfinite(t))) t = rh.ray.tfar;
+    tri_normal(f, prim, n);
+    v_unit(n);
+    if (f->has_under && f->refine != TRACE_REFINE_NONE && !float_hits) {
+        double tt, p[3], an[3];
+        if (f->refine == TRACE_REFINE_FULL && tr_shape_refine(&f->shape, o, d, t, &tt) &&
+            tt > 0)
+            t = tt;
+        for (int i = 0; i < 3; i++) p[i] = o[i] + t * d[i];
+        tr_shape_normal(&f->shape, p, an);
+        if (v_dot(an, n) < 0) { an[0] = -an[0]; an[1] = -an[1]; an[2] = -an[2]; }
+        v_set(n, an);
+    }
+    if (x.best_surf >= 0 && x.best_t < t) {      /* an analytic surface is nearer */
+        h->surf = x.best_surf;
+        h->prim = -1;
+        h->t = x.best_t;
+        v_set(h->n, x.best_n);
+        return 1;
+    }
+    h->surf = f->id;
+    h->prim = prim;
+    h->t = t;
+    v_set(h->n, n);
+    return 1;
+}
+
+/* A ray refracted forward through a lens surface can only meet the candidates the
+ * lens named (see tr_lens.c).  Does that hold for this ray?  Then cand[0..*nc-1]. */
+static inline int seq_cands(const trace_scene *sc, const trace_options *o,
+                            const double org[3], const double d[3], int last,
+                            uint32_t hist, const int **cand,
+                            const tr_shape *const **cg, int *nc)
+{
+    if (!(o->sequential && !o->float_hits && hist == 0 && d[2] > 0 &&
+          sc->seq_nsurf == sc->nsurf))
+        return 0;
+    if (last >= 0) {
+        const tr_surf *f = sc->surf[last];
+        *cand = f->seq;
+        *cg = f->seqg;
+        *nc = f->nseq;
+    } else {
+        if (!(sc->nentry > 0 && org[2] < sc->entry_z)) return 0;
+        *cand = sc->entry;
+        *cg = sc->entryg;
+        *nc = sc->nentry;
+    }
+    return *nc > 0;
+}
+
+/* The nearest of the candidates (ids cand, shapes cg) in double (the first one at a
+ * tie); 0 if none is hit.  Its normal waits for seq_normal (from bp). */
+static inline int seq_hit(const int *cand, const tr_shape *const *cg, int nc, int last,
+                          const double org[3], const double d[3], tr_hitrec *h,
+                          double bp[3])
+{
+    double best = INFINITY, t, p[3] = {0, 0, 0};
+    int bs = -1, ok;
+    for (int k = 0; k < nc; k++) {
+        const tr_shape *g = cg[k];
+        int leaving = cand[k] == last;
+        if (g->fast == TR_FAST_CONIC) ok = tr_conic_hit(g, org, d, leaving, &t, p);
+        else if (g->fast == TR_FAST_PLANE) ok = tr_plane_hit(g, org, d, leaving, &t);
+        else ok = tr_shape_hit_t(g, org, d, leaving, &t, p);
+        if (ok && t < best) {
+            best = t;
+            bs = k;
+            v_set(bp, p);
+        }
+    }
+    if (bs < 0) return 0;
+    h->surf = cand[bs];
+    h->prim = -1;
+    h->t = best;
+    return 1;
+}
+
+static inline void seq_normal(const trace_scene *sc, tr_hitrec *h, const double bp[3])
+{
+    const tr_shape *g = &sc->surf[h->surf]->shape;
+    if (g->fast == TR_FAST_CONIC) tr_conic_normal_local(g, bp, h->n);  /* world frame */
+    else tr_shape_hit_normal(g, bp, h->n);
+    front_normal(g, h->n);
+}
+
+/* The lens shortcut (the same hits, bit for bit), else Embree. */
+int tr_find_hit(const trace_scene *sc, const trace_options *o, const double org[3],
+                    const double d[3], int last, long last_prim, uint32_t hist,
+                    tr_hitrec *h)
+{
+    const int *cand;
+    const tr_shape *const *cg;
+    int nc;
+    double bp[3] = {0, 0, 0};
+    if (seq_cands(sc, o, org, d, last, hist, &cand, &cg, &nc) &&
+        seq_hit(cand, cg, nc, last, org, d, h, bp)) {
+        seq_normal(sc, h, bp);
+        return 1;
+    }
+    return nearest(sc, o->float_hits, org, d, last, last_prim, h);
+}
