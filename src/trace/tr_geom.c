@@ -188,6 +188,7 @@ static int init_axial(tr_shape *g, const trace_surface *s, char *err, size_t cap
     zlo = fmin(z0, z1) - extra;
     zhi = fmax(z0, z1) + extra;
     g->scale = fmax(smax, zhi - zlo);
+    g->reach = hypot(smax, fmax(fabs(zlo), fabs(zhi))) * (1 + 1e-9);
     local_box(g, smax, smax, zlo, zhi);
     return 0;
 }
@@ -210,6 +211,7 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
         }
         g->w[2] = 1; frame(g, s->up);
         g->scale = s->radius;
+        g->reach = s->radius;
         for (int i = 0; i < 3; i++) {
             g->lo[i] = s->at[i] - s->radius;
             g->hi[i] = s->at[i] + s->radius;
@@ -238,6 +240,7 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
                 return -1;
             }
             g->scale = fmax(x, y);
+            g->reach = hypot(x, y) * (1 + 1e-9);
             local_box(g, x, y, 0, 0);
         }
         break;
@@ -343,10 +346,12 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
                      int leaving, double *t, double p[3])
 {
     double lo[3], ld[3], r[2];
-    double c = g->c, k1 = 1.0 + g->k, tmin = 0;
+    double c = g->c, k1 = 1.0 + g->k, tmin = 0, t0 = 0;
     int nr = 0;
     to_local(g, o, lo);
     dir_local(g, d, ld);
+    if (!leaving && (t0 = tr_advance(g, lo, ld)) > 0)   /* a far start: see tr_int.h */
+        for (int j = 0; j < 3; j++) lo[j] += t0 * ld[j];
     double A = c * (ld[0] * ld[0] + ld[1] * ld[1] + k1 * ld[2] * ld[2]);
     double B = c * (lo[0] * ld[0] + lo[1] * ld[1] + k1 * lo[2] * ld[2]) - ld[2];
     double C = c * (lo[0] * lo[0] + lo[1] * lo[1] + k1 * lo[2] * lo[2]) - 2 * lo[2];
@@ -374,7 +379,7 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
         if (!(tt > tmin)) continue;
         for (int j = 0; j < 3; j++) p[j] = lo[j] + tt * ld[j];
         if (!tr_axial_ok(g, p)) continue;
-        *t = tt;
+        *t = t0 + tt;
         return 1;
     }
     return 0;

@@ -50,6 +50,7 @@ typedef struct tr_shape {
     double r_outer2, r_inner2; /* squared; r_outer2 = 0: unbounded (sphere limit) */
     double hw, hh;             /* rectangle half width (along u), half height (v) */
     double scale;              /* size, for tolerances */
+    double reach;              /* no point of the surface lies farther from at */
     double lo[3], hi[3];       /* world bounds */
     int aligned;               /* u, v, w are the world's x, y, z */
     double k1, ck1;            /* 1 + k and c (1 + k), as the formulas compute them */
@@ -57,6 +58,21 @@ typedef struct tr_shape {
 } tr_shape;
 
 enum { TR_FAST_NONE, TR_FAST_CONIC, TR_FAST_PLANE };
+
+/* A ray starting farther than TR_FAR reaches before its closest approach to a
+ * surface's vertex is solved from an origin advanced, in double, to one reach before
+ * that point (tr_advance: the advance, or 0 for a ray near enough).  The quadratic's
+ * terms then cancel only as far as the surface's own size makes them, wherever the ray
+ * started: the hit keeps the precision of a ray started next to the surface (about the
+ * rounding of the start point itself), not one that falls with the square of the
+ * distance.  Points of the ray before the advanced origin are farther than the reach
+ * from the vertex, so no root is lost. */
+#define TR_FAR 4.0
+static inline double tr_advance(const tr_shape *g, const double lo[3], const double d[3])
+{
+    double t0 = -(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach;
+    return t0 > TR_FAR * g->reach ? t0 : 0;
+}
 
 /* Inside the aperture at local (x, y)? */
 static inline int tr_in_aperture(const tr_shape *g, double x, double y)
@@ -98,8 +114,10 @@ static inline int tr_conic_hit(const tr_shape *g, const double o[3], const doubl
                                int leaving, double *t, double p[3])
 {
     double lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
-    double c = g->c, k1 = g->k1, r[2];
+    double c = g->c, k1 = g->k1, r[2], t0 = 0;
     int nr = 0;
+    if (!leaving && (t0 = tr_advance(g, lo, d)) > 0)
+        for (int j = 0; j < 3; j++) lo[j] += t0 * d[j];
     double A = c * (d[0] * d[0] + d[1] * d[1] + k1 * d[2] * d[2]);
     double B = c * (lo[0] * d[0] + lo[1] * d[1] + k1 * lo[2] * d[2]) - d[2];
     if (leaving) {
@@ -116,7 +134,7 @@ static inline int tr_conic_hit(const tr_shape *g, const double o[3], const doubl
         if (!(tt > 0)) continue;
         for (int j = 0; j < 3; j++) p[j] = lo[j] + tt * d[j];
         if (!tr_axial_ok(g, p)) continue;
-        *t = tt;
+        *t = t0 + tt;
         return 1;
     }
     return 0;

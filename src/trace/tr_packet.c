@@ -128,6 +128,14 @@ static vm conic_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3]
 {
     vd lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     double c = g->c, k1 = g->k1;
+    vd t0 = splat(0);
+    vm far = mask_none();
+    if (!leaving) {                      /* tr_advance: a far start */
+        t0 = -(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach;
+        far = t0 > TR_FAR * g->reach;
+        if (any(far))
+            for (int j = 0; j < 3; j++) lo[j] = sel(far, lo[j] + t0 * d[j], lo[j]);
+    }
     vd A = c * (d[0] * d[0] + d[1] * d[1] + k1 * d[2] * d[2]);
     vd B = c * (lo[0] * d[0] + lo[1] * d[1] + k1 * lo[2] * d[2]) - d[2];
     vd ra, rb;
@@ -151,12 +159,14 @@ static vm conic_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3]
     vd pa[3], pb[3];
     for (int j = 0; j < 3; j++) pa[j] = lo[j] + ra * d[j];
     vm oka = va & (ra > 0) & axial_ok(g, pa);
-    *t = ra;
+    int anyfar = any(far);
+    *t = anyfar ? sel(far, t0 + ra, ra) : ra;
     for (int j = 0; j < 3; j++) p[j] = pa[j];
     vm need = vb & ~oka;
     if (!any(need)) return oka;            /* the usual case: no lane looks further */
     for (int j = 0; j < 3; j++) pb[j] = lo[j] + rb * d[j];
     vm okb = need & (rb > 0) & axial_ok(g, pb);
+    if (anyfar) { ra = sel(far, t0 + ra, ra); rb = sel(far, t0 + rb, rb); }
     *t = sel(oka, ra, rb);
     for (int j = 0; j < 3; j++) p[j] = sel(oka, pa[j], pb[j]);
     return oka | okb;

@@ -21,10 +21,28 @@ void tr_options_default(trace_options *o)
     o->sequential = 1;
 }
 
+/* A compensated sum (Neumaier): s + c carries the sum of every term added, in the
+ * order added, to about one rounding of the result however many terms there are
+ * (a plain sum of 1e8 ray powers drifts by 2e-9). */
+typedef struct tr_ksum {
+    double s, c;
+} tr_ksum;
+
+static inline void ksum_add(tr_ksum *k, double x)
+{
+    double t = k->s + x;
+    if (fabs(k->s) >= fabs(x)) k->c += (k->s - t) + x;
+    else k->c += (x - t) + k->s;
+    k->s = t;
+}
+
+static inline double ksum(const tr_ksum *k) { return k->s + k->c; }
+
 /* A delivered batch (counts c, powers pw[0..n-1]) into the summary: the powers ray
- * by ray, in ray order. */
-static void add_batch(trace_summary *s, const trace_summary *c, const tr_power *pw,
-                      uint64_t n)
+ * by ray, in ray order, each into its compensated sum k[0..4] (emitted, detected,
+ * absorbed, escaped, cut off), whose value the summary shows. */
+static void add_batch(trace_summary *s, tr_ksum k[5], const trace_summary *c,
+                      const tr_power *pw, uint64_t n)
 {
     s->rays += c->rays;
     s->segments += c->segments;
@@ -37,15 +55,17 @@ static void add_batch(trace_summary *s, const trace_summary *c, const tr_power *
     s->medium_mismatch += c->medium_mismatch;
     s->failures += c->failures;
     if (c->max_depth_seen > s->max_depth_seen) s->max_depth_seen = c->max_depth_seen;
-    double e = s->emitted, d = s->detected, a = s->absorbed, x = s->escaped, k = s->cutoff;
+    tr_ksum e = k[0], d = k[1], a = k[2], x = k[3], q = k[4];
     for (uint64_t i = 0; i < n; i++) {
-        e += pw[i].emitted;
-        d += pw[i].detected;
-        a += pw[i].absorbed;
-        x += pw[i].escaped;
-        k += pw[i].cutoff;
+        ksum_add(&e, pw[i].emitted);
+        ksum_add(&d, pw[i].detected);
+        ksum_add(&a, pw[i].absorbed);
+        ksum_add(&x, pw[i].escaped);
+        ksum_add(&q, pw[i].cutoff);
     }
-    s->emitted = e; s->detected = d; s->absorbed = a; s->escaped = x; s->cutoff = k;
+    k[0] = e; k[1] = d; k[2] = a; k[3] = x; k[4] = q;
+    s->emitted = ksum(&e); s->detected = ksum(&d); s->absorbed = ksum(&a);
+    s->escaped = ksum(&x); s->cutoff = ksum(&q);
 }
 
 /* ---------------- the run: a pool of workers and a window of batches ----------------
@@ -81,6 +101,7 @@ typedef struct tr_pool {
     tr_slot *slot;
     int nslot;
     int stop;                    /* no more claims (cancel, error) */
+    tr_ksum power[5];            /* the delivered powers' sums (add_batch) */
 } tr_pool;
 
 typedef struct tr_thread {
@@ -168,7 +189,7 @@ static int drive(trace_scene *sc, tr_pool *p, tr_worker *w, const trace_sink *si
             if (s->nomem) rc = tr_scene_fail(sc, TRACE_ENOMEM, "out of memory for trace output");
             else if ((rc = deliver(s, sink)) != TRACE_OK)
                 tr_scene_fail(sc, rc, "the trace was cancelled");
-            if (rc == TRACE_OK) add_batch(sum, &s->counts, s->power, nb);
+            if (rc == TRACE_OK) add_batch(sum, p->power, &s->counts, s->power, nb);
             if (rc == TRACE_OK && sink->progress &&
                 sink->progress(sink->ctx, b0 + nb, sc->nrays))
                 rc = tr_scene_fail(sc, TRACE_ECANCEL, "the trace was cancelled");
