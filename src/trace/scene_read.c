@@ -99,6 +99,10 @@ static int tok_num(reader *r, const tok *t, const char *what, double *v)
     if (errno == ERANGE && fabs(*v) > 1) return fail(r, "%s: '%s' is out of range", what, buf);
     if (!isfinite(*v) || fabs(*v) > 1e30)
         return fail(r, "%s: '%s' is out of range (|x| <= 1e30)", what, buf);
+    /* one range for every number: 0, or 1e-30 <= |x| <= 1e30 (squares and products
+     * of lengths then neither underflow nor overflow; see README, Conventions) */
+    if ((*v != 0 && fabs(*v) < 1e-30) || (*v == 0 && errno == ERANGE))
+        return fail(r, "%s: '%s' is out of range (0, or 1e-30 <= |x| <= 1e30)", what, buf);
     return 0;
 }
 

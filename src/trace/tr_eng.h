@@ -27,7 +27,13 @@ typedef struct tr_surf {
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */
+    double pad;                /* analytic: its Embree box grows by this (tr_build) */
 } tr_surf;
+
+/* Embree sees coordinates in single precision: surfaces reaching beyond TR_EMBREE_MAX
+ * (or unbounded) stay out of its BVH and are tested in double on every query, and
+ * Embree's rays start where they enter the box of what it holds (see nearest()). */
+#define TR_EMBREE_MAX 1e15
 
 struct trace_scene {
     char err[512];
@@ -40,6 +46,10 @@ struct trace_scene {
     RTCScene scn;
     int built;
     double build_ms;
+    int *far, nfar;            /* surfaces outside Embree's range, tested in double */
+    int nembree;               /* surfaces Embree holds */
+    double elo[3], ehi[3];     /* ... their box, grown by epad */
+    double epad;               /* how far a float ray may stray from the double one */
     int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
     int entry[4], nentry;      /* lens: what a forward ray from left of it meets first */
     const tr_shape *entryg[4];
@@ -51,6 +61,8 @@ typedef struct tr_hitrec {
     int surf;
     long prim;
     double t, n[3];                  /* n: unit normal pointing into the front side */
+    int far;                         /* 1: the hit point is q (a far start), else o + t d */
+    double q[3];
 } tr_hitrec;
 
 static inline double tr_now_ms(void)
@@ -65,7 +77,17 @@ typedef struct tr_tally {
     uint32_t segments, interactions, tir, hits, cut_depth, cut_power, cut_reflection,
              mismatch, failures;
     int max_depth;
+    int fail_cause, fail_surf;   /* the ray's first numerical failure (TR_FAIL_*) */
 } tr_tally;
+
+/* Why a ray failed numerically (every failure makes the run an error, see tr_pool.c). */
+enum { TR_FAIL_NONE, TR_FAIL_POINT, TR_FAIL_DIR, TR_FAIL_POWER };
+
+/* The first failure of a batch, of a run: which ray, why, where. */
+typedef struct tr_failure {
+    uint64_t ray;
+    int cause, surf;
+} tr_failure;
 
 /* The powers of one ray's tally: summed ray by ray, in ray order, so that the sums
  * keep their bits whatever the thread count (the counts are summed in any order). */
@@ -147,6 +169,7 @@ typedef struct tr_worker {
     tr_power *power;             /* the batch's powers, one per ray (its slot's) */
     trace_summary *counts;       /* the batch's counts (its slot's) */
     int want_seg, want_hit;
+    tr_failure fail;             /* the batch's first failure (cause 0: none) */
     tr_out out;
     tr_wray *stack;
     tr_lane lane[TR_LANES];

@@ -122,6 +122,11 @@ static void pad_box(tr_shape *g)
 static int init_aperture(tr_shape *g, const trace_surface *s, char *err, size_t cap)
 {
     g->aperture = s->aperture;
+    if (!tr_len_ok(s->width) || !tr_len_ok(s->height) || !tr_len_ok(s->r_outer) ||
+        !tr_len_ok(s->r_inner)) {
+        tr_set_err(err, cap, "aperture sizes must be 0 or %g to %g", TR_LEN_MIN, TR_LEN_MAX);
+        return -1;
+    }
     if (s->aperture == TRACE_AP_RECT) {
         if (!(s->width > 0 && s->height > 0 && isfinite(s->width) && isfinite(s->height))) {
             tr_set_err(err, cap, "rectangle needs a positive width and height");
@@ -203,6 +208,16 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
     }
     v_set(g->at, s->at);
     g->radius = s->radius;
+    if (!isinf(s->radius) && !tr_len_ok(s->radius)) {
+        tr_set_err(err, cap, "radius %g is out of range (0, or %g to %g)", s->radius,
+                   TR_LEN_MIN, TR_LEN_MAX);
+        return -1;
+    }
+    for (int i = 0; i < 3; i++)
+        if (fabs(s->at[i]) > TR_LEN_MAX) {
+            tr_set_err(err, cap, "surface position beyond |x| <= %g", TR_LEN_MAX);
+            return -1;
+        }
     switch (s->shape) {
     case TRACE_SPHERE:
         if (!(s->radius > 0 && isfinite(s->radius))) {
@@ -263,7 +278,7 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
 /* ---- intersection ---- */
 
 static int plane_hit(const tr_shape *g, const double o[3], const double d[3],
-                     int leaving, double *t)
+                     int leaving, double *t, double p[3])
 {
     double lo[3], ld[3];
     if (leaving) return 0;
@@ -272,9 +287,12 @@ static int plane_hit(const tr_shape *g, const double o[3], const double d[3],
     if (ld[2] == 0) return 0;
     double tt = -lo[2] / ld[2];
     if (!(tt > 0)) return 0;
-    if (!tr_in_aperture(g, lo[0] + tt * ld[0], lo[1] + tt * ld[1])) return 0;
+    p[0] = lo[0] + tt * ld[0];
+    p[1] = lo[1] + tt * ld[1];
+    p[2] = 0;
+    if (!tr_in_aperture(g, p[0], p[1])) return 0;
     *t = tt;
-    return 1;
+    return tr_advance(g, lo, ld) > 0 ? 2 : 1;
 }
 
 /* p: the hit relative to the centre */
@@ -380,7 +398,7 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
         for (int j = 0; j < 3; j++) p[j] = lo[j] + tt * ld[j];
         if (!tr_axial_ok(g, p)) continue;
         *t = t0 + tt;
-        return 1;
+        return t0 > 0 ? 2 : 1;
     }
     return 0;
 }
@@ -390,11 +408,11 @@ int tr_shape_hit_t(const tr_shape *g, const double o[3], const double d[3], int 
 {
     switch (g->fast) {
     case TR_FAST_CONIC: return tr_conic_hit(g, o, d, leaving, t, p);
-    case TR_FAST_PLANE: return tr_plane_hit(g, o, d, leaving, t);
+    case TR_FAST_PLANE: return tr_plane_hit(g, o, d, leaving, t, p);
     default: break;
     }
     switch (g->shape) {
-    case TRACE_PLANE: return plane_hit(g, o, d, leaving, t);
+    case TRACE_PLANE: return plane_hit(g, o, d, leaving, t, p);
     case TRACE_SPHERE: return sphere_hit(g, o, d, leaving, t, p);
     default: return axial_hit(g, o, d, leaving, t, p);
     }
@@ -417,13 +435,23 @@ void tr_shape_hit_normal(const tr_shape *g, const double p[3], double n[3])
     }
 }
 
+void tr_shape_world(const tr_shape *g, const double p[3], double q[3])
+{
+    if (g->shape == TRACE_SPHERE) {               /* p is relative to the centre */
+        for (int i = 0; i < 3; i++) q[i] = g->at[i] + p[i];
+        return;
+    }
+    to_world_dir(g, p, q);
+    for (int i = 0; i < 3; i++) q[i] += g->at[i];
+}
+
 int tr_shape_hit(const tr_shape *g, const double o[3], const double d[3], int leaving,
                  double *t, double n[3])
 {
     double p[3];
-    if (!tr_shape_hit_t(g, o, d, leaving, t, p)) return 0;
-    tr_shape_hit_normal(g, p, n);
-    return 1;
+    int ok = tr_shape_hit_t(g, o, d, leaving, t, p);
+    if (ok) tr_shape_hit_normal(g, p, n);
+    return ok;
 }
 
 /* Single precision throughout (what a float-only tracer computes). */

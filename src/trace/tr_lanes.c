@@ -108,7 +108,8 @@ static int lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr
             ty->absorbed += p;
             tr_emit_segment(w, &L->out, &s, L->ray, q, TRACE_END_ABSORB, surf);
         } else {
-            tr_hitrec h = {surf, -1, x->t[l], {x->nrm[0][l], x->nrm[1][l], x->nrm[2][l]}};
+            tr_hitrec h = {surf, -1, x->t[l], {x->nrm[0][l], x->nrm[1][l], x->nrm[2][l]},
+                           0, {0, 0, 0}};
             ty->detected += p;
             ty->hits++;
             tr_emit_segment(w, &L->out, &s, L->ray, q, TRACE_END_DETECT, surf);

@@ -34,7 +34,10 @@ void tr_pk_set_add(tr_pk_set *s, int id, const tr_shape *g, const trace_material
     s->kind[i] = m->kind;
     s->nf[i] = m->n_front;
     s->nb[i] = m->n_back;
-    for (int j = 0; j < 3; j++) s->wn[j][i] = -g->w[j];
+    for (int j = 0; j < 3; j++) {
+        s->wn[j][i] = -g->w[j];
+        s->at[j][i] = g->at[j];
+    }
     s->nc++;
 }
 
@@ -124,7 +127,7 @@ static inline vm axial_ok(const tr_shape *g, const vd p[3])
 /* tr_conic_hit with tr_quad_roots: the roots in ascending order, the first one in
  * front on the vertex branch and the aperture wins. */
 static vm conic_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3], vd *t,
-                    vd p[3])
+                    vd p[3], vm *farout)
 {
     vd lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     double c = g->c, k1 = g->k1;
@@ -160,6 +163,7 @@ static vm conic_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3]
     for (int j = 0; j < 3; j++) pa[j] = lo[j] + ra * d[j];
     vm oka = va & (ra > 0) & axial_ok(g, pa);
     int anyfar = any(far);
+    *farout = far;
     *t = anyfar ? sel(far, t0 + ra, ra) : ra;
     for (int j = 0; j < 3; j++) p[j] = pa[j];
     vm need = vb & ~oka;
@@ -173,18 +177,25 @@ static vm conic_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3]
 }
 
 /* tr_plane_hit */
-static vm plane_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3], vd *t)
+static vm plane_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3], vd *t,
+                    vd p[3], vm *far)
 {
     if (leaving) return mask_none();
     vd lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     vd tt = -lo[2] / d[2];
     *t = tt;
-    return (d[2] != 0) & (tt > 0) & in_aperture(g, lo[0] + tt * d[0], lo[1] + tt * d[1]);
+    p[0] = lo[0] + tt * d[0];
+    p[1] = lo[1] + tt * d[1];
+    p[2] = splat(0);
+    *far = (-(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach) > TR_FAR * g->reach;
+    return (d[2] != 0) & (tt > 0) & in_aperture(g, p[0], p[1]);
 }
 
 /* The chosen candidate of each lane and what the step needs of it. */
 typedef struct pick {
-    vd t, p[3];            /* distance and the conic's local hit point */
+    vd t, p[3];            /* distance and the local hit point */
+    vm far;                /* a far start: the hit point is at + p (tr_advance) */
+    vd at[3];              /* ... the candidate's vertex */
     vm k;                  /* candidate index, -1: none */
     vm conic;              /* lanes whose candidate is a conic */
     vd kind;               /* its material (trace_material_kind) */
@@ -196,17 +207,19 @@ typedef struct pick {
 static void nearest(const tr_pk_set *s, const vd o[3], const vd d[3], pick *k)
 {
     vd best = splat(INFINITY), t, p[3];
+    vm far;
     k->k = msplat(-1);
+    k->far = mask_none();
     for (int j = 0; j < 3; j++) k->p[j] = splat(0);
     for (int i = 0; i < s->nc; i++) {
         int cone = s->g[i]->fast == TR_FAST_CONIC;
-        vm ok = cone ? conic_hit(s->g[i], s->leaving[i], o, d, &t, p)
-                     : plane_hit(s->g[i], s->leaving[i], o, d, &t);
+        vm ok = cone ? conic_hit(s->g[i], s->leaving[i], o, d, &t, p, &far)
+                     : plane_hit(s->g[i], s->leaving[i], o, d, &t, p, &far);
         vm up = ok & (t < best);
         best = sel(up, t, best);
         k->k = seli(up, msplat(i), k->k);
-        if (cone)
-            for (int j = 0; j < 3; j++) k->p[j] = sel(up, p[j], k->p[j]);
+        k->far = seli(up, far, k->far);
+        for (int j = 0; j < 3; j++) k->p[j] = sel(up, p[j], k->p[j]);
     }
     k->t = best;
     vm ix = k->k & 3;                      /* lanes without a hit leave the packet */
@@ -217,6 +230,8 @@ static void nearest(const tr_pk_set *s, const vd o[3], const vd d[3], pick *k)
     k->nf = __builtin_shuffle(load(s->nf), ix);
     k->nb = __builtin_shuffle(load(s->nb), ix);
     for (int j = 0; j < 3; j++) k->wn[j] = __builtin_shuffle(load(s->wn[j]), ix);
+    if (any(k->far))
+        for (int j = 0; j < 3; j++) k->at[j] = __builtin_shuffle(load(s->at[j]), ix);
 }
 
 /* seq_normal: tr_conic_normal_local turned to the front, or a plane's -w. */
@@ -304,6 +319,8 @@ unsigned tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *
         q[i] = in->o[i] + k.t * in->d[i];
         x->nrm[i] = n[i];
     }
+    if (any(k.far))                        /* on_hit: a far start's point (tr_advance) */
+        for (int i = 0; i < 3; i++) q[i] = sel(k.far, k.at[i] + k.p[i], q[i]);
     vm fin = finite(q[0]) & finite(q[1]) & finite(q[2]) & finite(n[0]);
     out->len = in->len + k.t;
     out->opl = in->opl + in->n * k.t;

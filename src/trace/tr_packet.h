@@ -47,7 +47,8 @@ typedef struct tr_pk_set {
     const tr_shape *g[4];
     int leaving[4];              /* the rays start on it */
     double c[TR_PK], ck1[TR_PK], cone[TR_PK], kind[TR_PK], nf[TR_PK], nb[TR_PK],
-           wn[3][TR_PK];         /* curvature terms, material kind and indices, -w */
+           wn[3][TR_PK],         /* curvature terms, material kind and indices, -w */
+           at[3][TR_PK];         /* vertices */
 } tr_pk_set;
 
 /* Empty s, then add the candidates in order (surface id, shape g, material m). */

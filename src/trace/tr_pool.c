@@ -86,6 +86,7 @@ typedef struct tr_slot {
     tr_power *power;             /* one per ray of the batch */
     trace_summary counts;        /* the batch's counts (no powers) */
     tr_out out;                  /* the batch's records (buffers reused) */
+    tr_failure fail;             /* its first numerical failure */
     uint64_t batch;              /* which batch the slot holds */
     int done, nomem;
 } tr_slot;
@@ -102,6 +103,7 @@ typedef struct tr_pool {
     int nslot;
     int stop;                    /* no more claims (cancel, error) */
     tr_ksum power[5];            /* the delivered powers' sums (add_batch) */
+    tr_failure fail;             /* the first failure delivered (in ray order) */
 } tr_pool;
 
 typedef struct tr_thread {
@@ -133,7 +135,9 @@ static void fill(tr_pool *p, tr_worker *w, tr_slot *s, uint64_t b)
     w->out = s->out;                       /* the slot's buffers, emptied */
     w->out.seg.n = w->out.hit.n = 0;
     w->nomem = 0;
+    w->fail.cause = TR_FAIL_NONE;
     tr_trace_batch(w);
+    s->fail = w->fail;
     s->out = w->out;
     s->nomem = w->nomem;
 }
@@ -190,6 +194,7 @@ static int drive(trace_scene *sc, tr_pool *p, tr_worker *w, const trace_sink *si
             else if ((rc = deliver(s, sink)) != TRACE_OK)
                 tr_scene_fail(sc, rc, "the trace was cancelled");
             if (rc == TRACE_OK) add_batch(sum, p->power, &s->counts, s->power, nb);
+            if (rc == TRACE_OK && s->fail.cause && !p->fail.cause) p->fail = s->fail;
             if (rc == TRACE_OK && sink->progress &&
                 sink->progress(sink->ctx, b0 + nb, sc->nrays))
                 rc = tr_scene_fail(sc, TRACE_ECANCEL, "the trace was cancelled");
@@ -210,6 +215,33 @@ static int drive(trace_scene *sc, tr_pool *p, tr_worker *w, const trace_sink *si
     pthread_cond_broadcast(&p->more);
     pthread_mutex_unlock(&p->mu);
     return rc;
+}
+
+/* A trace whose results are not all finite is an error, with its cause: never a
+ * success with NaN in the summary. */
+static int numeric_check(trace_scene *sc, const trace_summary *s, const tr_failure *f)
+{
+    static const char *why[] = {
+        [TR_FAIL_POINT] = "its hit point is not a finite number",
+        [TR_FAIL_DIR] = "its direction is not finite (indices or angles beyond what "
+                        "double precision holds)",
+        [TR_FAIL_POWER] = "its power is not a finite number"};
+    char msg[400];
+    if (s->failures) {
+        char at[48] = "";
+        if (f->surf >= 0) snprintf(at, sizeof at, " after surface %d", f->surf + 1);
+        snprintf(msg, sizeof msg, "%llu ray path%s failed numerically (of %llu source "
+                 "rays); the first, from source ray %llu, failed%s: %s",
+                 (unsigned long long)s->failures, s->failures == 1 ? "" : "s",
+                 (unsigned long long)s->rays, (unsigned long long)f->ray, at,
+                 f->cause > 0 && f->cause <= TR_FAIL_POWER ? why[f->cause] : "?");
+        return tr_scene_fail(sc, TRACE_EINVAL, msg);
+    }
+    if (!(isfinite(s->emitted) && isfinite(s->detected) && isfinite(s->absorbed) &&
+          isfinite(s->escaped) && isfinite(s->cutoff)))
+        return tr_scene_fail(sc, TRACE_EINVAL, "the summed powers are not finite "
+                             "(a source's power per ray beyond double precision)");
+    return TRACE_OK;
 }
 
 static int check_options(trace_scene *sc, const trace_options *o)
@@ -335,6 +367,7 @@ int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
         for (int i = 0; i < nstarted; i++) pthread_join(tid[i], NULL);
     }
     s.trace_ms = tr_now_ms() - t0;
+    if (rc == TRACE_OK) rc = numeric_check(sc, &s, &p.fail);
     if (mu) pthread_mutex_destroy(&p.mu);
     if (more) pthread_cond_destroy(&p.more);
     if (ready) pthread_cond_destroy(&p.ready);

@@ -16,8 +16,11 @@ typedef struct tr_ctx {
     int last_surf;
     long last_prim;
     int float_hits;
+    double ta;                       /* Embree's ray starts at o + ta d */
     int best_surf;                   /* nearest analytic hit so far */
     double best_t, best_n[3];
+    int best_far;                    /* ... from a far start: its point best_q */
+    double best_q[3];
 } tr_ctx;
 
 static int fail(trace_scene *sc, int code, const char *msg)
@@ -87,6 +90,9 @@ static void drop_embree(trace_scene *sc)
     sc->scn = NULL;
     sc->dev = NULL;
     sc->built = 0;
+    free(sc->far);
+    sc->far = NULL;
+    sc->nfar = sc->nembree = 0;
 }
 
 void tr_scene_free(trace_scene *sc)
@@ -201,6 +207,12 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
             rc = fail(sc, TRACE_EINVAL, msg);
             goto bad;
         }
+        if (fabs(x) > TR_EMBREE_MAX) {     /* Embree holds meshes in single precision */
+            snprintf(msg, sizeof msg, "vertex %ld: coordinate %g is beyond the range of "
+                     "meshes (|x| <= %g)", i / 3 + 1, x, TR_EMBREE_MAX);
+            rc = fail(sc, TRACE_EINVAL, msg);
+            goto bad;
+        }
         f->vtx[i] = x;
         if (x < lo[i % 3]) lo[i % 3] = x;
         if (x > hi[i % 3]) hi[i % 3] = x;
@@ -297,12 +309,12 @@ static void user_bounds(const struct RTCBoundsFunctionArguments *a)
 {
     const tr_surf *f = a->geometryUserPtr;
     struct RTCBounds *b = a->bounds_o;
-    b->lower_x = nextafterf((float)f->shape.lo[0], -INFINITY);
-    b->lower_y = nextafterf((float)f->shape.lo[1], -INFINITY);
-    b->lower_z = nextafterf((float)f->shape.lo[2], -INFINITY);
-    b->upper_x = nextafterf((float)f->shape.hi[0], INFINITY);
-    b->upper_y = nextafterf((float)f->shape.hi[1], INFINITY);
-    b->upper_z = nextafterf((float)f->shape.hi[2], INFINITY);
+    b->lower_x = nextafterf((float)(f->shape.lo[0] - f->pad), -INFINITY);
+    b->lower_y = nextafterf((float)(f->shape.lo[1] - f->pad), -INFINITY);
+    b->lower_z = nextafterf((float)(f->shape.lo[2] - f->pad), -INFINITY);
+    b->upper_x = nextafterf((float)(f->shape.hi[0] + f->pad), INFINITY);
+    b->upper_y = nextafterf((float)(f->shape.hi[1] + f->pad), INFINITY);
+    b->upper_z = nextafterf((float)(f->shape.hi[2] + f->pad), INFINITY);
 }
 
 /* Front-facing unit normal of an analytic surface from tr_shape_hit's. */
@@ -317,12 +329,13 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *a)
     tr_ctx *x = (tr_ctx *)a->context;
     const tr_surf *f = a->geometryUserPtr;
     struct RTCRayHit *rh = (struct RTCRayHit *)a->rayhit;
-    double t, n[3];
-    int leaving = x->last_surf == f->id;
-    int ok = x->float_hits ? tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n)
-                           : tr_shape_hit(&f->shape, x->o, x->d, leaving, &t, n);
+    double t, n[3], p[3];
+    int leaving = x->last_surf == f->id, ok;
+    if (x->float_hits) ok = tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n);
+    else if ((ok = tr_shape_hit_t(&f->shape, x->o, x->d, leaving, &t, p)))
+        tr_shape_hit_normal(&f->shape, p, n);
     if (!ok || !(t < x->best_t)) return;
-    float tf = (float)t;
+    float tf = (float)(t - x->ta);
     if (tf > rh->ray.tfar) return;          /* a triangle is clearly nearer */
     rh->ray.tfar = tf;
     rh->hit.geomID = a->geomID;
@@ -336,6 +349,8 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *a)
     x->best_surf = f->id;
     x->best_t = t;
     v_set(x->best_n, n);
+    x->best_far = ok == 2 && !x->float_hits;
+    if (x->best_far) tr_shape_world(&f->shape, p, x->best_q);
 }
 
 static void user_occluded(const struct RTCOccludedFunctionNArguments *a)
@@ -409,6 +424,53 @@ static int attach_user(trace_scene *sc, tr_surf *f)
     return 0;
 }
 
+/* Within the range Embree's single precision serves (meshes always are: add_mesh
+ * refuses vertices beyond it)? */
+static int in_range(const tr_surf *f)
+{
+    if (f->is_mesh) return 1;
+    for (int i = 0; i < 3; i++)
+        if (!(fabs(f->shape.lo[i]) <= TR_EMBREE_MAX && fabs(f->shape.hi[i]) <= TR_EMBREE_MAX))
+            return 0;
+    return 1;
+}
+
+/* The box of what Embree holds, and how far its float ray may stray from the double
+ * one inside it: the origin rounds to half an ulp of the largest coordinate M, the
+ * direction to half an ulp of each component, over at most the box's diagonal D.
+ * Every analytic surface's box grows by eight times that (a ray that meets the surface
+ * in double is always offered to it); the box itself by as much again. */
+static void embree_box(trace_scene *sc)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < sc->nsurf; i++) {
+        const tr_surf *f = sc->surf[i];
+        if (!in_range(f)) continue;
+        for (int j = 0; j < 3; j++) {
+            if (f->is_mesh) {
+                for (long v = 0; v < f->nv; v++) {
+                    lo[j] = fmin(lo[j], f->vtx[3 * v + j]);
+                    hi[j] = fmax(hi[j], f->vtx[3 * v + j]);
+                }
+            } else {
+                lo[j] = fmin(lo[j], f->shape.lo[j]);
+                hi[j] = fmax(hi[j], f->shape.hi[j]);
+            }
+        }
+    }
+    double m = 0, d[3];
+    for (int j = 0; j < 3; j++) {
+        if (!(lo[j] <= hi[j])) { lo[j] = hi[j] = 0; }
+        m = fmax(m, fmax(fabs(lo[j]), fabs(hi[j])));
+        d[j] = hi[j] - lo[j];
+    }
+    sc->epad = 8 * FLT_EPSILON * (m + v_norm(d)) + 1e-300;
+    for (int j = 0; j < 3; j++) {
+        sc->elo[j] = lo[j] - 2 * sc->epad;
+        sc->ehi[j] = hi[j] + 2 * sc->epad;
+    }
+}
+
 int tr_build(trace_scene *sc, double *ms)
 {
     if (!sc) return TRACE_EINVAL;
@@ -424,9 +486,17 @@ int tr_build(trace_scene *sc, double *ms)
     if (!sc->scn) { drop_embree(sc); return fail(sc, TRACE_EEMBREE, "no Embree scene"); }
     rtcSetSceneFlags(sc->scn, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(sc->scn, RTC_BUILD_QUALITY_MEDIUM);
+    if (sc->nsurf && !(sc->far = malloc((size_t)sc->nsurf * sizeof *sc->far))) {
+        drop_embree(sc);
+        return fail(sc, TRACE_ENOMEM, "out of memory");
+    }
+    embree_box(sc);
     for (int i = 0; i < sc->nsurf; i++) {
-        int rc = sc->surf[i]->is_mesh ? attach_mesh(sc, sc->surf[i])
-                                      : attach_user(sc, sc->surf[i]);
+        tr_surf *f = sc->surf[i];
+        if (!f->is_mesh && !in_range(f)) { sc->far[sc->nfar++] = i; continue; }
+        f->pad = sc->epad;
+        sc->nembree++;
+        int rc = f->is_mesh ? attach_mesh(sc, f) : attach_user(sc, f);
         if (rc) {
             drop_embree(sc);
             return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree geometry failed");
@@ -443,9 +513,10 @@ int tr_build(trace_scene *sc, double *ms)
     return TRACE_OK;
 }
 
-/* Nearest hit of the ray (o, d) in double; 0 if none. */
-static int nearest(const trace_scene *sc, int float_hits, const double o[3],
-                   const double d[3], int last_surf, long last_prim, tr_hitrec *h)
+/* Nearest hit among what Embree holds, its ray starting at o + ta d; 0 if none. */
+static int embree_nearest(const trace_scene *sc, int float_hits, const double o[3],
+                          const double d[3], int last_surf, long last_prim, double ta,
+                          tr_hitrec *h)
 {
     tr_ctx x;
     struct RTCRayHit rh;
@@ -458,7 +529,11 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
     x.float_hits = float_hits;
     x.best_surf = -1;
     x.best_t = INFINITY;
-    rh.ray.org_x = (float)o[0]; rh.ray.org_y = (float)o[1]; rh.ray.org_z = (float)o[2];
+    x.best_far = 0;
+    x.ta = ta;
+    rh.ray.org_x = (float)(o[0] + ta * d[0]);
+    rh.ray.org_y = (float)(o[1] + ta * d[1]);
+    rh.ray.org_z = (float)(o[2] + ta * d[2]);
     rh.ray.dir_x = (float)d[0]; rh.ray.dir_y = (float)d[1]; rh.ray.dir_z = (float)d[2];
     rh.ray.tnear = 0;
     rh.ray.tfar = INFINITY;
@@ -477,11 +552,13 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
         h->prim = -1;
         h->t = x.best_t;
         v_set(h->n, x.best_n);
+        h->far = x.best_far;
+        v_set(h->q, x.best_q);
         return 1;
     }
     long prim = rh.hit.primID;
-    double t = float_hits ? (double)rh.ray.tfar : tri_plane_t(f, prim, o, d), n[3];
-    if (!(t > 0 && isfinite(t))) t = rh.ray.tfar;
+    double t = float_hits ? ta + rh.ray.tfar : tri_plane_t(f, prim, o, d), n[3];
+    if (!(t > 0 && isfinite(t))) t = ta + rh.ray.tfar;
     tri_normal(f, prim, n);
     v_unit(n);
     if (f->has_under && f->refine != TRACE_REFINE_NONE && !float_hits) {
@@ -499,13 +576,66 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
         h->prim = -1;
         h->t = x.best_t;
         v_set(h->n, x.best_n);
+        h->far = x.best_far;
+        v_set(h->q, x.best_q);
         return 1;
     }
     h->surf = f->id;
     h->prim = prim;
     h->t = t;
     v_set(h->n, n);
+    h->far = 0;
     return 1;
+}
+
+/* Where the ray (o, d) enters the box b (lo, hi) and leaves it: 0 if it never meets it
+ * ahead (t >= 0). */
+static int slab(const double lo[3], const double hi[3], const double o[3],
+                const double d[3], double *tin)
+{
+    double a = 0, b = INFINITY;
+    for (int j = 0; j < 3; j++) {
+        if (d[j] == 0) {
+            if (o[j] < lo[j] || o[j] > hi[j]) return 0;
+            continue;
+        }
+        double t1 = (lo[j] - o[j]) / d[j], t2 = (hi[j] - o[j]) / d[j];
+        if (t1 > t2) { double x = t1; t1 = t2; t2 = x; }
+        if (t1 > a) a = t1;
+        if (t2 < b) b = t2;
+    }
+    if (!(a <= b)) return 0;
+    *tin = a;
+    return 1;
+}
+
+/* Nearest hit of the ray (o, d) in double; 0 if none.  Embree's float ray starts where
+ * the double one enters the box of what Embree holds (so neither a far start nor one
+ * beyond single precision's range reaches it); the surfaces outside its range follow
+ * in double. */
+static int nearest(const trace_scene *sc, int float_hits, const double o[3],
+                   const double d[3], int last_surf, long last_prim, tr_hitrec *h)
+{
+    double ta;
+    int got = 0;
+    if (sc->nembree && slab(sc->elo, sc->ehi, o, d, &ta))
+        got = embree_nearest(sc, float_hits, o, d, last_surf, last_prim, ta, h);
+    for (int i = 0; i < sc->nfar; i++) {
+        const tr_surf *f = sc->surf[sc->far[i]];
+        double t, n[3], p[3];
+        int ok = tr_shape_hit_t(&f->shape, o, d, last_surf == f->id, &t, p);
+        if (!ok || (got && !(t < h->t))) continue;
+        tr_shape_hit_normal(&f->shape, p, n);
+        front_normal(&f->shape, n);
+        h->surf = f->id;
+        h->prim = -1;
+        h->t = t;
+        v_set(h->n, n);
+        h->far = ok == 2;
+        if (h->far) tr_shape_world(&f->shape, p, h->q);
+        got = 1;
+    }
+    return got;
 }
 
 /* A ray refracted forward through a lens surface can only meet the candidates the
@@ -539,16 +669,17 @@ static inline int seq_hit(const int *cand, const tr_shape *const *cg, int nc, in
                           double bp[3])
 {
     double best = INFINITY, t, p[3] = {0, 0, 0};
-    int bs = -1, ok;
+    int bs = -1, ok, far = 0;
     for (int k = 0; k < nc; k++) {
         const tr_shape *g = cg[k];
         int leaving = cand[k] == last;
         if (g->fast == TR_FAST_CONIC) ok = tr_conic_hit(g, org, d, leaving, &t, p);
-        else if (g->fast == TR_FAST_PLANE) ok = tr_plane_hit(g, org, d, leaving, &t);
+        else if (g->fast == TR_FAST_PLANE) ok = tr_plane_hit(g, org, d, leaving, &t, p);
         else ok = tr_shape_hit_t(g, org, d, leaving, &t, p);
         if (ok && t < best) {
             best = t;
             bs = k;
+            far = ok == 2;
             v_set(bp, p);
         }
     }
@@ -556,6 +687,8 @@ static inline int seq_hit(const int *cand, const tr_shape *const *cg, int nc, in
     h->surf = cand[bs];
     h->prim = -1;
     h->t = best;
+    h->far = far;
+    if (far) tr_shape_world(cg[bs], bp, h->q);
     return 1;
 }
 

@@ -166,16 +166,25 @@ void tr_ray_start(tr_wray *r, const tr_ray0 *r0, tr_tally *ty, double *p0)
     ty->emitted = *p0;
 }
 
+/* A numerical failure of the ray (its first cause kept); a finite power p is counted
+ * as cut off so the balance still holds for the rest. */
+static void ray_failed(tr_tally *ty, int cause, int surf, double p)
+{
+    if (!ty->failures) { ty->fail_cause = cause; ty->fail_surf = surf; }
+    ty->failures++;
+    if (isfinite(p)) ty->cutoff += p;
+}
+
 /* One step once the hit h of *r is known: the segment to it and what the surface
  * does.  Returns 1 if *r goes on. */
 static inline int on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int *sp,
                          tr_wray *r, const tr_hitrec *h, uint64_t ray, double p0)
 {
     double p = r->pol.jss + r->pol.jpp, q[3];
-    for (int i = 0; i < 3; i++) q[i] = r->o[i] + h->t * r->d[i];
+    if (h->far) v_set(q, h->q);
+    else for (int i = 0; i < 3; i++) q[i] = r->o[i] + h->t * r->d[i];
     if (!(isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]) && isfinite(h->n[0]))) {
-        ty->failures++;
-        ty->cutoff += p;
+        ray_failed(ty, TR_FAIL_POINT, h->surf, p);
         return 0;
     }
     const tr_surf *f = w->sc->surf[h->surf];
@@ -219,6 +228,11 @@ void tr_trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int 
         double p = r.pol.jss + r.pol.jpp, q[3];
         tr_hitrec h;
         if (r.depth > ty->max_depth) ty->max_depth = r.depth;
+        if (!(isfinite(r.d[0]) && isfinite(r.d[1]) && isfinite(r.d[2]) && isfinite(p))) {
+            ray_failed(ty, isfinite(p) ? TR_FAIL_DIR : TR_FAIL_POWER, r.last_surf, p);
+            live = 0;                   /* never handed to Embree */
+            continue;
+        }
         if (r.depth >= o->max_depth) { ty->cutoff += p; ty->cut_depth++; live = 0; continue; }
         if (!tr_find_hit(sc, o, r.o, r.d, r.last_surf, r.last_prim, r.hist, &h)) {
             for (int i = 0; i < 3; i++) q[i] = r.o[i] + o->escape_length * r.d[i];
@@ -260,6 +274,8 @@ void tr_fold(tr_worker *w, uint64_t i, const tr_tally *t)
     s->cut_reflection += t->cut_reflection;
     s->medium_mismatch += t->mismatch;
     s->failures += t->failures;
+    if (t->failures && !w->fail.cause)
+        w->fail = (tr_failure){w->first + i, t->fail_cause, t->fail_surf};
     if (t->max_depth > s->max_depth_seen) s->max_depth_seen = t->max_depth;
 }
 

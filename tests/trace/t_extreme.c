@@ -1,0 +1,379 @@
+/* t_extreme.c -- the trace engine at the extremes (issue 9), a table of rows like
+ * tests/unit_paraxial_extreme.c, each asserted against an independent computation
+ * written here in long double or closed form (no engine code): far ray starts
+ * (precision must not depend on where a ray starts), coordinates beyond single
+ * precision, coincident surfaces, sizes whose squares under- or overflow, non-finite
+ * results as errors, and compensated power sums at 1e7 rays (the 1e8 row is in
+ * `bench_trace sum`, run by scripts/bench_trace.sh: it takes about a minute). */
+#include <float.h>
+#include <stdio.h>
+#include "unit.h"
+#include "tt.h"
+
+static const trace_api *tr;
+
+#if defined(__SANITIZE_ADDRESS__)
+#define SLOW_BUILD 1
+#else
+#define SLOW_BUILD 0
+#endif
+
+/* ---- a small recorder of detector hits ---- */
+typedef struct hits {
+    trace_hit h[64];
+    int n;
+} hits;
+
+static int on_hit(void *ctx, const trace_hit *h)
+{
+    hits *k = ctx;
+    if (k->n < 64) k->h[k->n] = *h;
+    k->n++;
+    return 0;
+}
+
+static trace_options geometry_only(void)
+{
+    trace_options o;
+    tr->options_default(&o);
+    o.fresnel = 0;
+    o.reflections = 0;
+    o.threads = 1;
+    return o;
+}
+
+static trace_material mat(int kind, double n1, double n2)
+{
+    trace_material m = {kind, n1, n2};
+    return m;
+}
+
+static int add_plane(trace_scene *sc, int kind, double z, double r, double n1, double n2)
+{
+    trace_surface s = {0};
+    s.shape = TRACE_PLANE;
+    s.at[2] = z;
+    s.axis[2] = 1;
+    s.aperture = TRACE_AP_DISC;
+    s.r_outer = r;
+    trace_material m = mat(kind, n1, n2);
+    return tr->add_surface(sc, &s, &m);
+}
+
+static int add_cap(trace_scene *sc, int kind, double z, double R, double ap, double n1,
+                   double n2)
+{
+    trace_surface s = {0};
+    s.shape = TRACE_AXIAL;
+    s.at[2] = z;
+    s.axis[2] = 1;
+    s.radius = R;
+    s.aperture = TRACE_AP_DISC;
+    s.r_outer = ap;
+    trace_material m = mat(kind, n1, n2);
+    return tr->add_surface(sc, &s, &m);
+}
+
+static int add_rays(trace_scene *sc, const trace_ray *r, int n)
+{
+    trace_source s = {0};
+    s.type = TRACE_SRC_RAYS;
+    s.count = n;
+    s.ray = r;
+    return tr->add_source(sc, &s, NULL);
+}
+
+/* ---- 1. precision independent of the start ---- */
+
+/* Exact (long double) x on the plane z = zd of the ray x = h parallel to the axis,
+ * refracted n1 -> n2 at the spherical cap of radius R with its vertex at z = 0. */
+static long double cap_exact_x(long double h, long double R, long double n1, long double n2,
+                               long double zd)
+{
+    long double zs = R - sqrtl(R * R - h * h);           /* sag at h */
+    long double nx = -h / R, nz = (R - zs) / R;          /* unit normal toward +z */
+    long double mu = n1 / n2, ci = nz;                   /* d = (0, 0, 1) */
+    long double g = sqrtl(1 - mu * mu * (1 - ci * ci)) - mu * ci;
+    long double dx = g * nx, dz = mu + g * nz;
+    return h + (zd - zs) * dx / dz;
+}
+
+static void far_cap(void)
+{
+    const double L[] = {1, 1e2, 1e4, 1e6, 1e8};
+    const double R = 50, h = 3, n2 = 1.5, zd = 100;
+    long double want = cap_exact_x(h, R, 1, n2, zd);
+    for (size_t i = 0; i < sizeof L / sizeof L[0]; i++) {
+        trace_scene *sc = tr->scene_new();
+        hits k = {.n = 0};
+        trace_sink sink = {&k, NULL, on_hit, NULL};
+        trace_options o = geometry_only();
+        add_cap(sc, TRACE_REFRACT, 0, R, 12, 1, n2);
+        add_plane(sc, TRACE_DETECT, zd, 1e3, 1, 1);
+        trace_ray r = {{h, 0, -L[i]}, {0, 0, 1}, 1};
+        add_rays(sc, &r, 1);
+        int rc = tr->run(sc, &o, &sink, NULL);
+        double got = k.n == 1 ? k.h[0].pos[0] : NAN;
+        double rel = fabs((double)(got - want) / (double)want);
+        CHECK(rc == TRACE_OK && k.n == 1 && rel <= 1e-14,
+              "far start: a cap R 50 met by a ray from %g before it: detector x %.17g, "
+              "exact %.17Lg (%.1e relative, <= 1e-14)", L[i], got, want, rel);
+        tr->scene_free(sc);
+    }
+}
+
+/* A cap of radius 1e-3 watched from 1e6 away: every ray that lands on it in exact
+ * arithmetic is recorded (Embree's float ray must not miss its box). */
+static void tiny_far_cap(void)
+{
+    trace_scene *sc = tr->scene_new();
+    hits k = {.n = 0};
+    trace_sink sink = {&k, NULL, on_hit, NULL};
+    trace_options o = geometry_only();
+    add_cap(sc, TRACE_DETECT, 0, 1e-3, 1e-3, 1, 1);
+    enum { N = 33 };
+    trace_ray r[N];
+    int expect = 0;
+    for (int i = 0; i < N; i++) {
+        /* aim at (x, 0, 0), x across the aperture and beyond: lands iff |x| <= 1e-3
+         * (the cap is a hemisphere of radius 1e-3: its rim is the aperture) */
+        double x = -1.6e-3 + 1e-4 * i, z0 = -1e6;
+        double d[3] = {x, 0, -z0}, l = sqrt(d[0] * d[0] + d[2] * d[2]);
+        r[i] = (trace_ray){{0, 0, z0}, {d[0] / l, 0, d[2] / l}, 1};
+        /* where it crosses the aperture plane z = sag(rim) = 1e-3, exactly: x (1 + 1e-3/1e6) */
+        long double xr = (long double)x * (1 + 1e-9L);
+        if (fabsl(xr) < 1e-3L * (1 - 1e-9L)) expect++;
+    }
+    add_rays(sc, r, N);
+    int rc = tr->run(sc, &o, &sink, NULL);
+    CHECK(rc == TRACE_OK && k.n == expect,
+          "far start: a cap of radius 1e-3 seen from 1e6 records every ray that lands on "
+          "it (%d of %d, exact %d)", k.n, N, expect);
+    tr->scene_free(sc);
+}
+
+/* A near-axis real ray through the Cooke triplet meets the paraxial focus to 1e-12
+ * relative, from any start distance (the lens shortcut and its packets: 8 rays). */
+static void far_triplet(void)
+{
+    const double L[] = {1, 10, 1e2, 1e3, 1e4, 1e5, 1e6};
+    trace_lens_surface s[TT_NSURF];
+    trace_lens l;
+    tt_triplet(s, &l, 0);
+    double zp = tt_paraxial_image(&l, -INFINITY);
+    for (size_t i = 0; i < sizeof L / sizeof L[0]; i++) {
+        trace_scene *sc = tr->scene_new();
+        hits k = {.n = 0};
+        trace_sink sink = {&k, NULL, on_hit, NULL};
+        trace_options o = geometry_only();
+        trace_lens ll = l;
+        ll.z_detector = zp;
+        int id = tr->add_lens(sc, &ll);
+        trace_ray r[8];
+        for (int j = 0; j < 8; j++)
+            r[j] = (trace_ray){{0, 1e-6 * (j + 1), -L[i]}, {0, 0, 1}, 1};
+        add_rays(sc, r, 8);
+        int rc = id >= 0 ? tr->run(sc, &o, &sink, NULL) : id;
+        double worst = 0;
+        for (int j = 0; j < k.n && j < 8; j++) {
+            const trace_hit *h = &k.h[j];
+            double zc = h->pos[2] - h->pos[1] * h->dir[2] / h->dir[1];
+            worst = fmax(worst, fabs(zc - zp) / zp);
+        }
+        CHECK(rc == TRACE_OK && k.n == 8 && worst <= 1e-12,
+              "far start: near-axis rays through the triplet from %g before it cross the "
+              "axis at the paraxial focus %.15g to %.1e relative (<= 1e-12)", L[i], zp,
+              worst);
+        tr->scene_free(sc);
+    }
+}
+
+/* ---- 2. beyond single precision's range ---- */
+
+static void huge(void)
+{
+    /* a detector rect 1e20 x 1e20 and a detector sphere of radius 1e19: hit */
+    {
+        trace_scene *sc = tr->scene_new();
+        hits k = {.n = 0};
+        trace_sink sink = {&k, NULL, on_hit, NULL};
+        trace_options o = geometry_only();
+        trace_surface p = {0};
+        p.shape = TRACE_PLANE;
+        p.at[2] = 10;
+        p.axis[2] = 1;
+        p.aperture = TRACE_AP_RECT;
+        p.width = p.height = 1e20;
+        trace_material m = mat(TRACE_DETECT, 1, 1);
+        tr->add_surface(sc, &p, &m);
+        trace_ray r = {{3e18, -2e19, 0}, {0, 0, 1}, 1};
+        add_rays(sc, &r, 1);
+        int rc = tr->run(sc, &o, &sink, NULL);
+        CHECK(rc == TRACE_OK && k.n == 1 && k.h[0].pos[0] == 3e18 && k.h[0].pos[1] == -2e19
+              && k.h[0].pos[2] == 10,
+              "huge: a detector rect 1e20 x 1e20 is hit at (3e18, -2e19, 10) exactly");
+        tr->scene_free(sc);
+    }
+    {
+        trace_scene *sc = tr->scene_new();
+        hits k = {.n = 0};
+        trace_sink sink = {&k, NULL, on_hit, NULL};
+        trace_options o = geometry_only();
+        trace_surface p = {0};
+        p.shape = TRACE_SPHERE;
+        p.radius = 1e19;
+        trace_material m = mat(TRACE_DETECT, 1, 1);
+        tr->add_surface(sc, &p, &m);
+        trace_ray r = {{0, 0, 0}, {0.6, 0, 0.8}, 1};
+        add_rays(sc, &r, 1);
+        int rc = tr->run(sc, &o, &sink, NULL);
+        double e = k.n == 1 ? fabs(hypot(k.h[0].pos[0], k.h[0].pos[2]) - 1e19) / 1e19 : 1;
+        CHECK(rc == TRACE_OK && k.n == 1 && e <= 4e-16,
+              "huge: a detector sphere of radius 1e19 sees the ray from its centre "
+              "(radius to %.1e relative)", e);
+        tr->scene_free(sc);
+    }
+    /* a ray from -1.9e18 (beyond float's safe range for Embree) to a small detector */
+    {
+        trace_scene *sc = tr->scene_new();
+        hits k = {.n = 0};
+        trace_sink sink = {&k, NULL, on_hit, NULL};
+        trace_options o = geometry_only();
+        add_plane(sc, TRACE_DETECT, 10, 1, 1, 1);
+        trace_ray r[2] = {{{0.5, 0, -1.9e18}, {0, 0, 1}, 1}, {{0, 0, -1e30}, {0, 0, 1}, 1}};
+        add_rays(sc, r, 2);
+        int rc = tr->run(sc, &o, &sink, NULL);
+        CHECK(rc == TRACE_OK && k.n == 2 && k.h[0].pos[0] == 0.5 && k.h[0].pos[2] == 10 &&
+              k.h[1].pos[2] == 10,
+              "huge: rays from z = -1.9e18 and -1e30 meet a detector of radius 1 at z = 10");
+        tr->scene_free(sc);
+    }
+    /* glass side of a plane into index 1e-200: the direction overflows; an error with
+     * its cause, no abort */
+    {
+        trace_scene *sc = tr->scene_new();
+        trace_options o = geometry_only();
+        add_plane(sc, TRACE_REFRACT, 0, 1, 1e-200, 1.5);
+        add_plane(sc, TRACE_DETECT, -10, 1, 1, 1);
+        trace_ray r = {{0, 0, 1}, {0, 0, -1}, 1};
+        trace_source src = {0};
+        src.type = TRACE_SRC_RAYS;
+        src.count = 1;
+        src.ray = &r;
+        src.n_medium = 1.5;
+        tr->add_source(sc, &src, NULL);
+        trace_summary sum;
+        int rc = tr->run(sc, &o, NULL, &sum);
+        CHECK(rc == TRACE_EINVAL && strstr(tr->error(sc), "failed numerically") &&
+              strstr(tr->error(sc), "after surface 1"),
+              "huge: a plane into index 1e-200 is an error with its cause (%s)",
+              tr->error(sc));
+        tr->scene_free(sc);
+    }
+}
+
+/* ---- 5. underflow, overflow ---- */
+
+static void tiny(void)
+{
+    trace_scene *sc = tr->scene_new();
+    trace_surface s = {0};
+    s.shape = TRACE_AXIAL;
+    s.axis[2] = 1;
+    s.radius = 1;
+    s.aperture = TRACE_AP_DISC;
+    s.r_outer = 1e-200;
+    trace_material m = mat(TRACE_DETECT, 1, 1);
+    int rc = tr->add_surface(sc, &s, &m);
+    CHECK(rc == TRACE_EINVAL && strstr(tr->error(sc), "1e-30"),
+          "tiny: aperture 1e-200 is refused, not squared to 0 (%s)", tr->error(sc));
+    s.r_outer = 0.5;
+    s.r_inner = 1e-200;
+    rc = tr->add_surface(sc, &s, &m);
+    CHECK(rc == TRACE_EINVAL, "tiny: hole 1e-200 is refused (%s)", tr->error(sc));
+    s.r_inner = 0;
+    s.radius = 1e-310;
+    rc = tr->add_surface(sc, &s, &m);
+    CHECK(rc == TRACE_EINVAL && strstr(tr->error(sc), "out of range"),
+          "tiny: radius 1e-310 is refused (%s)", tr->error(sc));
+    trace_source g = {0};
+    g.type = TRACE_SRC_GRID;
+    g.dir[2] = 1;
+    g.radius = 1e-310;
+    g.count = 5;
+    rc = tr->add_source(sc, &g, NULL);
+    CHECK(rc == TRACE_EINVAL, "tiny: a collimated source of radius 1e-310 is refused (%s)",
+          tr->error(sc));
+    trace_source ga = {0};
+    ga.type = TRACE_SRC_GAUSSIAN;
+    ga.dir[2] = 1;
+    ga.waist = 1e-310;
+    ga.wavelength = 1e-3;
+    ga.rings = 3;
+    rc = tr->add_source(sc, &ga, NULL);
+    CHECK(rc == TRACE_EINVAL, "tiny: a Gaussian waist of 1e-310 is refused (%s)",
+          tr->error(sc));
+    tr->scene_free(sc);
+
+    /* dir 0 0 1e-170 is the +z direction, exactly */
+    sc = tr->scene_new();
+    hits k = {.n = 0};
+    trace_sink sink = {&k, NULL, on_hit, NULL};
+    trace_options o = geometry_only();
+    add_plane(sc, TRACE_DETECT, 5, 1, 1, 1);
+    trace_source c = {0};
+    c.type = TRACE_SRC_FAN;
+    c.dir[2] = 1e-170;
+    c.count = 1;
+    rc = tr->add_source(sc, &c, NULL);
+    if (rc == TRACE_OK) rc = tr->run(sc, &o, &sink, NULL);
+    CHECK(rc == TRACE_OK && k.n == 1 && k.h[0].dir[2] == 1 && k.h[0].pos[2] == 5,
+          "tiny: a direction 0 0 1e-170 is +z exactly (rc %d: %s)", rc,
+          rc ? tr->error(sc) : "ok");
+    tr->scene_free(sc);
+}
+
+/* ---- 6. sums that drift ---- */
+
+/* A collimated grid of about n rays of total power 1 onto a detector: emitted and
+ * detected are n fl(1/n) to within one rounding (computed here in long double), the
+ * balance is exact, the same bits on 1 and 2 threads. */
+static void sums(long across)
+{
+    trace_summary s[2];
+    int rc[2];
+    for (int th = 0; th < 2; th++) {
+        trace_scene *sc = tr->scene_new();
+        trace_options o = geometry_only();
+        o.threads = th + 1;
+        add_plane(sc, TRACE_DETECT, 1, 2, 1, 1);
+        trace_source g = {0};
+        g.type = TRACE_SRC_GRID;
+        g.dir[2] = 1;
+        g.radius = 1;
+        g.count = across;
+        tr->add_source(sc, &g, NULL);
+        rc[th] = tr->run(sc, &o, NULL, &s[th]);
+        tr->scene_free(sc);
+    }
+    long double each = 1.0 / (double)s[0].rays, want = each * (long double)s[0].rays;
+    double e = fabs((double)(s[0].emitted - want)), dd = fabs((double)(s[0].detected - want));
+    CHECK(rc[0] == TRACE_OK && rc[1] == TRACE_OK && e <= DBL_EPSILON && dd <= DBL_EPSILON &&
+          s[0].emitted == s[0].detected &&
+          !memcmp(&s[0].emitted, &s[1].emitted, 5 * sizeof(double)),
+          "sums: %llu rays of power 1: emitted %.17g, detected %.17g (exact n fl(1/n) = "
+          "%.17Lg, off by %.1e), same bits on 1 and 2 threads",
+          (unsigned long long)s[0].rays, s[0].emitted, s[0].detected, want, fmax(e, dd));
+}
+
+int main(void)
+{
+    tr = tt_api();
+    far_cap();
+    tiny_far_cap();
+    far_triplet();
+    huge();
+    tiny();
+    sums(SLOW_BUILD ? 400 : 3568);   /* 3568 across: 9 998 ... rays (1e7) */
+    return unit_failed();
+}
