@@ -115,15 +115,17 @@ static int tess_axial(const sc_surface *f, int level, mesh *m)
         double rin = a * (k - 1) / level, rout = a * k / level;
         while (i < (k == 1 ? 0 : nin) || j < nout) {
             double p[3], q[3], r[3];
+            /* angles by index, the seam's last index being index 0 (2 pi is not 0
+             * for sin): neighbours share their vertices bit for bit */
             double ai = 2 * PI * (double)(i + 1) / (double)nin;
             double aj = 2 * PI * (double)(j + 1) / (double)nout;
-            axial_point(f, u, v, rin, 2 * PI * (double)i / (double)nin, p);
-            axial_point(f, u, v, rout, 2 * PI * (double)j / (double)nout, q);
+            axial_point(f, u, v, rin, 2 * PI * (double)(i % nin) / (double)nin, p);
+            axial_point(f, u, v, rout, 2 * PI * (double)(j % nout) / (double)nout, q);
             if (j < nout && (k == 1 || i == nin || aj <= ai)) {
-                axial_point(f, u, v, rout, aj, r);
+                axial_point(f, u, v, rout, 2 * PI * (double)((j + 1) % nout) / (double)nout, r);
                 j++;
             } else {
-                axial_point(f, u, v, rin, ai, r);
+                axial_point(f, u, v, rin, 2 * PI * (double)((i + 1) % nin) / (double)nin, r);
                 i++;
             }
             if (put(m, p, q, r)) return -1;
@@ -172,11 +174,16 @@ static int tess_sphere(const sc_surface *f, int level, mesh *m)
         for (int j = 0; j < nlon; j++) {
             double c[4][3];   /* (i, j) (i, j+1) (i+1, j+1) (i+1, j) */
             for (int q = 0; q < 4; q++) {
-                double th = PI * (i + (q >= 2)) / level;
-                double ph = 2 * PI * (j + (q == 1 || q == 2)) / nlon;
-                c[q][0] = f->at[0] + f->radius * sin(th) * cos(ph);
-                c[q][1] = f->at[1] + f->radius * sin(th) * sin(ph);
-                c[q][2] = f->at[2] + f->radius * cos(th);
+                /* vertices by index: the seam's longitude nlon is longitude 0 and the
+                 * poles are one point each, exactly (sin(pi) and sin(2 pi) are not 0
+                 * in double: they left a hole at the pole and a crack on the seam) */
+                int a = i + (q >= 2), b = (j + (q == 1 || q == 2)) % nlon;
+                double th = PI * a / level, ph = 2 * PI * b / nlon;
+                double st = a == 0 || a == level ? 0 : sin(th);
+                double ct = a == 0 ? 1 : a == level ? -1 : cos(th);
+                c[q][0] = f->at[0] + f->radius * st * cos(ph);
+                c[q][1] = f->at[1] + f->radius * st * sin(ph);
+                c[q][2] = f->at[2] + f->radius * ct;
             }
             if (i > 0 && put_outward(m, c[0], c[1], c[2], f->at)) return -1;
             if (i < level - 1 && put_outward(m, c[0], c[2], c[3], f->at)) return -1;

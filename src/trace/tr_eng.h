@@ -24,6 +24,8 @@ typedef struct tr_surf {
     double *media;             /* mesh: ntri*2 or NULL */
     long nv, ntri;
     double eps;                /* mesh: plane distances below this are "here" */
+    int closed;                /* mesh: closed and consistently wound, its normals
+                                  outward (1) or inward (-1); 0: not known closed */
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */

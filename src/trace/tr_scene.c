@@ -176,6 +176,78 @@ static double under_gap(const tr_surf *f)
     return gap;
 }
 
+/* ---- closed meshes: a ray going into one must meet it again ---- */
+
+static uint64_t mix64(uint64_t x)
+{
+    x ^= x >> 33; x *= 0xff51afd7ed558ccdULL; x ^= x >> 33; x *= 0xc4ceb9fe1a85ec53ULL;
+    return x ^ (x >> 33);
+}
+
+/* Is the mesh closed (vertices welded where their coordinates are equal, every edge
+ * used once in each direction)?  1: its normals point outward (positive volume), -1:
+ * inward, 0: not closed, or out of memory. */
+static int mesh_closed(const tr_surf *f)
+{
+    size_t nv = (size_t)f->nv, cap = 16, ne = (size_t)f->ntri * 3, ecap = 16;
+    while (cap < 2 * nv) cap *= 2;
+    while (ecap < 2 * ne) ecap *= 2;
+    long *slot = malloc(cap * sizeof *slot);
+    uint32_t *weld = malloc(nv * sizeof *weld);
+    uint64_t *edge = malloc(ecap * sizeof *edge);
+    int closed = 0;
+    if (!slot || !weld || !edge) goto out;
+    for (size_t i = 0; i < cap; i++) slot[i] = -1;
+    for (size_t i = 0; i < nv; i++) {
+        uint64_t b[3], h = 0;
+        memcpy(b, f->vtx + 3 * i, sizeof b);
+        for (int j = 0; j < 3; j++)      /* -0 and 0 are one coordinate */
+            h = mix64(h ^ (b[j] == 0x8000000000000000ULL ? 0 : b[j]));
+        size_t k = h & (cap - 1);
+        for (;; k = (k + 1) & (cap - 1)) {
+            if (slot[k] < 0) { slot[k] = (long)i; weld[i] = (uint32_t)i; break; }
+            const double *a = f->vtx + 3 * slot[k], *c = f->vtx + 3 * i;
+            if (a[0] == c[0] && a[1] == c[1] && a[2] == c[2]) {
+                weld[i] = (uint32_t)slot[k];
+                break;
+            }
+        }
+    }
+    memset(edge, 0xff, ecap * sizeof *edge);          /* empty: all ones */
+    double vol = 0;
+    for (long t = 0; t < f->ntri; t++) {
+        uint32_t w[3];
+        for (int j = 0; j < 3; j++) w[j] = weld[f->idx[3 * t + j]];
+        const double *a = f->vtx + 3 * w[0], *b = f->vtx + 3 * w[1], *c = f->vtx + 3 * w[2];
+        double bc[3];
+        v_cross(b, c, bc);
+        vol += v_dot(a, bc);
+        for (int j = 0; j < 3; j++) {
+            uint64_t key = (uint64_t)w[j] << 32 | w[(j + 1) % 3];
+            size_t k = mix64(key) & (ecap - 1);
+            for (;; k = (k + 1) & (ecap - 1)) {
+                if (edge[k] == key) goto out;          /* an edge used twice one way */
+                if (edge[k] == UINT64_MAX) { edge[k] = key; break; }
+            }
+        }
+    }
+    for (size_t k = 0; k < ecap; k++) {                /* each edge once the other way */
+        if (edge[k] == UINT64_MAX) continue;
+        uint64_t rev = (edge[k] << 32) | (edge[k] >> 32);
+        size_t j = mix64(rev) & (ecap - 1);
+        for (;; j = (j + 1) & (ecap - 1)) {
+            if (edge[j] == rev) break;
+            if (edge[j] == UINT64_MAX) goto out;
+        }
+    }
+    closed = vol > 0 ? 1 : vol < 0 ? -1 : 0;
+out:
+    free(slot);
+    free(weld);
+    free(edge);
+    return closed;
+}
+
 int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m)
 {
     char msg[256];
@@ -253,6 +325,7 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     }
     double diag[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     f->eps = 1e-9 * v_norm(diag);
+    f->closed = mesh_closed(f);
     if (mesh->underlying) {
         if (tr_shape_init(&f->shape, mesh->underlying, sc->err, sizeof sc->err)) {
             rc = TRACE_EINVAL;
@@ -513,6 +586,39 @@ int tr_build(trace_scene *sc, double *ms)
     return TRACE_OK;
 }
 
+/* A ray that went into a closed mesh must meet it again, but Embree's float test can
+ * let a ray through exactly at a shared vertex or edge.  Then the same query is asked
+ * again with the float direction turned by 1e-6 rad four ways; the first triangle of
+ * that mesh it meets (not the one the ray left, farther than its eps in double) is the
+ * hit, its distance taken in double along the true ray. */
+static void closed_retry(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
+                         const tr_surf *m, const double o[3], const double d[3], double ta)
+{
+    double u[3], v[3], a[3] = {1, 0, 0};
+    if (fabs(d[0]) > 0.6) { a[0] = 0; a[1] = 1; }
+    v_cross(d, a, u);
+    v_unit(u);
+    v_cross(d, u, v);
+    for (int k = 0; k < 4; k++) {
+        const double *w = k < 2 ? u : v;
+        double s = k % 2 ? -1e-6 : 1e-6, dd[3];
+        for (int j = 0; j < 3; j++) dd[j] = d[j] + s * w[j];
+        struct RTCRayHit r2 = *rh;
+        r2.ray.dir_x = (float)dd[0]; r2.ray.dir_y = (float)dd[1]; r2.ray.dir_z = (float)dd[2];
+        r2.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        r2.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        int best = x->best_surf;
+        rtcIntersect1(sc->scn, &x->ec, &r2);
+        x->best_surf = best;                /* analytic hits are the true ray's already */
+        if (r2.hit.geomID != (unsigned)m->id) continue;
+        double t = tri_plane_t(m, r2.hit.primID, o, d);
+        if (!(t > m->eps) || !((float)(t - ta) <= rh->ray.tfar)) continue;
+        rh->hit = r2.hit;
+        rh->ray.tfar = (float)(t - ta);
+        return;
+    }
+}
+
 /* Nearest hit among what Embree holds, its ray starting at o + ta d; 0 if none. */
 static int embree_nearest(const trace_scene *sc, int float_hits, const double o[3],
                           const double d[3], int last_surf, long last_prim, double ta,
@@ -545,6 +651,15 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(sc->scn, &x.ec, &rh);
+    if (!float_hits && last_surf >= 0 && last_prim >= 0 &&
+        rh.hit.geomID != (unsigned)last_surf) {
+        const tr_surf *m = sc->surf[last_surf];
+        double n[3];
+        if (m->is_mesh && m->closed) {
+            tri_normal(m, last_prim, n);
+            if (v_dot(n, d) * m->closed < 0) closed_retry(sc, &x, &rh, m, o, d, ta);
+        }
+    }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
     const tr_surf *f = sc->surf[rh.hit.geomID];
     if (!f->is_mesh) {

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include "unit.h"
 #include "tt.h"
+#include "trace/scene.h"
 
 static const trace_api *tr;
 
@@ -366,6 +367,98 @@ static void sums(long across)
           (unsigned long long)s[0].rays, s[0].emitted, s[0].detected, want, fmax(e, dd));
 }
 
+/* ---- 4. meshes that leak ---- */
+
+/* Rays aimed at points of a tessellated surface (its vertices, its seam) through an
+ * index-matched mesh (refract 1 -> 1: no bending): every ray must cross it exactly
+ * `want` times (interactions = want x rays), none slipping through a hole or crack. */
+static int mesh_crossings(const sc_surface *f, int level, const trace_ray *r, int n,
+                          uint64_t *inter)
+{
+    double *tri = NULL;
+    long ntri = 0;
+    char err[SC_ERRMAX];
+    if (sc_tessellate(f, level, &tri, &ntri, err)) { printf("# %s\n", err); return -1; }
+    trace_scene *sc = tr->scene_new();
+    trace_mesh m = {tri, 3 * ntri, NULL, ntri, NULL, NULL, 0};
+    trace_material mm = mat(TRACE_REFRACT, 1, 1);
+    int rc = tr->add_mesh(sc, &m, &mm);
+    if (rc >= 0) rc = add_rays(sc, r, n);
+    trace_summary sum;
+    trace_options o = geometry_only();
+    if (rc >= 0) rc = tr->run(sc, &o, NULL, &sum);
+    *inter = rc == TRACE_OK ? sum.interactions : 0;
+    tr->scene_free(sc);
+    free(tri);
+    return rc;
+}
+
+/* The vertices of sc_tessellate's sphere at level L (as it computes them, in exact
+ * terms: latitude a pi / L, longitude b 2 pi / 2L) and the midpoints of its seam
+ * edges; rays from outside toward the centre through each. */
+static void leak_sphere(int level, int vertices)
+{
+    sc_surface f = {0};
+    f.shape = SC_SPHERE;
+    f.radius = 1;
+    int nlon = 2 * level, n = 0, cap = (level + 1) * (vertices ? nlon : 1) + 2 * level + 2;
+    trace_ray *r = calloc((size_t)cap, sizeof *r);
+    for (int a = 0; a <= level; a++)
+        for (int b = 0; b < (vertices ? nlon : 1); b++) {
+            long double th = 3.14159265358979323846264338L * a / level;
+            long double ph = 2 * 3.14159265358979323846264338L * b / nlon;
+            long double p[3] = {sinl(th) * cosl(ph), sinl(th) * sinl(ph), cosl(th)};
+            for (int k = 0; k < 2 && !(k == 1 && (a == 0 || a == level)); k++) {
+                long double q[3] = {p[0], p[1], p[2]};
+                if (k) {                       /* the midpoint of the seam edge below */
+                    if (a == level || b) break;
+                    long double t2 = 3.14159265358979323846264338L * (a + 0.5L) / level;
+                    q[0] = sinl(t2); q[1] = 0; q[2] = cosl(t2);
+                }
+                for (int j = 0; j < 3; j++) {
+                    r[n].o[j] = (double)(3 * q[j]);
+                    r[n].d[j] = (double)-q[j];
+                }
+                r[n].power = 1;
+                n++;
+            }
+        }
+    uint64_t inter;
+    int rc = mesh_crossings(&f, level, r, n, &inter);
+    CHECK(rc == TRACE_OK && inter == 2 * (uint64_t)n,
+          "watertight: a sphere tessellated at level %d: %d rays aimed at its %s cross it "
+          "twice each (%llu crossings of %d)", level, n,
+          vertices ? "vertices, poles and seam" : "poles and seam", (unsigned long long)inter,
+          2 * n);
+    free(r);
+}
+
+/* A cap tessellated at level L: rays along the axis at every vertex inside its rim
+ * (hexapolar rings, 6k vertices on ring k, the seam at angle 0) cross it once each. */
+static void leak_cap(int level)
+{
+    sc_surface f = {0};
+    f.shape = SC_CAP;
+    f.axis[2] = 1;
+    f.radius = 20;
+    f.aperture = 10;
+    int n = 0, cap = 1 + 3 * level * (level + 1);
+    trace_ray *r = calloc((size_t)cap, sizeof *r);
+    for (int k = 0; k < level; k++)           /* the rim is an open edge: not aimed at */
+        for (int j = 0; j < (k ? 6 * k : 1); j++) {
+            long double s = 10.0L * k / level, ph = 2 * 3.14159265358979323846264338L * j / (k ? 6 * k : 1);
+            r[n] = (trace_ray){{(double)(s * cosl(ph)), (double)(s * sinl(ph)), -5}, {0, 0, 1}, 1};
+            n++;
+        }
+    uint64_t inter;
+    int rc = mesh_crossings(&f, level, r, n, &inter);
+    CHECK(rc == TRACE_OK && inter == (uint64_t)n,
+          "watertight: a cap tessellated at level %d: %d rays along the axis at its "
+          "vertices cross it once each (%llu crossings)", level, n,
+          (unsigned long long)inter);
+    free(r);
+}
+
 int main(void)
 {
     tr = tt_api();
@@ -374,6 +467,10 @@ int main(void)
     far_triplet();
     huge();
     tiny();
+    leak_sphere(8, 1);
+    leak_sphere(40, 1);
+    leak_sphere(400, 0);
+    leak_cap(16);
     sums(SLOW_BUILD ? 400 : 3568);   /* 3568 across: 9 998 ... rays (1e7) */
     return unit_failed();
 }
