@@ -222,3 +222,89 @@ int sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, char
     *ntri = m.n;
     return 0;
 }
+
+/* ---- coincident surfaces ----------------------------------------------------------- */
+
+/* The same underlying surface at the same place (apertures aside)?  *flip: a plane
+ * whose normal is reversed (its n1 and n2 swap sides). */
+static int same_surface(const sc_surface *a, const sc_surface *b, int *flip)
+{
+    int axial_a = a->shape >= SC_CAP && a->shape <= SC_ASPHERE;
+    int axial_b = b->shape >= SC_CAP && b->shape <= SC_ASPHERE;
+    *flip = 0;
+    if (a->shape == SC_MESH || b->shape == SC_MESH) return 0;
+    if (a->shape != b->shape && !(axial_a && axial_b)) return 0;
+    for (int i = 0; i < 3; i++) if (a->at[i] != b->at[i]) return 0;
+    if (a->shape == SC_SPHERE) return a->radius == b->radius;
+    int same = 1, opp = 1;
+    for (int i = 0; i < 3; i++) {
+        same &= a->axis[i] == b->axis[i];
+        opp &= a->axis[i] == -b->axis[i];
+    }
+    if (a->shape == SC_PLANE) { *flip = !same && opp; return same || opp; }
+    if (!same || a->radius != b->radius || a->conic != b->conic) return 0;
+    int n = a->ncoef > b->ncoef ? a->ncoef : b->ncoef;
+    for (int i = 0; i < n; i++)
+        if ((i < a->ncoef ? a->coef[i] : 0) != (i < b->ncoef ? b->coef[i] : 0)) return 0;
+    return 1;
+}
+
+/* Their apertures: 1 the same, 0 disjoint (a disc inside an annulus's hole: a lens
+ * face and its mount), -1 overlapping in part. */
+static int same_aperture(const sc_surface *a, const sc_surface *b)
+{
+    if (a->shape == SC_SPHERE) return 1;
+    int ra = a->shape == SC_PLANE && !(a->aperture > 0), rb = b->shape == SC_PLANE && !(b->aperture > 0);
+    if (ra || rb) {
+        if (ra && rb && a->rect[0] == b->rect[0] && a->rect[1] == b->rect[1]) {
+            for (int i = 0; i < 3; i++)
+                if (fabs(a->up[i]) != fabs(b->up[i])) return -1;
+            return 1;
+        }
+        return -1;
+    }
+    if (a->aperture == b->aperture && a->hole == b->hole) return 1;
+    return a->aperture <= b->hole || b->aperture <= a->hole ? 0 : -1;
+}
+
+/* Surfaces at the same place (the same shape, position, axis and aperture) are traced
+ * as one interface, each in turn in the order they are listed (a ray going along the
+ * axis, or into a sphere, meets the first one first); refracting ones must then chain
+ * their media, n1 -> n -> n2.  Refused, with both lines: a chain that breaks, and the
+ * same surface listed twice with apertures that overlap only in part. */
+int sc_check_coincident(const sc_scene *sc, char *err)
+{
+    static const char *names[] = {"plane", "sphere", "cap", "conic", "asphere", "mesh"};
+    for (int i = 0; i < sc->nsurf; i++)
+        for (int j = i + 1; j < sc->nsurf; j++) {
+            const sc_surface *a = &sc->surf[i], *b = &sc->surf[j];
+            int flip, ap;
+            if (!same_surface(a, b, &flip) || (ap = same_aperture(a, b)) == 0) continue;
+            if (ap < 0) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this %s lies on the %s of line %ld with "
+                         "an aperture that overlaps it only in part: give coincident surfaces "
+                         "the same aperture, or apertures that do not overlap",
+                         b->src, b->line, names[b->shape], names[a->shape], a->line);
+                return -1;
+            }
+            if (a->tessellate || b->tessellate) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this %s coincides with the %s of line "
+                         "%ld: coincident surfaces are taken in order only as analytic "
+                         "surfaces (drop tessellate)", b->src, b->line, names[b->shape],
+                         names[a->shape], a->line);
+                return -1;
+            }
+            if (a->kind != SC_REFRACT || b->kind != SC_REFRACT) continue;
+            /* the medium between them: a's n2 (or, a reversed plane, its n1) */
+            double bn1 = flip ? b->n2 : b->n1;
+            if (a->n2 != bn1) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this %s coincides with the %s of line "
+                         "%ld and their media do not chain: %g -> %g there, then %g -> %g "
+                         "here (coincident surfaces are one interface, taken in the "
+                         "order listed: n1 -> n -> n2)", b->src, b->line, names[b->shape],
+                         names[a->shape], a->line, a->n1, a->n2, bn1, flip ? b->n1 : b->n2);
+                return -1;
+            }
+        }
+    return 0;
+}

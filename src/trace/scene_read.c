@@ -912,6 +912,7 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
     if (st < 0) goto bad;
     if (!sc->nsurf) { fail(&r, "the scene has no surface"); goto bad; }
     if (!sc->nsource) { fail(&r, "the scene has no source of rays"); goto bad; }
+    if (sc_check_coincident(sc, err)) goto bad;     /* with both lines */
     return 0;
 bad:
     sc_free(sc);

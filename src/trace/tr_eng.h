@@ -30,6 +30,10 @@ typedef struct tr_surf {
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */
     double pad;                /* analytic: its Embree box grows by this (tr_build) */
+    int group, gprev, gnext;   /* analytic surfaces at the same place (the same shape,
+                                  position, axis and aperture): the group's first
+                                  member, the members before and after it in the
+                                  order they were added; -1: none (tr_build) */
 } tr_surf;
 
 /* Embree sees coordinates in single precision: surfaces reaching beyond TR_EMBREE_MAX
@@ -50,6 +54,7 @@ struct trace_scene {
     double build_ms;
     int *far, nfar;            /* surfaces outside Embree's range, tested in double */
     int nembree;               /* surfaces Embree holds */
+    int ngroup;                /* surfaces in a group of coincident ones */
     double elo[3], ehi[3];     /* ... their box, grown by epad */
     double epad;               /* how far a float ray may stray from the double one */
     int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */

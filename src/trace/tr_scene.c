@@ -396,6 +396,14 @@ static void front_normal(const tr_shape *g, double n[3])
     if (g->shape != TRACE_SPHERE) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
 }
 
+/* Does a ray that left surface `last` leave f too (f itself, or coincident with it)?
+ * Its root at t = 0 is then excluded exactly. */
+static inline int leaves(const trace_scene *sc, int last, const tr_surf *f)
+{
+    return last == f->id ||
+           (last >= 0 && f->group >= 0 && sc->surf[last]->group == f->group);
+}
+
 static void user_intersect(const struct RTCIntersectFunctionNArguments *a)
 {
     if (a->N != 1 || !a->valid[0]) return;
@@ -403,7 +411,7 @@ static void user_intersect(const struct RTCIntersectFunctionNArguments *a)
     const tr_surf *f = a->geometryUserPtr;
     struct RTCRayHit *rh = (struct RTCRayHit *)a->rayhit;
     double t, n[3], p[3];
-    int leaving = x->last_surf == f->id, ok;
+    int leaving = leaves(x->sc, x->last_surf, f), ok;
     if (x->float_hits) ok = tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n);
     else if ((ok = tr_shape_hit_t(&f->shape, x->o, x->d, leaving, &t, p)))
         tr_shape_hit_normal(&f->shape, p, n);
@@ -497,6 +505,54 @@ static int attach_user(trace_scene *sc, tr_surf *f)
     return 0;
 }
 
+/* The same surface at the same place (every figure equal; a plane also with its
+ * normal reversed)? */
+static int same_place(const tr_shape *a, const tr_shape *b)
+{
+    if (a->shape != b->shape || a->aperture != b->aperture || a->nasph != b->nasph)
+        return 0;
+    for (int i = 0; i < 3; i++) if (a->at[i] != b->at[i]) return 0;
+    int flip = a->shape == TRACE_PLANE && a->w[0] == -b->w[0] && a->w[1] == -b->w[1] &&
+               a->w[2] == -b->w[2];
+    if (!flip && a->shape != TRACE_SPHERE)
+        for (int i = 0; i < 3; i++) if (a->w[i] != b->w[i]) return 0;
+    if (a->radius != b->radius || a->c != b->c || a->k != b->k ||
+        a->r_outer2 != b->r_outer2 || a->r_inner2 != b->r_inner2 || a->hw != b->hw ||
+        a->hh != b->hh)
+        return 0;
+    for (int i = 0; i < a->nasph; i++) if (a->asph[i] != b->asph[i]) return 0;
+    if (a->aperture == TRACE_AP_RECT)       /* the same rectangle, or turned by pi */
+        for (int i = 0; i < 3; i++)
+            if (fabs(a->u[i]) != fabs(b->u[i]) || fabs(a->v[i]) != fabs(b->v[i])) return 0;
+    return 1;
+}
+
+/* Groups of coincident analytic surfaces, their members in the order they were added:
+ * a ray that meets one meets the others at the same point, one after the other (see
+ * tr_find_hit).  The lens shortcut does not know them: a scene with any is traced
+ * through Embree alone. */
+static void group_coincident(trace_scene *sc)
+{
+    sc->ngroup = 0;
+    for (int i = 0; i < sc->nsurf; i++) {
+        tr_surf *f = sc->surf[i];
+        f->group = f->gprev = f->gnext = -1;
+        if (f->is_mesh) continue;
+        for (int j = i - 1; j >= 0; j--) {
+            tr_surf *g = sc->surf[j];
+            if (g->is_mesh || !same_place(&f->shape, &g->shape)) continue;
+            if (g->group < 0) { g->group = j; sc->ngroup++; }
+            while (g->gnext >= 0) g = sc->surf[g->gnext];   /* the group's last member */
+            f->group = g->group;
+            f->gprev = g->id;
+            g->gnext = f->id;
+            sc->ngroup++;
+            break;
+        }
+    }
+    if (sc->ngroup) sc->seq_nsurf = -1;
+}
+
 /* Within the range Embree's single precision serves (meshes always are: add_mesh
  * refuses vertices beyond it)? */
 static int in_range(const tr_surf *f)
@@ -564,6 +620,7 @@ int tr_build(trace_scene *sc, double *ms)
         return fail(sc, TRACE_ENOMEM, "out of memory");
     }
     embree_box(sc);
+    group_coincident(sc);
     for (int i = 0; i < sc->nsurf; i++) {
         tr_surf *f = sc->surf[i];
         if (!f->is_mesh && !in_range(f)) { sc->far[sc->nfar++] = i; continue; }
@@ -738,7 +795,7 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
     for (int i = 0; i < sc->nfar; i++) {
         const tr_surf *f = sc->surf[sc->far[i]];
         double t, n[3], p[3];
-        int ok = tr_shape_hit_t(&f->shape, o, d, last_surf == f->id, &t, p);
+        int ok = tr_shape_hit_t(&f->shape, o, d, leaves(sc, last_surf, f), &t, p);
         if (!ok || (got && !(t < h->t))) continue;
         tr_shape_hit_normal(&f->shape, p, n);
         front_normal(&f->shape, n);
@@ -815,6 +872,47 @@ static inline void seq_normal(const trace_scene *sc, tr_hitrec *h, const double 
     front_normal(g, h->n);
 }
 
+/* A ray leaving a member of a group of coincident surfaces at org meets the next
+ * member in its direction there, at t = 0: going to the back side of the group's
+ * first member, the one added after `last`, else the one before.  1 and the hit, or
+ * 0 when it has passed them all. */
+static int coincident_next(const trace_scene *sc, const double org[3], const double d[3],
+                           int last, tr_hitrec *h)
+{
+    const tr_surf *f = sc->surf[last], *g0 = sc->surf[f->group];
+    double nb[3];
+    tr_shape_normal(&g0->shape, org, nb);
+    if (g0->shape.shape == TRACE_SPHERE) { nb[0] = -nb[0]; nb[1] = -nb[1]; nb[2] = -nb[2]; }
+    double dn = v_dot(d, nb);
+    int next = dn > 0 ? f->gnext : dn < 0 ? f->gprev : -1;
+    if (next < 0) return 0;
+    const tr_surf *g = sc->surf[next];
+    h->surf = next;
+    h->prim = -1;
+    h->t = 0;
+    h->far = 0;
+    tr_shape_normal(&g->shape, org, h->n);
+    front_normal(&g->shape, h->n);
+    return 1;
+}
+
+/* A ray that meets a group of coincident surfaces (any member: they tie) meets its
+ * first member first when it goes to the group's back side, else its last. */
+static void coincident_first(const trace_scene *sc, const double d[3], tr_hitrec *h)
+{
+    const tr_surf *f = sc->surf[h->surf], *g = sc->surf[f->group], *head = g;
+    /* h->n is f's front normal; a plane may face the other way from the group's head */
+    int opp_f = f->shape.shape == TRACE_PLANE && v_dot(f->shape.w, head->shape.w) < 0;
+    double s = opp_f ? -1 : 1;
+    int back = -s * v_dot(d, h->n) > 0;          /* toward the head's back side */
+    if (!back) while (g->gnext >= 0) g = sc->surf[g->gnext];
+    if (g == f) return;
+    int opp_g = g->shape.shape == TRACE_PLANE && v_dot(g->shape.w, head->shape.w) < 0;
+    if (opp_f != opp_g)
+        for (int i = 0; i < 3; i++) h->n[i] = -h->n[i];
+    h->surf = g->id;
+}
+
 /* The lens shortcut (the same hits, bit for bit), else Embree. */
 int tr_find_hit(const trace_scene *sc, const trace_options *o, const double org[3],
                     const double d[3], int last, long last_prim, uint32_t hist,
@@ -824,10 +922,16 @@ int tr_find_hit(const trace_scene *sc, const trace_options *o, const double org[
     const tr_shape *const *cg;
     int nc;
     double bp[3] = {0, 0, 0};
+    if (last >= 0 && sc->ngroup && sc->surf[last]->group >= 0 &&
+        coincident_next(sc, org, d, last, h))
+        return 1;
     if (seq_cands(sc, o, org, d, last, hist, &cand, &cg, &nc) &&
         seq_hit(cand, cg, nc, last, org, d, h, bp)) {
         seq_normal(sc, h, bp);
         return 1;
     }
-    return nearest(sc, o->float_hits, org, d, last, last_prim, h);
+    if (!nearest(sc, o->float_hits, org, d, last, last_prim, h)) return 0;
+    if (sc->ngroup && h->prim < 0 && sc->surf[h->surf]->group >= 0)
+        coincident_first(sc, d, h);
+    return 1;
 }
