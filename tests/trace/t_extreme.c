@@ -273,6 +273,94 @@ static void huge(void)
     }
 }
 
+/* ---- 3. coincident surfaces ---- */
+
+/* Fresnel power transmittances at incidence angle cos ci from n1 into n2. */
+static void fresnel_T(long double n1, long double n2, long double ci, long double *Ts,
+                      long double *Tp)
+{
+    long double st = n1 / n2 * sqrtl(1 - ci * ci), ct = sqrtl(1 - st * st);
+    long double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
+    long double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
+    *Ts = 1 - rs * rs;
+    *Tp = 1 - rp * rp;
+}
+
+/* Two planes at one z, refract 1 1.5 then 1.5 1: a ray at 45 degrees meets both,
+ * in order, from either side: T = (Ts^2 + Tp^2) / 2 without reflected rays, and
+ * (1 - Rs)/(1 + Rs) and (1 - Rp)/(1 + Rp) averaged with them (the zero-thickness
+ * layer's incoherent sum), its direction unchanged. */
+static void coincident_planes(void)
+{
+    long double Ts, Tp;
+    fresnel_T(1, 1.5L, sqrtl(0.5L), &Ts, &Tp);
+    long double t1 = (Ts * Ts + Tp * Tp) / 2;
+    long double t2 = ((Ts / (2 - Ts)) + (Tp / (2 - Tp))) / 2;   /* (1-R)/(1+R) */
+    for (int refl = 0; refl < 2; refl++)
+        for (int back = 0; back < 2; back++) {
+            trace_scene *sc = tr->scene_new();
+            hits k = {.n = 0};
+            trace_sink sink = {&k, NULL, on_hit, NULL};
+            trace_options o;
+            tr->options_default(&o);
+            o.threads = 1;
+            o.reflections = refl;
+            o.cutoff = 0;
+            o.max_depth = 40;
+            add_plane(sc, TRACE_REFRACT, 0, 5, 1, 1.5);
+            add_plane(sc, TRACE_REFRACT, 0, 5, 1.5, 1);
+            add_plane(sc, TRACE_DETECT, back ? -10 : 10, 100, 1, 1);
+            double z0 = back ? 10 : -10, dz = back ? -1 : 1;
+            trace_ray r = {{0, -10, z0}, {0, sqrt(0.5), dz * sqrt(0.5)}, 1};
+            add_rays(sc, &r, 1);
+            trace_summary sum;
+            int rc = tr->run(sc, &o, &sink, &sum);
+            double want = (double)(refl ? t2 : t1), e = fabs(sum.detected - want);
+            double de = k.n ? fabs(k.h[0].dir[1] - sqrt(0.5)) : 1;
+            /* with reflections the layer's bounces go on to the depth limit (cutoff 0),
+             * the last of them far below rounding */
+            CHECK(rc == TRACE_OK && e <= 1e-15 && (refl || sum.cut_depth == 0) &&
+                  sum.medium_mismatch == 0 && (refl || (k.n == 1 && de <= 1e-15)),
+                  "coincident: planes 1 -> 1.5 -> 1 at one z, a ray from the %s, reflections "
+                  "%s: T = %.17g, exact %.17g (%.1e); %d interactions",
+                  back ? "back" : "front", refl ? "on" : "off", sum.detected, want, e,
+                  (int)sum.interactions);
+            tr->scene_free(sc);
+        }
+}
+
+/* A cemented interface as two caps sharing vertex and radius, 1 -> 1.5 -> 1.6: the
+ * rays leave bent as by one interface 1 -> 1.6 (Snell's law chains), none trapped. */
+static void coincident_caps(void)
+{
+    trace_scene *sc = tr->scene_new();
+    hits k = {.n = 0};
+    trace_sink sink = {&k, NULL, on_hit, NULL};
+    trace_options o = geometry_only();
+    add_cap(sc, TRACE_REFRACT, 0, 20, 5, 1, 1.5);
+    add_cap(sc, TRACE_REFRACT, 0, 20, 5, 1.5, 1.6);
+    add_plane(sc, TRACE_DETECT, 30, 100, 1.6, 1.6);
+    trace_ray r[5];
+    for (int i = 0; i < 5; i++) r[i] = (trace_ray){{0, i - 2.0, -5}, {0, 0, 1}, 1};
+    add_rays(sc, r, 5);
+    trace_summary sum;
+    int rc = tr->run(sc, &o, &sink, &sum);
+    double worst = 0;
+    for (int i = 0; i < k.n && i < 5; i++) {
+        long double h = fabsl((long double)k.h[i].pos[1]), want = 0;
+        long double y0 = r[k.h[i].ray].o[1];
+        want = cap_exact_x(y0, 20, 1, 1.6L, 30);
+        worst = fmax(worst, fabs((double)((long double)k.h[i].pos[1] - want)));
+        (void)h;
+    }
+    CHECK(rc == TRACE_OK && k.n == 5 && sum.interactions == 10 && sum.cut_depth == 0 &&
+          worst <= 1e-13,
+          "coincident: caps 1 -> 1.5 -> 1.6 sharing vertex and radius bend 5 rays as one "
+          "interface 1 -> 1.6 (detector y to %.1e of the exact; %d interactions)", worst,
+          (int)sum.interactions);
+    tr->scene_free(sc);
+}
+
 /* ---- 5. underflow, overflow ---- */
 
 static void tiny(void)
@@ -466,6 +554,8 @@ int main(void)
     tiny_far_cap();
     far_triplet();
     huge();
+    coincident_planes();
+    coincident_caps();
     tiny();
     leak_sphere(8, 1);
     leak_sphere(40, 1);
