@@ -116,9 +116,9 @@ static void far_cap(void)
         int rc = tr->run(sc, &o, &sink, NULL);
         double got = k.n == 1 ? k.h[0].pos[0] : NAN;
         double rel = fabs((double)(got - want) / (double)want);
-        CHECK(rc == TRACE_OK && k.n == 1 && rel <= 1e-14,
+        CHECK(rc == TRACE_OK && k.n == 1 && rel <= 1e-15,
               "far start: a cap R 50 met by a ray from %g before it: detector x %.17g, "
-              "exact %.17Lg (%.1e relative, <= 1e-14)", L[i], got, want, rel);
+              "exact %.17Lg (%.1e relative, <= 1e-15)", L[i], got, want, rel);
         tr->scene_free(sc);
     }
 }
