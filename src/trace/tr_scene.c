@@ -643,11 +643,13 @@ int tr_build(trace_scene *sc, double *ms)
     return TRACE_OK;
 }
 
-/* A ray that went into a closed mesh must meet it again, but Embree's float test can
- * let a ray through exactly at a shared vertex or edge.  Then the same query is asked
- * again with the float direction turned by 1e-6 rad four ways; the first triangle of
- * that mesh it meets (not the one the ray left, farther than its eps in double) is the
- * hit, its distance taken in double along the true ray. */
+/* A ray that went into a closed mesh must meet it again, and one that meets a closed
+ * mesh from inside must have gone in; but Embree's float test can let a ray through
+ * exactly at a shared vertex or edge.  Then the same query is asked again with the
+ * float direction turned by 1e-6 rad four ways; the first triangle of that mesh it
+ * meets nearer than the hit in hand (not the one the ray left, nor the one in hand,
+ * farther than the mesh's eps in double) is the hit, its distance taken in double
+ * along the true ray. */
 static void closed_retry(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
                          const tr_surf *m, const double o[3], const double d[3], double ta)
 {
@@ -667,7 +669,9 @@ static void closed_retry(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         int best = x->best_surf;
         rtcIntersect1(sc->scn, &x->ec, &r2);
         x->best_surf = best;                /* analytic hits are the true ray's already */
-        if (r2.hit.geomID != (unsigned)m->id) continue;
+        if (r2.hit.geomID != (unsigned)m->id ||
+            (rh->hit.geomID == (unsigned)m->id && r2.hit.primID == rh->hit.primID))
+            continue;
         double t = tri_plane_t(m, r2.hit.primID, o, d);
         if (!(t > m->eps) || !((float)(t - ta) <= rh->ray.tfar)) continue;
         rh->hit = r2.hit;
@@ -715,6 +719,17 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
         if (m->is_mesh && m->closed) {
             tri_normal(m, last_prim, n);
             if (v_dot(n, d) * m->closed < 0) closed_retry(sc, &x, &rh, m, o, d, ta);
+        }
+    }
+    /* ... and one that leaves a closed mesh it never went into may have slipped in
+     * through a shared vertex or edge: is there a nearer entry? */
+    if (!float_hits && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID &&
+        rh.hit.geomID != (unsigned)last_surf) {
+        const tr_surf *m = sc->surf[rh.hit.geomID];
+        double n[3];
+        if (m->is_mesh && m->closed) {
+            tri_normal(m, rh.hit.primID, n);
+            if (v_dot(n, d) * m->closed > 0) closed_retry(sc, &x, &rh, m, o, d, ta);
         }
     }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
