@@ -30,6 +30,7 @@ typedef struct tr_surf {
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */
     double pad;                /* analytic: its Embree box grows by this (tr_build) */
+    const double *eoff;        /* ... and moves by minus the scene's eoff */
     int group, gprev, gnext;   /* analytic surfaces at the same place (the same shape,
                                   position, axis and aperture): the group's first
                                   member, the members before and after it in the
@@ -57,6 +58,9 @@ struct trace_scene {
     int ngroup;                /* surfaces in a group of coincident ones */
     double elo[3], ehi[3];     /* ... their box, grown by epad */
     double epad;               /* how far a float ray may stray from the double one */
+    double eoff[3];            /* Embree's coordinates are the world's minus this (the
+                                  centre of its box): a scene far from the origin keeps
+                                  single precision's digits for its own size */
     int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
     int entry[4], nentry;      /* lens: what a forward ray from left of it meets first */
     const tr_shape *entryg[4];

@@ -381,13 +381,14 @@ static void embree_error(void *user, enum RTCError code, const char *str)
 static void user_bounds(const struct RTCBoundsFunctionArguments *a)
 {
     const tr_surf *f = a->geometryUserPtr;
+    const double *c = f->eoff;
     struct RTCBounds *b = a->bounds_o;
-    b->lower_x = nextafterf((float)(f->shape.lo[0] - f->pad), -INFINITY);
-    b->lower_y = nextafterf((float)(f->shape.lo[1] - f->pad), -INFINITY);
-    b->lower_z = nextafterf((float)(f->shape.lo[2] - f->pad), -INFINITY);
-    b->upper_x = nextafterf((float)(f->shape.hi[0] + f->pad), INFINITY);
-    b->upper_y = nextafterf((float)(f->shape.hi[1] + f->pad), INFINITY);
-    b->upper_z = nextafterf((float)(f->shape.hi[2] + f->pad), INFINITY);
+    b->lower_x = nextafterf((float)(f->shape.lo[0] - c[0] - f->pad), -INFINITY);
+    b->lower_y = nextafterf((float)(f->shape.lo[1] - c[1] - f->pad), -INFINITY);
+    b->lower_z = nextafterf((float)(f->shape.lo[2] - c[2] - f->pad), -INFINITY);
+    b->upper_x = nextafterf((float)(f->shape.hi[0] - c[0] + f->pad), INFINITY);
+    b->upper_y = nextafterf((float)(f->shape.hi[1] - c[1] + f->pad), INFINITY);
+    b->upper_z = nextafterf((float)(f->shape.hi[2] - c[2] + f->pad), INFINITY);
 }
 
 /* Front-facing unit normal of an analytic surface from tr_shape_hit's. */
@@ -480,7 +481,7 @@ static int attach_mesh(trace_scene *sc, tr_surf *f)
     unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                            3 * sizeof(unsigned), (size_t)f->ntri);
     if (!v || !ix) { rtcReleaseGeometry(g); return -1; }
-    for (long i = 0; i < 3 * f->nv; i++) v[i] = (float)f->vtx[i];
+    for (long i = 0; i < 3 * f->nv; i++) v[i] = (float)(f->vtx[i] - sc->eoff[i % 3]);
     memcpy(ix, f->idx, (size_t)f->ntri * 3 * sizeof(unsigned));
     rtcSetGeometryUserData(g, f);
     rtcSetGeometryIntersectFilterFunction(g, mesh_filter);
@@ -565,7 +566,8 @@ static int in_range(const tr_surf *f)
 }
 
 /* The box of what Embree holds, and how far its float ray may stray from the double
- * one inside it: the origin rounds to half an ulp of the largest coordinate M, the
+ * one inside it: Embree's coordinates are the world's less the box's centre (eoff),
+ * the origin rounds to half an ulp of the largest of those coordinates M, the
  * direction to half an ulp of each component, over at most the box's diagonal D.
  * Every analytic surface's box grows by eight times that (a ray that meets the surface
  * in double is always offered to it); the box itself by as much again. */
@@ -590,7 +592,8 @@ static void embree_box(trace_scene *sc)
     double m = 0, d[3];
     for (int j = 0; j < 3; j++) {
         if (!(lo[j] <= hi[j])) { lo[j] = hi[j] = 0; }
-        m = fmax(m, fmax(fabs(lo[j]), fabs(hi[j])));
+        sc->eoff[j] = lo[j] / 2 + hi[j] / 2;
+        m = fmax(m, fmax(fabs(lo[j] - sc->eoff[j]), fabs(hi[j] - sc->eoff[j])));
         d[j] = hi[j] - lo[j];
     }
     sc->epad = 8 * FLT_EPSILON * (m + v_norm(d)) + 1e-300;
@@ -625,6 +628,7 @@ int tr_build(trace_scene *sc, double *ms)
         tr_surf *f = sc->surf[i];
         if (!f->is_mesh && !in_range(f)) { sc->far[sc->nfar++] = i; continue; }
         f->pad = sc->epad;
+        f->eoff = sc->eoff;
         sc->nembree++;
         int rc = f->is_mesh ? attach_mesh(sc, f) : attach_user(sc, f);
         if (rc) {
@@ -698,9 +702,9 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     x.best_t = INFINITY;
     x.best_far = 0;
     x.ta = ta;
-    rh.ray.org_x = (float)(o[0] + ta * d[0]);
-    rh.ray.org_y = (float)(o[1] + ta * d[1]);
-    rh.ray.org_z = (float)(o[2] + ta * d[2]);
+    rh.ray.org_x = (float)(o[0] + ta * d[0] - sc->eoff[0]);
+    rh.ray.org_y = (float)(o[1] + ta * d[1] - sc->eoff[1]);
+    rh.ray.org_z = (float)(o[2] + ta * d[2] - sc->eoff[2]);
     rh.ray.dir_x = (float)d[0]; rh.ray.dir_y = (float)d[1]; rh.ray.dir_z = (float)d[2];
     rh.ray.tnear = 0;
     rh.ray.tfar = INFINITY;
@@ -805,8 +809,10 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
 {
     double ta;
     int got = 0;
+    /* (float_hits compares with a float-only tracer: its float ray starts at o) */
     if (sc->nembree && slab(sc->elo, sc->ehi, o, d, &ta))
-        got = embree_nearest(sc, float_hits, o, d, last_surf, last_prim, ta, h);
+        got = embree_nearest(sc, float_hits, o, d, last_surf, last_prim,
+                             float_hits ? 0 : ta, h);
     for (int i = 0; i < sc->nfar; i++) {
         const tr_surf *f = sc->surf[sc->far[i]];
         double t, n[3], p[3];
