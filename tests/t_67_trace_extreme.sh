@@ -114,3 +114,15 @@ x_far_tess() {
              END { exit bad }' "$XW/faran/h.csv" "$XW/farts/h.csv"
 }
 check "extreme: a tessellated singlet at x = 1e7 hits where the analytic one does (to 4e-9)" x_far_tess
+
+# crossing surfaces: refracting planes that cross inside both apertures are refused,
+# mirrors may meet, planes whose apertures end before the line they share pass
+xscene crossing 'plane refract 1 1.5 at 0 0 0 normal 0 0 1 disc 5' \
+    'plane refract 1.5 1 at 0 0 1 normal 0 1 1 rect 4 4' 'source ray from 0 0 -1 dir 0 0 1'
+check "extreme: refracting planes that cross inside their apertures are refused with both lines" \
+    x_refused crossing "crossing.scene:2: this refracting plane crosses the one of line 1"
+xscene apart 'plane refract 1 1.5 at 0 0 0 normal 0 0 1 disc 5' \
+    'plane refract 1.5 1 at 0 0 10 normal 0 0.2 1 disc 5' 'plane detect at 0 0 40 normal 0 0 1 disc 99' \
+    'source ray from 0 0 -1 dir 0 0 1' 'reflections off'
+check "extreme: refracting planes whose apertures do not reach their common line are traced" \
+    x_traced apart 1

@@ -267,11 +267,61 @@ static int same_aperture(const sc_surface *a, const sc_surface *b)
     return a->aperture <= b->hole || b->aperture <= a->hole ? 0 : -1;
 }
 
+/* Where the line p0 + s e (in plane f) runs inside f's disc or rectangle: [*s0, *s1],
+ * or 0 if it misses it. */
+static int plane_chord(const sc_surface *f, const double *p0, const double *e, double *s0,
+                       double *s1)
+{
+    double q[3] = {p0[0] - f->at[0], p0[1] - f->at[1], p0[2] - f->at[2]};
+    if (f->aperture > 0) {
+        double b = g_dot(e, q), c = g_dot(q, q) - f->aperture * f->aperture;
+        double disc = b * b - c;
+        if (!(disc > 0)) return 0;
+        *s0 = -b - sqrt(disc);
+        *s1 = -b + sqrt(disc);
+        return 1;
+    }
+    double u[3], lo = -INFINITY, hi = INFINITY;
+    g_cross(f->up, f->axis, u);
+    const double *ax[2] = {u, f->up};
+    for (int k = 0; k < 2; k++) {
+        double x = g_dot(q, ax[k]), dx = g_dot(e, ax[k]), h = f->rect[k] / 2;
+        if (dx == 0) { if (fabs(x) > h) return 0; continue; }
+        double a = (-h - x) / dx, b = (h - x) / dx;
+        if (a > b) { double t = a; a = b; b = t; }
+        if (a > lo) lo = a;
+        if (b < hi) hi = b;
+    }
+    if (!(lo < hi)) return 0;
+    *s0 = lo;
+    *s1 = hi;
+    return 1;
+}
+
+/* Two refracting planes that cross each other inside both apertures (the media
+ * between them would depend on which side of the other each ray is)? */
+static int planes_cross(const sc_surface *a, const sc_surface *b)
+{
+    double e[3], p0[3], m[3], n[3], sa0, sa1, sb0, sb1;
+    g_cross(a->axis, b->axis, e);
+    double ee = g_dot(e, e);
+    if (!(ee > 1e-24)) return 0;                       /* parallel */
+    double da = g_dot(a->axis, a->at), db = g_dot(b->axis, b->at);
+    g_cross(b->axis, e, m);
+    g_cross(e, a->axis, n);
+    for (int i = 0; i < 3; i++) p0[i] = (da * m[i] + db * n[i]) / ee;
+    g_unit(e);
+    if (!plane_chord(a, p0, e, &sa0, &sa1) || !plane_chord(b, p0, e, &sb0, &sb1)) return 0;
+    double lo = fmax(sa0, sb0), hi = fmin(sa1, sb1), size = (sa1 - sa0) + (sb1 - sb0);
+    return hi - lo > 1e-9 * size;
+}
+
 /* Surfaces at the same place (the same shape, position, axis and aperture) are traced
  * as one interface, each in turn in the order they are listed (a ray going along the
  * axis, or into a sphere, meets the first one first); refracting ones must then chain
- * their media, n1 -> n -> n2.  Refused, with both lines: a chain that breaks, and the
- * same surface listed twice with apertures that overlap only in part. */
+ * their media, n1 -> n -> n2.  Refused, with both lines: a chain that breaks, the
+ * same surface listed twice with apertures that overlap only in part, coincident
+ * tessellated surfaces, and refracting planes that cross inside both apertures. */
 int sc_check_coincident(const sc_scene *sc, char *err)
 {
     static const char *names[] = {"plane", "sphere", "cap", "conic", "asphere", "mesh"};
@@ -279,6 +329,14 @@ int sc_check_coincident(const sc_scene *sc, char *err)
         for (int j = i + 1; j < sc->nsurf; j++) {
             const sc_surface *a = &sc->surf[i], *b = &sc->surf[j];
             int flip, ap;
+            if (a->shape == SC_PLANE && b->shape == SC_PLANE && a->kind == SC_REFRACT &&
+                b->kind == SC_REFRACT && planes_cross(a, b)) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this refracting plane crosses the one of "
+                         "line %ld inside both their apertures: which medium lies between "
+                         "them is ambiguous (end one where it meets the other)", b->src,
+                         b->line, a->line);
+                return -1;
+            }
             if (!same_surface(a, b, &flip) || (ap = same_aperture(a, b)) == 0) continue;
             if (ap < 0) {
                 snprintf(err, SC_ERRMAX, "%s:%ld: this %s lies on the %s of line %ld with "
