@@ -1,8 +1,8 @@
 /* tr_eng.h -- private to the engine's core files: the scene as the trace loop sees it
- * (tr_scene.c builds it on Embree and answers "which surface next"), a ray's working
- * state and books (tr_trace.c, the recursive trace loop), the lanes of the packet path
- * (tr_lanes.c) and the worker the thread pool hands batches to (tr_pool.c).  The
- * exported table is in tr_engine.c. */
+ * (tr_scene.c builds it on Embree, tr_hit.c answers "which surface next"), a ray's
+ * working state and books (tr_trace.c, the recursive trace loop), the lanes of the
+ * packet path (tr_lanes.c) and the worker the thread pool hands batches to
+ * (tr_pool.c).  The exported table is in tr_engine.c. */
 #ifndef TR_ENG_H
 #define TR_ENG_H
 #include <embree3/rtcore.h>
@@ -195,6 +195,11 @@ int tr_add_surface(trace_scene *sc, const trace_surface *s, const trace_material
 int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m);
 int tr_add_source(trace_scene *sc, const trace_source *s, uint64_t *first);
 int tr_build(trace_scene *sc, double *ms);
+/* ---- the next hit (tr_hit.c) ---- */
+/* Embree's callbacks (tr_build attaches them). */
+void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a);
+void tr_user_occluded(const struct RTCOccludedFunctionNArguments *a);
+void tr_mesh_filter(const struct RTCFilterFunctionNArguments *a);
 /* The next surface a ray meets: the lens shortcut (the same hits, bit for bit), else
  * Embree; 0 if none. */
 int tr_find_hit(const trace_scene *sc, const trace_options *o, const double org[3],

@@ -1,8 +1,8 @@
 /* tr_int.h -- private to the trace engine's own files (tr_*.c); callers use trace.h.
  * Analytic surfaces in double (tr_geom.c), optics (tr_optics.c), sources
- * (tr_source.c), the scene on Embree (tr_scene.c), the trace loop (tr_trace.c, tr_lanes.c,
- * tr_pool.c: tr_eng.h), the table (tr_engine.c), sequential
- * lenses (tr_lens.c). */
+ * (tr_source.c), the scene on Embree (tr_scene.c) and its next-hit query (tr_hit.c), the
+ * trace loop (tr_trace.c, tr_lanes.c, tr_pool.c: tr_eng.h), the table (tr_engine.c),
+ * sequential lenses (tr_lens.c). */
 #ifndef TR_INT_H
 #define TR_INT_H
 #include <math.h>
