@@ -299,7 +299,9 @@ static int plane_hit(const tr_shape *g, const double o[3], const double d[3],
 static int sphere_hit(const tr_shape *g, const double o[3], const double d[3],
                       int leaving, double *t, double p[3])
 {
-    double q[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
+    double q[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]}, t0 = 0;
+    if (!leaving && (t0 = tr_advance(g, q, d)) > 0)     /* a far start: see tr_int.h */
+        for (int i = 0; i < 3; i++) q[i] += t0 * d[i];
     double A = v_dot(d, d), B = v_dot(q, d), R = g->radius;
     double l[3] = {q[0] - B / A * d[0], q[1] - B / A * d[1], q[2] - B / A * d[2]};
     double h2 = R * R - v_dot(l, l);
@@ -314,8 +316,8 @@ static int sphere_hit(const tr_shape *g, const double o[3], const double d[3],
     else if (r[1] > 0) tt = r[1];
     if (!(tt > 0)) return 0;
     for (int i = 0; i < 3; i++) p[i] = q[i] + tt * d[i];
-    *t = tt;
-    return 1;
+    *t = t0 + tt;
+    return t0 > 0 ? 2 : 1;
 }
 
 static void axial_normal_local(const tr_shape *g, const double p[3], double nl[3])
