@@ -675,13 +675,17 @@ static void leak_icosphere(int level)
     trace_material mm = mat(TRACE_REFRACT, 1, 1);
     int rc = tr->add_mesh(sc, &mesh, &mm);
     if (rc >= 0) rc = add_rays(sc, r, (int)m.nv);
-    trace_summary sum = {0};
+    trace_summary sum = {0}, one = {0};
     trace_options o = geometry_only();
-    o.threads = 0;
+    o.threads = 2;
     if (rc >= 0) rc = tr->run(sc, &o, NULL, &sum);
-    CHECK(rc == TRACE_OK && sum.interactions == 2 * (uint64_t)m.nv,
+    o.threads = 1;
+    if (rc >= 0) rc = tr->run(sc, &o, NULL, &one);
+    int same = sum.interactions == one.interactions && sum.segments == one.segments &&
+               !memcmp(&sum.emitted, &one.emitted, 5 * sizeof(double));
+    CHECK(rc == TRACE_OK && sum.interactions == 2 * (uint64_t)m.nv && same,
           "watertight: an icosphere of %ld faces: rays through each of its %ld vertices "
-          "cross it twice (%llu crossings of %ld)", m.nf, m.nv,
+          "cross it twice (%llu crossings of %ld), the same on 1 and 2 threads", m.nf, m.nv,
           (unsigned long long)sum.interactions, 2 * m.nv);
     tr->scene_free(sc);
     free(r); free(m.v); free(m.f); free(m.key); free(m.val);
