@@ -219,7 +219,8 @@ static void nearest(const tr_pk_set *s, const vd o[3], const vd d[3], pick *k)
         best = sel(up, t, best);
         k->k = seli(up, msplat(i), k->k);
         k->far = seli(up, far, k->far);
-        for (int j = 0; j < 3; j++) k->p[j] = sel(up, p[j], k->p[j]);
+        if (cone || any(up & far))           /* a plane's point only for a far start */
+            for (int j = 0; j < 3; j++) k->p[j] = sel(up, p[j], k->p[j]);
     }
     k->t = best;
     vm ix = k->k & 3;                      /* lanes without a hit leave the packet */

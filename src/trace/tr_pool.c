@@ -30,9 +30,10 @@ typedef struct tr_ksum {
 
 static inline void ksum_add(tr_ksum *k, double x)
 {
-    double t = k->s + x;
-    if (fabs(k->s) >= fabs(x)) k->c += (k->s - t) + x;
-    else k->c += (x - t) + k->s;
+    /* the rounding error of s + x, exactly (Knuth's two-sum: the same value as
+     * Neumaier's branch on |s| >= |x|, without the branch) */
+    double t = k->s + x, z = t - k->s;
+    k->c += (k->s - (t - z)) + (x - z);
     k->s = t;
 }
 
