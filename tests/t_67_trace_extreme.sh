@@ -126,3 +126,19 @@ xscene apart 'plane refract 1 1.5 at 0 0 0 normal 0 0 1 disc 5' \
     'source ray from 0 0 -1 dir 0 0 1' 'reflections off'
 check "extreme: refracting planes whose apertures do not reach their common line are traced" \
     x_traced apart 1
+
+# the same bits on any thread count: coincident caps, a closed tessellated sphere
+for th in 1 2; do
+    xscene "thr$th" 'cap refract 1 1.5 vertex 0 0 0 radius 20 aperture 5' \
+        'cap refract 1.5 1.6 vertex 0 0 0 radius 20 aperture 5' \
+        'sphere refract 1.6 1.2 center 0 0 12 radius 3 tessellate 40' \
+        'plane detect at 0 0 30 normal 0 0 1 disc 50' \
+        'source collimated from 0 0 -5 dir 0 0 1 radius 4.5 grid 61' "threads $th" \
+        'output hits h.csv' 'output summary s.sum'
+done
+x_threads() {
+    xtrace "$BIN" thr1 && xtrace "$BIN" thr2 || return 1
+    cmp "$XW/thr1/h.csv" "$XW/thr2/h.csv" &&       # the summary's line 1 names the scene
+        [ "$(tail -n +2 "$XW/thr1/s.sum")" = "$(tail -n +2 "$XW/thr2/s.sum")" ]
+}
+check "extreme: coincident caps and a closed mesh give the same bits on 1 and 2 threads" x_threads
