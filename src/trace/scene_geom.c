@@ -316,12 +316,45 @@ static int planes_cross(const sc_surface *a, const sc_surface *b)
     return hi - lo > 1e-9 * size;
 }
 
+/* Two refracting surfaces of revolution on one axis (caps, conics, aspheres, and discs
+ * square to it) that cross inside both apertures: the gap between them changes sign. */
+static int axial_cross(const sc_surface *a, const sc_surface *b)
+{
+    int pa = a->shape == SC_PLANE, pb = b->shape == SC_PLANE;
+    if (a->shape == SC_SPHERE || b->shape == SC_SPHERE || a->shape == SC_MESH ||
+        b->shape == SC_MESH || (pa && !(a->aperture > 0)) || (pb && !(b->aperture > 0)))
+        return 0;
+    double sb = 1, off[3], x[3];
+    for (int i = 0; i < 3; i++) {
+        if (a->axis[i] != b->axis[i]) sb = -1;
+        off[i] = b->at[i] - a->at[i];
+    }
+    if (sb < 0) {                          /* only a plane may face the other way */
+        if (!pb) return 0;
+        for (int i = 0; i < 3; i++) if (a->axis[i] != -b->axis[i]) return 0;
+    }
+    g_cross(off, a->axis, x);              /* the vertices on one axis? */
+    if (!(sqrt(g_dot(x, x)) <= 1e-12 * (sqrt(g_dot(off, off)) + a->aperture))) return 0;
+    double dz = g_dot(off, a->axis), smax = fmin(a->aperture, b->aperture);
+    double smin = fmax(pa ? a->hole : 0, pb ? b->hole : 0);
+    double tol = 1e-12 * (fabs(dz) + smax), lo = 0, hi = 0;
+    if (!(smax > smin)) return 0;
+    for (int i = 0; i <= 256; i++) {
+        double s = smin + (smax - smin) * i / 256;
+        double g = (pb ? 0 : sag(b, s)) + dz - (pa ? 0 : sag(a, s));
+        lo = fmin(lo, g);
+        hi = fmax(hi, g);
+    }
+    return lo < -tol && hi > tol;
+}
+
 /* Surfaces at the same place (the same shape, position, axis and aperture) are traced
  * as one interface, each in turn in the order they are listed (a ray going along the
  * axis, or into a sphere, meets the first one first); refracting ones must then chain
  * their media, n1 -> n -> n2.  Refused, with both lines: a chain that breaks, the
  * same surface listed twice with apertures that overlap only in part, coincident
- * tessellated surfaces, and refracting planes that cross inside both apertures. */
+ * tessellated surfaces, refracting planes that cross inside both apertures, and
+ * refracting surfaces of revolution on one axis that cross inside both. */
 int sc_check_coincident(const sc_scene *sc, char *err)
 {
     static const char *names[] = {"plane", "sphere", "cap", "conic", "asphere", "mesh"};
@@ -335,6 +368,13 @@ int sc_check_coincident(const sc_scene *sc, char *err)
                          "line %ld inside both their apertures: which medium lies between "
                          "them is ambiguous (end one where it meets the other)", b->src,
                          b->line, a->line);
+                return -1;
+            }
+            if (a->kind == SC_REFRACT && b->kind == SC_REFRACT && axial_cross(a, b)) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this refracting %s crosses the %s of line "
+                         "%ld inside both their apertures: which medium lies between them "
+                         "is ambiguous (end one where it meets the other)", b->src, b->line,
+                         names[b->shape], names[a->shape], a->line);
                 return -1;
             }
             if (!same_surface(a, b, &flip) || (ap = same_aperture(a, b)) == 0) continue;
