@@ -126,9 +126,13 @@ static void closed_retry(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         r2.ray.dir_x = (float)dd[0]; r2.ray.dir_y = (float)dd[1]; r2.ray.dir_z = (float)dd[2];
         r2.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         r2.hit.primID = RTC_INVALID_GEOMETRY_ID;
-        int best = x->best_surf;
+        tr_ctx keep = *x;                   /* analytic hits are the true ray's already */
         rtcIntersect1(sc->scn, &x->ec, &r2);
-        x->best_surf = best;                /* analytic hits are the true ray's already */
+        x->best_surf = keep.best_surf;
+        x->best_t = keep.best_t;
+        v_set(x->best_n, keep.best_n);
+        x->best_far = keep.best_far;
+        v_set(x->best_q, keep.best_q);
         if (r2.hit.geomID != (unsigned)m->id ||
             (rh->hit.geomID == (unsigned)m->id && r2.hit.primID == rh->hit.primID))
             continue;
