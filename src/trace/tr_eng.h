@@ -56,7 +56,10 @@ struct trace_scene {
     int *far, nfar;            /* surfaces outside Embree's range, tested in double */
     int nembree;               /* surfaces Embree holds */
     int ngroup;                /* surfaces in a group of coincident ones */
+    int nclosed;               /* closed meshes */
     double elo[3], ehi[3];     /* ... their box, grown by epad */
+    double nlo[3], nhi[3];     /* ... grown by its diagonal: a ray starting in there
+                                  hands Embree its own origin */
     double epad;               /* how far a float ray may stray from the double one */
     double eoff[3];            /* Embree's coordinates are the world's minus this (the
                                   centre of its box): a scene far from the origin keeps

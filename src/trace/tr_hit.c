@@ -176,7 +176,7 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(sc->scn, &x.ec, &rh);
-    if (!float_hits && last_surf >= 0 && last_prim >= 0 &&
+    if (sc->nclosed && !float_hits && last_surf >= 0 && last_prim >= 0 &&
         rh.hit.geomID != (unsigned)last_surf) {
         const tr_surf *m = sc->surf[last_surf];
         double n[3];
@@ -187,7 +187,7 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     }
     /* ... and one that leaves a closed mesh it never went into may have slipped in
      * through a shared vertex or edge: is there a nearer entry? */
-    if (!float_hits && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID &&
+    if (sc->nclosed && !float_hits && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID &&
         rh.hit.geomID != (unsigned)last_surf) {
         const tr_surf *m = sc->surf[rh.hit.geomID];
         double n[3];
@@ -270,7 +270,10 @@ static int nearest(const trace_scene *sc, int float_hits, const double o[3],
     double ta;
     int got = 0;
     /* (float_hits compares with a float-only tracer: its float ray starts at o) */
-    if (sc->nembree && slab(sc->elo, sc->ehi, o, d, &ta))
+    int near = o[0] >= sc->nlo[0] && o[0] <= sc->nhi[0] && o[1] >= sc->nlo[1] &&
+               o[1] <= sc->nhi[1] && o[2] >= sc->nlo[2] && o[2] <= sc->nhi[2];
+    if (near) ta = 0;                      /* the usual case: no slab to clip */
+    if (sc->nembree && (near || slab(sc->elo, sc->ehi, o, d, &ta)))
         got = embree_nearest(sc, float_hits, o, d, last_surf, last_prim,
                              float_hits ? 0 : ta, h);
     for (int i = 0; i < sc->nfar; i++) {

@@ -46,15 +46,19 @@ typedef struct tr_pk_set {
     int id[4];                   /* their surface ids */
     const tr_shape *g[4];
     int leaving[4];              /* the rays start on it */
+    int farok[4];                /* a ray may start far from it (tr_advance): 0 when
+                                    the rays start on a surface too near for that */
+    int anyfar;                  /* some farok[] is 1 */
     double c[TR_PK], ck1[TR_PK], cone[TR_PK], kind[TR_PK], nf[TR_PK], nb[TR_PK],
            wn[3][TR_PK],         /* curvature terms, material kind and indices, -w */
            at[3][TR_PK];         /* vertices */
 } tr_pk_set;
 
-/* Empty s, then add the candidates in order (surface id, shape g, material m). */
+/* Empty s, then add the candidates in order (surface id, shape g, material m); from:
+ * the surface the rays start on (NULL: anywhere, from the sources). */
 void tr_pk_set_clear(tr_pk_set *s);
 void tr_pk_set_add(tr_pk_set *s, int id, const tr_shape *g, const trace_material *m,
-                   int leaving);
+                   int leaving, const tr_shape *from);
 
 /* What happened to each lane in a step. */
 enum {

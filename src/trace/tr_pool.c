@@ -57,12 +57,12 @@ static void add_batch(trace_summary *s, tr_ksum k[5], const trace_summary *c,
     s->failures += c->failures;
     if (c->max_depth_seen > s->max_depth_seen) s->max_depth_seen = c->max_depth_seen;
     tr_ksum e = k[0], d = k[1], a = k[2], x = k[3], q = k[4];
-    for (uint64_t i = 0; i < n; i++) {
+    for (uint64_t i = 0; i < n; i++) {   /* a zero term changes no bit: skipped */
         ksum_add(&e, pw[i].emitted);
-        ksum_add(&d, pw[i].detected);
-        ksum_add(&a, pw[i].absorbed);
-        ksum_add(&x, pw[i].escaped);
-        ksum_add(&q, pw[i].cutoff);
+        if (pw[i].detected != 0) ksum_add(&d, pw[i].detected);
+        if (pw[i].absorbed != 0) ksum_add(&a, pw[i].absorbed);
+        if (pw[i].escaped != 0) ksum_add(&x, pw[i].escaped);
+        if (pw[i].cutoff != 0) ksum_add(&q, pw[i].cutoff);
     }
     k[0] = e; k[1] = d; k[2] = a; k[3] = x; k[4] = q;
     s->emitted = ksum(&e); s->detected = ksum(&d); s->absorbed = ksum(&a);

@@ -42,7 +42,7 @@ void tr_scene_set_entry(trace_scene *sc, const int *cand, int n, double z)
             const tr_surf *f = sc->surf[cand[i]];
             sc->entryg[sc->nentry] = &f->shape;
             sc->entry[sc->nentry++] = cand[i];
-            tr_pk_set_add(&sc->entry_pk, cand[i], &f->shape, &f->mat, 0);
+            tr_pk_set_add(&sc->entry_pk, cand[i], &f->shape, &f->mat, 0, NULL);
         }
     sc->entry_z = z;
 }
@@ -57,7 +57,8 @@ void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
             const tr_surf *c = sc->surf[cand[i]];
             f->seqg[f->nseq] = &c->shape;
             f->seq[f->nseq++] = cand[i];
-            tr_pk_set_add(&f->pk, cand[i], &c->shape, &c->mat, cand[i] == id);
+            tr_pk_set_add(&f->pk, cand[i], &c->shape, &c->mat, cand[i] == id,
+                          &f->shape);
         }
     sc->seq_nsurf = sc->nsurf;
 }
@@ -312,6 +313,7 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     double diag[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     f->eps = 1e-9 * v_norm(diag);
     f->closed = mesh_closed(f);
+    sc->nclosed += f->closed != 0;
     if (mesh->underlying) {
         if (tr_shape_init(&f->shape, mesh->underlying, sc->err, sizeof sc->err)) {
             rc = TRACE_EINVAL;
@@ -473,7 +475,8 @@ static int in_range(const tr_surf *f)
 /* The box of what Embree holds, and how far its float ray may stray from the double
  * one inside it: Embree's coordinates are the world's less the box's centre (eoff),
  * the origin rounds to half an ulp of the largest of those coordinates M, the
- * direction to half an ulp of each component, over at most the box's diagonal D.
+ * direction to half an ulp of each component, over at most three times the box's
+ * diagonal D (a ray starting within D of the box starts there, see tr_hit.c).
  * Every analytic surface's box grows by eight times that (a ray that meets the surface
  * in double is always offered to it); the box itself by as much again. */
 static void embree_box(trace_scene *sc)
@@ -501,10 +504,13 @@ static void embree_box(trace_scene *sc)
         m = fmax(m, fmax(fabs(lo[j] - sc->eoff[j]), fabs(hi[j] - sc->eoff[j])));
         d[j] = hi[j] - lo[j];
     }
-    sc->epad = 8 * FLT_EPSILON * (m + v_norm(d)) + 1e-300;
+    double diag = v_norm(d);
+    sc->epad = 8 * FLT_EPSILON * (m + 3 * diag) + 1e-300;
     for (int j = 0; j < 3; j++) {
         sc->elo[j] = lo[j] - 2 * sc->epad;
         sc->ehi[j] = hi[j] + 2 * sc->epad;
+        sc->nlo[j] = sc->elo[j] - diag;
+        sc->nhi[j] = sc->ehi[j] + diag;
     }
 }
 
