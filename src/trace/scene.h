@@ -123,6 +123,8 @@ void sc_point_rays(const sc_source *s, sc_ray *out);
  * (hexapolar rings, vertices on the surface), rectangles into 2 level^2, spheres
  * into 4 level (level - 1) (level >= 2).  Oriented as the surface's normal. */
 int  sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, char *err);
+/* Coincident surfaces: 0, or -1 with both FILE:LINEs in err (scene_geom.c). */
+int  sc_check_coincident(const sc_scene *sc, char *err);
 
 /* ---- running (inside the module: needs the engine) ----------------------------- */
 

@@ -100,6 +100,10 @@ static int tok_num(reader *r, const tok *t, const char *what, double *v)
     if (errno == ERANGE && fabs(*v) > 1) return fail(r, "%s: '%s' is out of range", what, buf);
     if (!isfinite(*v) || fabs(*v) > 1e30)
         return fail(r, "%s: '%s' is out of range (|x| <= 1e30)", what, buf);
+    /* one range for every number: 0, or 1e-30 <= |x| <= 1e30 (squares and products
+     * of lengths then neither underflow nor overflow; see README, Conventions) */
+    if ((*v != 0 && fabs(*v) < 1e-30) || (*v == 0 && errno == ERANGE))
+        return fail(r, "%s: '%s' is out of range (0, or 1e-30 <= |x| <= 1e30)", what, buf);
     return 0;
 }
 
@@ -1038,6 +1042,7 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
     if (!sc->nsurf) { fail(&r, "the scene has no surface"); goto bad; }
     if (!sc->nsource) { fail(&r, "the scene has no source of rays"); goto bad; }
     if (axial_pairs(sc, err)) goto bad;
+    if (sc_check_coincident(sc, err)) goto bad;     /* with both lines */
     return 0;
 bad:
     sc_free(sc);
