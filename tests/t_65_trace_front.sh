@@ -430,3 +430,34 @@ consistent_quiet() {   # the consistent singlet says nothing of media
         ! grep -qi 'media\|mismatch' "$TW/mmok/out"
 }
 check "mismatch: a consistent scene says nothing about media" consistent_quiet
+
+# The tessellation table stops on a signal too (its traces poll the stop flag per
+# batch of 4096 rays): a 1001 x 1001 bundle takes many seconds; SIGTERM after 0.5 s.
+table_stopped() {
+    d=$WORK/tablestop; rm -rf "$d"; mkdir -p "$d"
+    printf 'table\n50\n-50\n8\n1.5168\n12\n1001\nn\n' > "$d/in"
+    python3 - "$1" "$d" <<'PYEOF'
+import os, signal, subprocess, sys, time
+bin_, d = sys.argv[1], sys.argv[2]
+p = subprocess.Popen([bin_, "--trace", "-i", "in", "r.rec"], cwd=d,
+                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+time.sleep(0.5)
+fails = []
+if p.poll() is not None: fails.append("the table ended before the signal (exit %d)" % p.returncode)
+t0 = time.time()
+p.send_signal(signal.SIGTERM)
+try: rc = p.wait(timeout=30)
+except subprocess.TimeoutExpired: p.kill(); rc = p.wait(); fails.append("did not stop in 30 s")
+dt = time.time() - t0
+if dt > 1.0: fails.append("stopped %.2f s after the signal" % dt)
+if rc != 143: fails.append("exit %d, want 143" % rc)
+rec = open(os.path.join(d, "r.rec")).read()
+if "input: 1001\n" not in rec: fails.append("record lost answers")
+print("\n".join(fails) or "ok (%.3f s)" % dt)
+sys.exit(1 if fails else 0)
+PYEOF
+}
+if command -v python3 > /dev/null; then
+    check "stop: SIGTERM during the tessellation table ends within 1 s, exit 143, record intact" \
+        table_stopped "$BIN"
+fi
