@@ -2,6 +2,7 @@
  * '#' comments, one "axis NAME" block per joint.  Every error names FILE:LINE:
  * unknown keys, a key given twice, bad numbers, a GPIO line used twice, values out of
  * range.  The geometry keys go to the geometry part (rg_geom_file_key). */
+#define _DEFAULT_SOURCE
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -10,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include "rg_hw.h"
+#include "rig/rg_hw.h"
 
 #define MAXFILE (1 << 20)
-#define MAXWORDS 4
+#define MAXWORDS 24
 
 static const char *const axis_names[RG_NJOINTS] = {"m1a", "m1b", "u", "v", "m2a", "m2b"};
 
@@ -27,6 +28,7 @@ typedef struct reader {
     /* where each key was given (duplicates): globals, then per axis */
     long gseen[16];
     long aseen[RG_NJOINTS][16];
+    const rig_api *geo;         /* the geometry half (its keys), or NULL */
 } reader;
 
 static int fail(reader *r, const char *fmt, ...)
@@ -106,7 +108,7 @@ static int global_key(reader *r, int k, char **w, int nw)
 {
     rg_rig *g = r->rig;
     const char *a = nw > 1 ? w[1] : NULL;
-    if (k != G_LASER && k != G_INTERLOCK && k != G_HEART && nw > 2)
+    if (nw > (k == G_LASER || k == G_INTERLOCK || k == G_HEART ? 3 : 2))
         return fail(r, "'%s' takes one value", w[0]);
     switch (k) {
     case G_CHIP:
@@ -148,7 +150,7 @@ static int axis_key(reader *r, int k, char **w, int nw)
 {
     rg_axis *x = &r->rig->axis[r->cur];
     const char *a = nw > 1 ? w[1] : NULL;
-    if (k > A_HOME && nw > 2) return fail(r, "'%s' takes one value", w[0]);
+    if (nw > (k <= A_HOME ? 3 : 2)) return fail(r, "'%s' takes one value", w[0]);
     switch (k) {
     case A_STEP: return line_spec(r, w[0], w, nw, &x->step);
     case A_DIR: return line_spec(r, w[0], w, nw, &x->dir);
@@ -167,7 +169,7 @@ static int axis_key(reader *r, int k, char **w, int nw)
     case A_HOMESPEED: return positive(r, w[0], a, 1e6, &x->home_speed);
     case A_DIRINV: return yesno(r, w[0], a, "yes", "no", &x->dir_invert);
     case A_SIMHOME: {
-        int ok, rc = yesno(r, w[0], a, "ok", "broken", &ok);
+        int ok = 1, rc = yesno(r, w[0], a, "ok", "broken", &ok);
         x->sim_home_broken = !ok;
         return rc;
     }
@@ -177,34 +179,12 @@ static int axis_key(reader *r, int k, char **w, int nw)
 
 static int one_line(reader *r, char *s)
 {
-    char *w[MAXWORDS + 1], *p = s, *rest;
+    char *w[MAXWORDS + 1], *p = s;
     int nw = 0, k;
     char *hash = strchr(s, '#');
     if (hash) *hash = 0;
     while (*p && isspace((unsigned char)*p)) p++;
     if (!*p) return 0;
-    /* the text after the key, for the geometry part's own parsing */
-    rest = p;
-    while (*rest && !isspace((unsigned char)*rest)) rest++;
-    while (*rest && isspace((unsigned char)*rest)) rest++;
-    {
-        char geomargs[1024];
-        size_t n = strlen(rest);
-        char key[64];
-        size_t kl = strcspn(p, " \t\r\n\v\f");
-        while (n && isspace((unsigned char)rest[n - 1])) n--;
-        if (kl < sizeof key && n < sizeof geomargs) {
-            memcpy(key, p, kl); key[kl] = 0;
-            memcpy(geomargs, rest, n); geomargs[n] = 0;
-            if (find(gkeys, NG, key) < 0 && find(akeys, NA, key) < 0 &&
-                strcmp(key, "axis") && rg_geom_file_key) {
-                char gerr[RG_ERRMAX];
-                int g = rg_geom_file_key(&r->rig->geom, key, geomargs, gerr, sizeof gerr);
-                if (g < 0) return fail(r, "%s", gerr);
-                if (g > 0) { r->rig->geom_keys++; return 0; }
-            }
-        }
-    }
     while (*p) {
         while (*p && isspace((unsigned char)*p)) *p++ = 0;
         if (!*p) break;
@@ -236,6 +216,17 @@ static int one_line(reader *r, char *s)
                         axis_names[r->cur], r->aseen[r->cur][k]);
         r->aseen[r->cur][k] = r->line;
         return axis_key(r, k, w, nw);
+    }
+    if (r->geo && r->geo->geometry_key) {
+        char gerr[RG_ERRMAX];
+        int g;
+        if (!strcmp(w[0], "joint"))
+            return fail(r, "'joint' is for geometry-only files: here each axis block gives "
+                        "its steps and travel");
+        g = r->geo->geometry_key(&r->rig->geom, nw, (const char *const *)w, gerr,
+                                 sizeof gerr);
+        if (g == 0) { r->rig->geom_keys++; return 0; }
+        if (g != 1) return fail(r, "%s", gerr);
     }
     return fail(r, "unknown key '%s'", w[0]);
 }
@@ -312,13 +303,27 @@ static int finish(reader *r)
             }
     if (g->heartbeat.offset >= 0 && !(g->heartbeat_timeout_ms > 0))
         g->heartbeat_timeout_ms = 5;
+    /* the geometry's joints are the axes (per rad for angles) */
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        const rg_axis *x = &g->axis[j];
+        double u = x->linear ? 1 : M_PI / 180;
+        g->geom.joint[j].steps_per = x->steps_per / u;
+        g->geom.joint[j].lo = x->min * u;
+        g->geom.joint[j].hi = x->max * u;
+    }
+    if (r->geo && r->geo->geometry_check) {
+        char gerr[RG_ERRMAX];
+        if (r->geo->geometry_check(&g->geom, gerr, sizeof gerr))
+            return WHOLE("%s: the geometry: %s", r->name, gerr);
+    }
 #undef WHOLE
     return 0;
 }
 
-static void defaults(rg_rig *g)
+static void defaults(rg_rig *g, const rig_api *geo)
 {
     memset(g, 0, sizeof *g);
+    if (geo && geo->geometry_default) geo->geometry_default(&g->geom);
     g->laser.offset = g->interlock.offset = g->heartbeat.offset = -1;
     for (int j = 0; j < RG_NJOINTS; j++) {
         rg_axis *x = &g->axis[j];
@@ -338,7 +343,8 @@ int rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, ch
     size_t i = 0;
     memset(&r, 0, sizeof r);
     r.name = name; r.rig = rig; r.cur = -1; r.err = err; r.cap = cap;
-    defaults(rig);
+    r.geo = rg_geom_api();
+    defaults(rig, r.geo);
     snprintf(rig->path, sizeof rig->path, "%s", name);
     while (i < len) {
         size_t e = i, n;

@@ -1,11 +1,11 @@
 /* rg_hw.h -- inside the machine part of the rig engine (not public): the chip
  * interface both backends implement (rg_sim.c, rg_gpiod.c, rg_null in rg_sim.c), the
  * machine state shared by motion (rg_motion.c) and safety (rg_safety.c), and the
- * rig-file hook for the geometry keys. */
+ * geometry half reached through its table. */
 #ifndef RG_HW_H
 #define RG_HW_H
 #include <stdint.h>
-#include "rig.h"
+#include "rig/rg_int.h"
 
 /* Output groups: each is one bulk request, so one call changes all its lines (all
  * STEP lines together).  Bit j of a mask or value is axis j (RG_J_*); LASER and
@@ -75,19 +75,13 @@ int  rg_expose(rg_machine *m, double ms, rg_stop_fn stop, void *ctx, char *err,
                size_t cap);
 void rg_emergency_off(void);
 void rg_laser_off(rg_machine *m);
-void rg_timing(const rg_machine *m, rg_timing *t);
+void rg_get_timing(const rg_machine *m, rg_timing *t);
 const char *rg_sched_note(const rg_machine *m);
 /* rg_file.c */
 int  rg_rig_load(const char *path, rg_rig *rig, char *err, size_t cap);
 int  rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,
                   size_t cap);
-/* The geometry part reads its own keys: 1 if key is one of them (value read, or
- * RG_EINVAL... returned as -1 with why in err), 0 if it is not a geometry key.
- * Weak: without the geometry part every such key is unknown. */
-int rg_geom_file_key(rg_geometry *g, const char *key, const char *args, char *err,
-                     size_t cap) __attribute__((weak));
-
-/* Fill the machine entry points of the API table (rg_api.c calls it). */
-void rg_machine_api(rig_api *api);
+/* The geometry half's table (rig_get_api): its rig-file keys, default and check. */
+const rig_api *rg_geom_api(void);
 
 #endif
