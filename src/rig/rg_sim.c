@@ -143,8 +143,12 @@ static void check_interlock(sim *s)
 {
     int closed = interlock_closed(s);
     if (closed != s->sh->interlock) {
+        /* stamped when it opened, which may lie between two reads */
+        int64_t now = s->sh->now_ns, at = (int64_t)llround(s->rig->sim_interlock_open_ms * 1e6);
         s->sh->interlock = closed;
+        if (!closed && s->rig->sim_interlock_open_ms >= 0 && at < now) s->sh->now_ns = at;
         logs(s, closed ? "interlock closed" : "interlock open", NULL);
+        s->sh->now_ns = now;
     }
     if (s->sh->laser && !closed) {
         int64_t tick = rg_tick_ns(s->rig);
