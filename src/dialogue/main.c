@@ -24,6 +24,7 @@ static const dialogue dialogues[] = {
      lm_classic_example},
     {"--trace", "ray tracing: scene files, a lens's real fan, tessellation table", lm_trace,
      lm_trace_example},
+    {"--rig", "the cornea rig: home, move, expose, scan (sim or libgpiod; 36-39)", lm_rig, lm_rig_example},
     {"--thick", "thick lens: R1, R2, t, n, any media (sections 8-10, 21)", lm_thick, lm_thick_example},
     {"--thin", "thin lens equation: f, do, di from the other two (57)", lm_thin, lm_thin_example},
     {"--gauss", "Gauss's formula, one refracting surface (section 4)", lm_gauss, lm_gauss_example},

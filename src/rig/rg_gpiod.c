@@ -181,7 +181,7 @@ static void g_close(rg_chip *cc)
 }
 
 static const rg_chip_ops gpiod_ops = {g_set, g_inputs, g_now, g_sleep_until, g_emergency,
-                                      g_close, NULL};
+                                      g_close, NULL, NULL};
 
 int rg_gpiod_open(const rg_rig *rig, const char *name, rg_chip **out, char *err, size_t cap)
 {

@@ -30,6 +30,8 @@ typedef struct rg_chip_ops {
     void (*close)(rg_chip *c);
     /* Moves and exposures tell the simulator what they do (log lines); may be NULL. */
     void (*note)(rg_chip *c, const char *what);
+    /* The motors' positions where the chip knows them (simulator): 1, else 0. */
+    int  (*motors)(rg_chip *c, long steps[RG_NJOINTS]);
 } rg_chip_ops;
 struct rg_chip { const rg_chip_ops *ops; };
 

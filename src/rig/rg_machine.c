@@ -101,6 +101,12 @@ void rg_get_timing(const rg_machine *m, rg_timing *t)
 
 const char *rg_sched_note(const rg_machine *m) { return m->sched; }
 static int homed(const rg_machine *m) { return m->homed; }
+static int motors(const rg_machine *m, long steps[RG_NJOINTS])
+{
+    if (m->chip->ops->motors && m->chip->ops->motors(m->chip, steps)) return 1;
+    rg_position(m, steps, NULL);
+    return 0;
+}
 
 void rg_machine_fill(rig_api *a)
 {
@@ -115,6 +121,7 @@ void rg_machine_fill(rig_api *a)
     a->expose = rg_expose;
     a->position = rg_position;
     a->homed = homed;
+    a->motors = motors;
     a->timing = rg_get_timing;
     a->close = rg_close;
     a->emergency_off = rg_emergency_off;

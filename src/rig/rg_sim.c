@@ -347,8 +347,15 @@ static void sim_close(rg_chip *c)
     free(s);
 }
 
+static int sim_motors(rg_chip *c, long steps[RG_NJOINTS])
+{
+    sim *s = (sim *)c;
+    for (int j = 0; j < RG_NJOINTS; j++) steps[j] = (long)s->sh->steps[j];
+    return 1;
+}
+
 static const rg_chip_ops sim_ops = {sim_set, sim_inputs, sim_now, sim_sleep_until,
-                                    sim_emergency, sim_close, sim_note};
+                                    sim_emergency, sim_close, sim_note, sim_motors};
 
 static int open_shared(sim *s, const char *path, char *err, size_t cap)
 {

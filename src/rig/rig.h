@@ -367,6 +367,9 @@ typedef struct rig_api {
     int (*expose)(rg_machine *m, double ms, rg_stop_fn stop, void *ctx, char *err,
                   size_t cap);
     void (*position)(const rg_machine *m, long steps[RG_NJOINTS], rg_pose *p);
+    /* Where the motors really are: 1 on the simulator (its motor model), 0 where the
+     * chip has no feedback (steps then hold the commanded position). */
+    int (*motors)(const rg_machine *m, long steps[RG_NJOINTS]);
     int (*homed)(const rg_machine *m);
     void (*timing)(const rg_machine *m, rg_timing *t);
     /* Laser off, then drivers disabled, lines released, log closed: 0 or RG_EIO. */
