@@ -4,7 +4,8 @@
 # homing), and the laser off first on every way out: SIGINT, SIGTERM and SIGHUP
 # mid-exposure and while waiting for an answer, end of input, and SIGKILL with the
 # heartbeat watchdog (tests/rig/rig_watchdog.c) outside the killed process.
-RIGEX=$TOP/golden/rig/example.rig
+RIGEX=$TOP/tests/rig/machine.rig
+RIGGOLD=$TOP/golden/rig/example.rig
 WD=$TOP/build/obj/rig_vm/rig_watchdog
 # rig_session DIR ANSWERS...: lensmat --rig in DIR, answers in DIR/in, record r.rec
 rig_session() {

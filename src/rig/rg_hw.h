@@ -68,6 +68,8 @@ int  rg_move(rg_machine *m, const rg_pose *p, rg_stop_fn stop, void *ctx, char *
 int  rg_home(rg_machine *m, rg_stop_fn stop, void *ctx, char *err, size_t cap);
 void rg_position(const rg_machine *m, long steps[RG_NJOINTS], rg_pose *p);
 int64_t rg_tick_ns(const rg_rig *rig);
+int  rg_plan_move(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
+                  double *seconds, char *err, size_t cap);
 void rg_wait(rg_machine *m, int64_t deadline);  /* sleep_until + lateness record */
 /* rg_safety.c */
 int  rg_open(const rg_rig *rig, const rg_open_opts *o, rg_machine **m, char *err,

@@ -118,6 +118,7 @@ void rg_machine_fill(rig_api *a)
     a->home = rg_home;
     a->move = rg_move;
     a->move_steps = rg_move_steps;
+    a->plan_move = rg_plan_move;
     a->expose = rg_expose;
     a->position = rg_position;
     a->homed = homed;

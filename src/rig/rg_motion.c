@@ -127,25 +127,18 @@ static void note(rg_machine *m, const char *what)
     if (m->chip->ops->note) m->chip->ops->note(m->chip, what);
 }
 
-int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop, void *ctx,
-                  char *err, size_t cap)
+/* The shared trapezoid of a move: V and A of the normalised profile (the tightest
+ * axis's speed and acceleration over its distance).  0, or RG_ETRAVEL. */
+static int plan(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
+                long n[RG_NJOINTS], int sign[RG_NJOINTS], trap *tp, char *err, size_t cap)
 {
-    const rg_rig *rig = &m->rig;
-    long n[RG_NJOINTS], done[RG_NJOINTS] = {0};
-    int sign[RG_NJOINTS];
     double V = INFINITY, A = INFINITY;
-    int64_t tick = rg_tick_ns(rig), t0;
-    trap tp;
     int any = 0, rc;
-    long k, K;
-
-    if (!m->homed) { snprintf(err, cap, "the machine is not homed: home it first"); return RG_EINVAL; }
     for (int j = 0; j < RG_NJOINTS; j++)
-        if ((rc = check_travel(rig, j, target[j], err, cap))) return rc;
-    if (m->laser_on) rg_laser_off(m);   /* never: expose returns with it off */
+        if ((rc = check_travel(rig, j, to[j], err, cap))) return rc;
     for (int j = 0; j < RG_NJOINTS; j++) {
         const rg_axis *x = &rig->axis[j];
-        long d = target[j] - m->pos[j];
+        long d = to[j] - from[j];
         n[j] = labs(d);
         sign[j] = d > 0 ? 1 : d < 0 ? -1 : 0;
         if (!n[j]) continue;
@@ -153,8 +146,37 @@ int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop,
         V = fmin(V, x->speed * x->steps_per / n[j]);
         A = fmin(A, x->accel * x->steps_per / n[j]);
     }
-    if (!any) return 0;
-    trap_plan(&tp, V, A);
+    if (any) trap_plan(tp, V, A);
+    else memset(tp, 0, sizeof *tp);
+    return 0;
+}
+
+int rg_plan_move(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
+                 double *seconds, char *err, size_t cap)
+{
+    long n[RG_NJOINTS];
+    int sign[RG_NJOINTS];
+    trap tp;
+    int rc = plan(rig, from, to, n, sign, &tp, err, cap);
+    *seconds = rc ? 0 : tp.T;
+    return rc;
+}
+
+int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop, void *ctx,
+                  char *err, size_t cap)
+{
+    const rg_rig *rig = &m->rig;
+    long n[RG_NJOINTS], done[RG_NJOINTS] = {0};
+    int sign[RG_NJOINTS];
+    int64_t tick = rg_tick_ns(rig), t0;
+    trap tp;
+    int rc;
+    long k, K;
+
+    if (!m->homed) { snprintf(err, cap, "the machine is not homed: home it first"); return RG_EINVAL; }
+    if ((rc = plan(rig, m->pos, target, n, sign, &tp, err, cap))) return rc;
+    if (m->laser_on) rg_laser_off(m);   /* never: expose returns with it off */
+    if (tp.T == 0) return 0;
     set_dirs(m, sign);
     t0 = m->chip->ops->now(m->chip) + tick;      /* DIR set up a tick before the first edge */
     K = (long)ceil(tp.T * 1e9 / tick);

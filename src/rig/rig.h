@@ -360,6 +360,9 @@ typedef struct rig_api {
      * pulse if any joint is outside travel or the machine is not homed. */
     int (*move)(rg_machine *m, const rg_pose *p, rg_stop_fn stop, void *ctx, char *err,
                 size_t cap);
+    /* The move's profile without moving: its duration (s); RG_ETRAVEL as move. */
+    int (*plan_move)(const rg_rig *rig, const long from[RG_NJOINTS],
+                     const long to[RG_NJOINTS], double *seconds, char *err, size_t cap);
     int (*move_steps)(rg_machine *m, const long steps[RG_NJOINTS], rg_stop_fn stop,
                       void *ctx, char *err, size_t cap);
     /* Laser on for ms (<= max_on_ms), only with the interlock closed and every axis

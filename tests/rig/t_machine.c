@@ -353,7 +353,7 @@ int main(int argc, char **argv)
     char *ex;
     rg = rig_get_api(RIG_ABI);
     if (!rg || !rg->rig_parse) { printf("FAIL no machine table\n"); return 1; }
-    ex = slurp(argc > 1 ? argv[1] : "golden/rig/example.rig");
+    ex = slurp(argc > 1 ? argv[1] : "tests/rig/machine.rig");
     if (!ex) { printf("FAIL cannot read the example rig file\n"); return 1; }
     snprintf(example, sizeof example, "%s", ex);
     snprintf(tmpdir, sizeof tmpdir, "/tmp/t_machine.XXXXXX");
