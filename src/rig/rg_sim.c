@@ -357,9 +357,14 @@ static int sim_motors(rg_chip *c, long steps[RG_NJOINTS])
 static const rg_chip_ops sim_ops = {sim_set, sim_inputs, sim_now, sim_sleep_until,
                                     sim_emergency, sim_close, sim_note, sim_motors};
 
+/* The state file appears under its name only once it has its full size (a watchdog
+ * mapping it earlier would fault): made as PATH.part, renamed when it is mapped. */
 static int open_shared(sim *s, const char *path, char *err, size_t cap)
 {
-    int fd = open(path, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    char part[600];
+    int fd;
+    snprintf(part, sizeof part, "%s.part", path);
+    fd = open(part, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     s->shlen = sizeof(rg_sim_shared);
     if (fd < 0 || ftruncate(fd, (off_t)s->shlen)) {
         snprintf(err, cap, "%s: %s", path, strerror(errno));
@@ -370,6 +375,14 @@ static int open_shared(sim *s, const char *path, char *err, size_t cap)
     close(fd);
     if (s->sh == MAP_FAILED) {
         snprintf(err, cap, "%s: %s", path, strerror(errno));
+        s->sh = NULL;
+        return RG_EIO;
+    }
+    memcpy(s->sh->magic, "lmrigsim", 8);
+    s->sh->pid = (int32_t)getpid();
+    if (rename(part, path)) {
+        snprintf(err, cap, "%s: %s", path, strerror(errno));
+        munmap(s->sh, s->shlen);
         s->sh = NULL;
         return RG_EIO;
     }

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 #include "rig/rig.h"
@@ -36,6 +37,8 @@ int main(int argc, char **argv)
     if (argc < 2) { fprintf(stderr, "usage: rig_watchdog STATEFILE [SECONDS]\n"); return 2; }
     while (!sh && now_ms() - t0 < limit) {     /* lensmat creates it when the chip opens */
         int fd = open(argv[1], O_RDONLY);
+        struct stat st;
+        if (fd >= 0 && (fstat(fd, &st) || st.st_size < (off_t)sizeof *sh)) { close(fd); fd = -1; }
         if (fd >= 0) {
             void *p = mmap(NULL, sizeof *sh, PROT_READ, MAP_SHARED, fd, 0);
             close(fd);
@@ -45,9 +48,9 @@ int main(int argc, char **argv)
         if (!sh) usleep(2000);
     }
     if (!sh) { printf("watchdog: no state file\n"); return 1; }
-    hold = sh->timeout_ns / 1e6;
     while (now_ms() - t0 < limit) {
         double t = now_ms();
+        hold = sh->timeout_ns / 1e6;        /* set just after the file appears */
         if (sh->heartbeat_edges != edges) { edges = sh->heartbeat_edges; last_edge = t; }
         light = sh->laser && t - last_edge <= hold;
         seen |= light;
