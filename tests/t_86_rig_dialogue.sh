@@ -140,3 +140,32 @@ check "rig: a target off the cornea is refused" rig_bad offcornea "in:8: target 
     "$RIGGOLD" sim - home point height 5 0
 check "rig: a scan of 2.5 points is refused" rig_bad halfscan "2.5 points: give a whole number" \
     "$RIGGOLD" sim - home scan 2.5
+
+# on a terminal: a bad rig file is explained and asked again; a refused move is said
+# and the session goes on; the refused answer is not recorded
+rig_tty() {
+    python3 - "$BIN" "$D/tty" "$RIGEX" "$TOP/tests" <<'PYEOF'
+import os, sys
+bin_, d, rig = sys.argv[1:4]
+sys.path.insert(0, sys.argv[4])
+from ptydrive import drive
+os.makedirs(d, exist_ok=True)
+with open(os.path.join(d, "broken.rig"), "w") as f: f.write("chip a\nlaser x\n")
+rc, out = drive([bin_, "--rig", "t.rec"],
+                [b"broken.rig\n", (rig + "\n").encode(), b"sim\n", b"t.log\n", b"home\n",
+                 b"joints\n", b"0\n", b"0\n", b"99\n", b"0\n", b"0\n", b"0\n", b"expose\n",
+                 b"5\n", b"quit\n"], cwd=d, home=d, timeout=60)
+rec = open(os.path.join(d, "t.rec")).read()
+fails = []
+if rc != 0: fails.append("exit %d" % rc)
+if "broken.rig:2: 'x' is not a line offset" not in out: fails.append("no re-ask for the rig file")
+if "Refused: axis u: 99 mm is outside its travel" not in out: fails.append("no refusal")
+if "Exposed 5 ms" not in rec: fails.append("the session did not go on")
+if "broken" in rec: fails.append("a refused answer was recorded")
+print("\n".join(fails) or "ok", out[-800:] if fails else "")
+sys.exit(1 if fails else 0)
+PYEOF
+}
+if command -v python3 > /dev/null; then
+    check "rig tty: a bad rig file is asked again, a refused move does not end the session" rig_tty
+fi

@@ -127,6 +127,3 @@ void rg_machine_fill(rig_api *a)
     a->close = rg_close;
     a->emergency_off = rg_emergency_off;
 }
-
-/* Until the geometry half's fill is linked in (its strong definition wins). */
-__attribute__((weak)) void rg_geometry_fill(rig_api *a) { (void)a; }
