@@ -131,7 +131,7 @@ rig_scan() {
     rig_session "$D/scan" "$RIGGOLD" sim sc.log home point height 1 30 scan 40 1.8 10 quit ||
         { cat "$D/scan/err"; return 1; }
     grep -q 'Scan: 40 points, .* 0 outside' "$D/scan/r.rec" || return 1
-    [ "$(grep -c 'Simulated motors: .*: within' "$D/scan/r.rec")" -eq 41 ] || return 1
+    [ "$(grep -c 'Simulated motors: detector miss .* (traced: .*: within' "$D/scan/r.rec")" -eq 41 ] || return 1
     [ "$(grep -c '^[0-9.]* laser 1' "$D/scan/sc.log")" -eq 40 ] && ! grep -q VIOLATION "$D/scan/sc.log"
 }
 check "rig: a 40-point scan lands every spot within the quantisation bound (closed loop)" rig_scan

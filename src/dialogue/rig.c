@@ -17,6 +17,7 @@
 #include "dialogues.h"
 #include "engine.h"
 #include "../rig/rig.h"
+#include "../trace/trace.h"
 #include "prompts_rig.h"
 
 #define P(k) rig_prompts[RIG_##k]
@@ -32,6 +33,8 @@ typedef struct rdlg {
     char log[WORD], state[WORD + 8];
     double worst_um, worst_bound_um;
     int outside;
+    const trace_api *tr;        /* the independent check, loaded with the first point */
+    int tr_tried;
 } rdlg;
 
 static const rig_api *volatile hook_api;
@@ -151,10 +154,14 @@ static int ask_ms(rdlg *d, double *ms)
     return ask_num(d, P(EXPOSE_MS), P(EXPOSE_MS_WHAT), LM_POSITIVE, 0, ms);
 }
 
-/* Closed loop (simulator): the simulated motors' pose through the exact forward
- * model; its detector miss must be within the bound half a step on every joint can
- * cause (first order, through the Jacobian).  miss, bound in um. */
-static int closed_loop(rdlg *d, double *miss, double *bound)
+/* Closed loop (simulator): the simulated motors' pose, through the exact forward
+ * model and through the trace engine (mirrors and cornea as surfaces, independent of
+ * the geometry code); the spot's miss at the detector point must be within the bound
+ * half a step on every joint can cause (first order, through the Jacobian).  miss
+ * (the larger of the two), traced (NAN without the tracer) and bound in um; 0 if the
+ * chip has no motor feedback. */
+static int closed_loop(rdlg *d, const double target[3], double *miss, double *traced,
+                       double *bound)
 {
     const rig_api *a = d->api;
     const rg_geometry *g = &d->rig.geom;
@@ -166,6 +173,7 @@ static int closed_loop(rdlg *d, double *miss, double *bound)
     if (!a->motors(d->m, s)) return 0;
     for (int j = 0; j < RG_NJOINTS; j++)
         p.j[j] = s[j] / d->rig.axis[j].steps_per * (linear(j) ? 1 : DEG);
+    *traced = NAN;
     if (a->forward(g, &p, &b, err, sizeof err) ||
         a->jacobian(g, &p, J, &cond, err, sizeof err)) { *miss = INFINITY; *bound = 0; return 1; }
     for (int r = 0; r < 2; r++)
@@ -175,6 +183,18 @@ static int closed_loop(rdlg *d, double *miss, double *bound)
                        (b.det[1] - g->detector[1]) * (b.det[1] - g->detector[1]) +
                        (b.det[2] - g->detector[2]) * (b.det[2] - g->detector[2]));
     *bound = 1e3 * sqrt(e[0] * e[0] + e[1] * e[1]) * (1 + 1e-6) + 1e-6;
+    if (!d->tr_tried) {
+        trace_get_api_fn get = (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
+        d->tr_tried = 1;
+        d->tr = get ? get(TRACE_ABI) : NULL;
+        if (!d->tr) lm_say(d->io, LM_BOTH, "%s", P(NO_TRACER));
+    }
+    if (d->tr && a->verify) {
+        rg_verify v;
+        if (a->verify(d->tr, g, &p, target, &v, err, sizeof err) || !v.hit) *traced = INFINITY;
+        else *traced = v.err_detector * 1e3;
+        if (*traced > *miss) *miss = *traced;
+    }
     return 1;
 }
 
@@ -186,7 +206,7 @@ static int visit(rdlg *d, const rg_target *t, double ms)
     rg_quantised q;
     long steps[RG_NJOINTS];
     char err[RG_ERRMAX], buf[512], dg[512];
-    double miss, bound;
+    double miss, traced, bound;
     int rc = a->solve(&d->rig.geom, t, NULL, &s, err, sizeof err);
     if (rc) return refused(d, rc, err);
     if ((rc = a->quantise(&d->rig.geom, t, &s, &q, err, sizeof err))) return refused(d, rc, err);
@@ -199,9 +219,14 @@ static int visit(rdlg *d, const rg_target *t, double ms)
     if ((rc = a->move_steps(d->m, steps, stop_cb, NULL, err, sizeof err)))
         return refused(d, rc, err);
     if (ms > 0 && (rc = do_expose_ms(d, ms))) return rc;
-    if (closed_loop(d, &miss, &bound)) {
+    if (closed_loop(d, s.target, &miss, &traced, &bound)) {
         int ok = miss <= bound;
-        lm_say(d->io, LM_BOTH, P(CLOSED_LOOP), miss, bound, ok ? P(CLOSED_OK) : P(CLOSED_BAD));
+        if (isnan(traced))
+            lm_say(d->io, LM_BOTH, P(CLOSED_LOOP_MODEL), miss, bound,
+                   ok ? P(CLOSED_OK) : P(CLOSED_BAD));
+        else
+            lm_say(d->io, LM_BOTH, P(CLOSED_LOOP), miss, traced, bound,
+                   ok ? P(CLOSED_OK) : P(CLOSED_BAD));
         if (miss > d->worst_um) d->worst_um = miss;
         if (bound > d->worst_bound_um) d->worst_bound_um = bound;
         d->outside += !ok;
