@@ -143,6 +143,7 @@ typedef struct watch {
     double worst;               /* largest spread of progress fractions, in steps */
     long ticks;
     int emergency_at;           /* call emergency_off at this tick (0: never) */
+    int stop_at;                /* ask to stop at this tick (0: never) */
     int laser_after;            /* laser line read after the emergency */
 } watch;
 
@@ -165,7 +166,7 @@ static int watcher(void *ctx)
         w->laser_after = w->sh->laser;
         return 1;
     }
-    return 0;
+    return w->stop_at && w->ticks >= w->stop_at;
 }
 
 static int open_sim(const char *text, rg_rig *rig, rg_machine **m, const char *log,
@@ -240,6 +241,29 @@ static void test_motion(void)
         CHECK(rg->move_steps(m, want, NULL, NULL, err, sizeof err) == RG_ETRAVEL &&
               sh->steps[RG_J_U] == before && strstr(err, "axis u: 20.0025 mm"),
               "a move past travel is refused before any pulse (%s)", err);
+    }
+    /* a move stopped half way (a signal): the position is no longer trusted */
+    {
+        long back[RG_NJOINTS], now[RG_NJOINTS];
+        memset(&w, 0, sizeof w);
+        w.sh = sh;
+        w.stop_at = 300;
+        rg->position(m, back, NULL);
+        back[RG_J_M1A] -= 2000;
+        CHECK(rg->move_steps(m, back, watcher, &w, err, sizeof err) == RG_ESTOP &&
+              !rg->homed(m) && strstr(err, "stopped"), "a stopped move un-homes the machine");
+        rg->position(m, now, NULL);
+        CHECK(now[RG_J_M1A] == sh->steps[RG_J_M1A] && now[RG_J_M1A] > back[RG_J_M1A],
+              "... after counting the steps it made (%ld)", now[RG_J_M1A]);
+        CHECK(rg->move_steps(m, back, NULL, NULL, err, sizeof err) == RG_EINVAL &&
+              rg->expose(m, 5, NULL, NULL, err, sizeof err) == RG_EINVAL,
+              "no move and no exposure until it is homed again");
+        CHECK(rg->home(m, NULL, NULL, err, sizeof err) == 0, "homed again (%s)", err);
+        memcpy(back, s, sizeof back);
+        back[RG_J_M1A] = 2000;
+        back[RG_J_M1B] = -2000; back[RG_J_U] = 3000; back[RG_J_V] = -7000;
+        back[RG_J_M2A] = 100; back[RG_J_M2B] = 1;
+        CHECK(rg->move_steps(m, back, NULL, NULL, err, sizeof err) == 0, "and back (%s)", err);
     }
     /* exposures */
     CHECK(rg->expose(m, 201, NULL, NULL, err, sizeof err) == RG_EINVAL &&
