@@ -47,3 +47,19 @@ all: build/lib/lensmat-rig.so
 MODULE_TEST_BINS  += build/lib/lensmat-rig.so build/asan/lib/lensmat-rig.so $(RIG_TBIN)
 MODULE_BENCH_BINS += build/lib/lensmat-rig.so $(RIG_BBIN)
 -include $(RIG_OBJ:.o=.d) $(RIG_SOBJ:.o=.d)
+
+# libFuzzer target for the geometry (tests/rig/fuzz_rig_geom.c): rig-file geometry
+# lines, then solve / quantise / Jacobian / forward on what they give; a short run in
+# t_80, a long one in `make fuzz`.
+build/fuzz_rig_geom: tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c src/rig/*.h) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+	    -o $@ tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c) -lgpiod -lgsl \
+	    -lgslcblas -lm -pthread
+fuzz-rig-geom: build/fuzz_rig_geom
+	@mkdir -p build/fuzz-rig-geom-corpus
+	build/fuzz_rig_geom -max_total_time=$${FUZZ_SECONDS:-600} -timeout=5 \
+	    build/fuzz-rig-geom-corpus tests/fuzz-rig-geom
+MODULE_TEST_BINS += build/fuzz_rig_geom
+fuzz: fuzz-rig-geom
+.PHONY: fuzz-rig-geom

@@ -21,7 +21,7 @@ void rg_detector_normal(const rg_geometry *g, double w[3])
  * direction; -1 when it meets the back or misses the aperture. */
 static int mirror_hit(const rg_gimbal *m, const double c[3], const double n[3],
                       const double o[3], const double d[3], double h[3],
-                      double out[3], double *inc)
+                      double out[3], double *inc, int ap)
 {
     double p0[3], rel[3];
     v3axpy(p0, c, m->offset, n);
@@ -31,7 +31,7 @@ static int mirror_hit(const rg_gimbal *m, const double c[3], const double n[3],
     double t = v3dot(rel, n) / dn;
     if (!(t > 0)) return -1;
     v3axpy(h, o, t, d);
-    if (m->radius > 0 && v3dist(h, p0) > m->radius) return -1;
+    if (ap && m->radius > 0 && v3dist(h, p0) > m->radius) return -1;
     v3reflect(out, d, n);
     *inc = acos(fmin(1, -dn));
     return 0;
@@ -39,17 +39,22 @@ static int mirror_hit(const rg_gimbal *m, const double c[3], const double n[3],
 
 int rg_mirrors(const rg_geometry *g, const rg_pose *p, rg_beam *b)
 {
+    return rg_mirrors_ap(g, p, b, 1);
+}
+
+int rg_mirrors_ap(const rg_geometry *g, const rg_pose *p, rg_beam *b, int ap)
+{
     double n1[3], n2[3], c2[3];
     b->diag = 0;
     rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);
     if (mirror_hit(&g->m1, g->m1.center, n1, g->laser_at, g->laser_dir, b->h1, b->d1,
-                   &b->inc1)) {
+                   &b->inc1, ap)) {
         b->diag |= RG_D_MISS_MIRROR;
         return -1;
     }
     rg_m2_center(g, p->j[RG_J_U], p->j[RG_J_V], c2);
     rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2);
-    if (mirror_hit(&g->m2, c2, n2, b->h1, b->d1, b->h2, b->d2, &b->inc2)) {
+    if (mirror_hit(&g->m2, c2, n2, b->h1, b->d1, b->h2, b->d2, &b->inc2, ap)) {
         b->diag |= RG_D_MISS_MIRROR;
         return -1;
     }
@@ -105,6 +110,11 @@ unsigned rg_travel_check(const rg_geometry *g, const rg_pose *p)
 
 int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b)
 {
+    return rg_forward_path(g, p, b, 1);
+}
+
+int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b, int checks)
+{
     double n1[3], n2[3], c2[3], w[3];
     for (int i = 0; i < 3; i++)
         b->spot[i] = b->normal[i] = b->d3[i] = b->det[i] = NAN;
@@ -126,6 +136,7 @@ int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b)
         v3sub(rel, g->detector, b->spot);
         v3axpy(b->det, b->spot, v3dot(rel, w) / dn, b->d3);
     }
+    if (!checks) return 0;
     /* what stands in the way: m2 across the detector leg and the incoming laser, m1
      * across the legs to and from the cornea */
     rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);

@@ -33,8 +33,13 @@ RG_HIDDEN int rg_gimbal_angles(const rg_gimbal *m, const double n[3], double *a,
 /* The beam through the two mirrors only: hit points, directions and the diagnostics
  * of the mirrors (miss, grazing).  0 or -1 (beam lost: b->diag says where). */
 RG_HIDDEN int rg_mirrors(const rg_geometry *g, const rg_pose *p, rg_beam *b);
+/* The same with ap 0: mirrors unbounded (the model's equations past the rims). */
+RG_HIDDEN int rg_mirrors_ap(const rg_geometry *g, const rg_pose *p, rg_beam *b, int ap);
 /* The whole path, plus blocking tests: 0 or -1. */
 RG_HIDDEN int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b);
+/* The same; checks 0: no blocking or travel tests (derivatives, landing errors). */
+RG_HIDDEN int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b,
+                              int checks);
 RG_HIDDEN int rg_forward(const rg_geometry *g, const rg_pose *p, rg_beam *b, char *err,
                          size_t errcap);
 /* m2's gimbal centre for a stage position. */
@@ -45,6 +50,16 @@ RG_HIDDEN void rg_detector_normal(const rg_geometry *g, double w[3]);
 RG_HIDDEN int rg_blocks(const rg_gimbal *m, const double c[3], const double n[3],
                         const double a[3], const double b[3]);
 RG_HIDDEN unsigned rg_travel_check(const rg_geometry *g, const rg_pose *p);
+
+/* ---- rg_aim.c: the construction repeated for mirror offsets (passes or -1) ---- */
+RG_HIDDEN int rg_aim_full(const rg_geometry *g, const double P[3], const double back[3],
+                          double n1[3], double n2[3], double c2[3]);
+RG_HIDDEN int rg_aim_stage(const rg_geometry *g, const double P[3], const double back[3],
+                           const double c2[3], double n1[3], double n2[3]);
+RG_HIDDEN int rg_aim_m1_beam(const rg_geometry *g, const double n1[3], double h1[3],
+                             double d1[3]);
+RG_HIDDEN int rg_aim_m2(const rg_geometry *g, const double P[3], const double h1[3],
+                        const double d1[3], const double c2[3], double n2[3]);
 
 /* ---- rg_solve.c ---- */
 RG_HIDDEN void rg_opts_fill(const rg_solve_opts *in, rg_solve_opts *o);

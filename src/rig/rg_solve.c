@@ -31,7 +31,7 @@ typedef struct nt_ctx {
 static int residual(const nt_ctx *c, const rg_pose *p, double *F)
 {
     rg_beam b;
-    if (rg_mirrors(c->g, p, &b)) return -1;
+    if (rg_mirrors_ap(c->g, p, &b, 0)) return -1;
     double rel[3], q[3], dd[3];
     v3sub(rel, c->target, b.h2);
     double along = v3dot(rel, b.d2);
@@ -141,7 +141,7 @@ static int spot4(const rg_geometry *g, const rg_pose *p, const double base[3],
                  const double e1[3], const double e2[3], double out[4])
 {
     rg_beam b;
-    if (rg_forward_beam(g, p, &b) || !isfinite(b.det[0])) return -1;
+    if (rg_forward_path(g, p, &b, 0) || !isfinite(b.det[0])) return -1;
     double d[3];
     v3sub(d, b.spot, base);
     out[0] = v3dot(d, t1);
@@ -262,18 +262,29 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
     v3scale(n2, bk, -1);
     v3sub(n2, n2, d12);
     if (v3norm(n1) < 1e-9 || v3norm(n2) < 1e-9) return fail(s, RG_D_GRAZING, err, errcap);
+    /* mirror surfaces off the axes: the construction repeated until the surfaces
+     * sit where the normals put them (rg_aim.c) */
+    int offs = g->m1.offset != 0 || g->m2.offset != 0, passes = 0;
+    if (offs && !o.newton_only) {
+        passes = rg_aim_full(g, P, bk, n1, n2, C2);
+        if (passes < 0) return fail(s, RG_D_NO_CONVERGE, err, errcap);
+        v3sub(d, C2, g->m2.center);
+        du = v3dot(d, g->p2_u);
+        dv = v3dot(d, g->p2_v);
+        s->pose.j[RG_J_U] = (du * vv - dv * uv) / gd;
+        s->pose.j[RG_J_V] = (dv * uu - du * uv) / gd;
+    }
     if (rg_gimbal_angles(&g->m1, n1, &s->pose.j[RG_J_M1A], &s->pose.j[RG_J_M1B]) ||
         rg_gimbal_angles(&g->m2, n2, &s->pose.j[RG_J_M2A], &s->pose.j[RG_J_M2B]))
         return fail(s, RG_D_GIMBAL, err, errcap);
-
-    /* mirror surfaces off the axes: the closed form is a start for the exact model */
-    if (g->m1.offset != 0 || g->m2.offset != 0) {
+    /* and checked on the exact model: Newton takes over if anything is left */
+    if (offs) {
         double in[3];
         v3scale(in, bk, -1);
         int it = rg_newton(g, &s->pose, (1u << RG_NJOINTS) - 1, P, in, o.tol,
                            o.max_iter, &s->residual);
         if (it < 0) return fail(s, RG_D_NO_CONVERGE, err, errcap);
-        s->iterations = it;
+        s->iterations = passes + it;
     }
 
     /* forward through the pose: blocking, apertures, travel, grazing, exactness */

@@ -152,7 +152,9 @@ typedef struct rg_solve_opts {
     double cond_max;           /* RG_D_ILLCOND above this (0: 1e4) */
     double tol;                /* Newton residual, mm (0: 1e-12) */
     int max_iter;              /* Newton iterations (0: 30) */
-    int no_checks;             /* 1: skip blocking/conditioning (speed); never in use */
+    int no_checks;             /* 1: skip the condition number (baseline timing only) */
+    int newton_only;           /* 1: mirror offsets by Newton alone, from the zero-offset
+                                  closed form (tests: the two methods must agree) */
 } rg_solve_opts;
 
 /* The beam through a pose (forward model, exact: offsets, finite mirrors). */
@@ -164,7 +166,8 @@ typedef struct rg_beam {
     double normal[3];          /* outward cornea normal there */
     double d3[3];              /* direction reflected by the cornea */
     double det[3];             /* where it crosses the detector plane (through the
-                                  detector point, normal to target->detector) */
+                                  detector point, normal along apex->detector: a
+                                  camera looking at the eye); NaN: never */
     double inc1, inc2, inc3;   /* incidence angles at m1, m2, cornea (rad) */
 } rg_beam;
 
@@ -180,8 +183,10 @@ typedef struct rg_solution {
     rg_beam beam;              /* the forward model through the pose */
 } rg_solution;
 
-/* Quantised pose: stage first, angles re-solved for the quantised centre, then
- * angles quantised; the landing errors of that pose on the exact forward model. */
+/* Quantised pose: stage first, angles re-solved for the quantised centre, then m1's
+ * angles (each grid corner around them), m2's re-aimed at the target, then m2's (the
+ * grid corners again; the nearest landing of the 16 wins); the landing errors of
+ * that pose on the exact forward model.  Steps count from the zero pose (joint 0). */
 typedef struct rg_quantised {
     rg_pose pose;              /* commanded (on the step grid) */
     int64_t steps[RG_NJOINTS]; /* step counts from the zero pose */

@@ -1,4 +1,4 @@
-/* bench_plan.c -- BENCH rig_plan_points_per_s: what each scan point costs before the
+/* bench_plan.c -- BENCH rig_plan_machine_points_per_s: what each scan point costs before the
  * motors turn, one thread: solve (section 38), quantise (stage first, angles
  * re-solved), plan the coordinated move from the previous point (travel checked,
  * trapezoid) and the forward check of the quantised pose, over the sunflower scan of
@@ -70,7 +70,7 @@ int main(int argc, char **argv)
     qsort(fwd, 5, sizeof *fwd, cmpd);
     printf("# rig plan: %d points to 1.8 mm, %d refused, motion %.1f s per point, one thread\n", N,
            bad, T / 5 / N);
-    printf("BENCH rig_plan_points_per_s %.0f points/s\n", runs[2]);
+    printf("BENCH rig_plan_machine_points_per_s %.0f points/s\n", runs[2]);
     printf("BENCH rig_plan_forward_only_per_s %.0f points/s\n", fwd[2]);
     printf("BENCH rig_plan_vs_forward %.3f ratio\n", runs[2] / fwd[2]);
     return bad != 0;

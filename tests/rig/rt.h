@@ -169,4 +169,12 @@ static rg_target rt_scan(int i, int n, double theta_max)
     rg_target t = {RG_T_ANGLES, theta_max * sqrt((i + 0.5) / n), fmod(i * 2.39996322972865332, 2 * RT_PI)};
     return t;
 }
+/* The same disc walked as a scan would: an equal-area spiral of `turns` turns,
+ * consecutive points close together. */
+static rg_target rt_scan_path(int i, int n, double theta_max, double turns)
+{
+    double f = sqrt((i + 0.5) / n);
+    rg_target t = {RG_T_ANGLES, theta_max * f, fmod(2 * RT_PI * turns * f, 2 * RT_PI)};
+    return t;
+}
 #endif

@@ -226,6 +226,36 @@ static void solutions(void)
         snprintf(what, sizeof what, "%s cornea, eye tilted (4, -3, 10 deg), decentred", name[model]);
         report(what, scan(&c, 120, 8 * RT_DEG), 120, 1);
     }
+    /* thick mirrors far off their axes: the construction must still converge */
+    rg_geometry th = g;
+    th.m1.offset = 10;
+    th.m2.offset = -6;
+    rg_target t0 = {RG_T_ANGLES, 0, 0};
+    rg_solution s0;
+    int r0 = rg->solve(&th, &t0, NULL, &s0, err, sizeof err);
+    CHECK(r0 == RG_EUNREACH && (s0.diag & RG_D_MISS_MIRROR),
+          "m1's surface 10 mm off its axes: the beam misses its 5 mm rim: %s", err);
+    th.m1.offset = 4;
+    th.m1.radius = th.m2.radius = 8;
+    th.m1.mount_radius = th.m2.mount_radius = 10;
+    report("mirror offsets 4 / -6 mm (8 mm rims)", scan(&th, 100, 7 * RT_DEG), 100, 1);
+    /* Newton alone from the zero-offset closed form lands on the same poses */
+    rg_solve_opts nopt = {0};
+    nopt.newton_only = 1;
+    double dp = 0;
+    int nits = 100, nok = 0;
+    for (int i = 0; i < 50; i++) {
+        rg_target t = rt_scan(i, 50, 12 * RT_DEG);
+        rg_solution a, b;
+        if (rg->solve(&g, &t, NULL, &a, err, sizeof err) ||
+            rg->solve(&g, &t, &nopt, &b, err, sizeof err)) continue;
+        nok++;
+        nits = b.iterations < nits ? b.iterations : nits;
+        for (int j = 0; j < RG_NJOINTS; j++) dp = fmax(dp, fabs(a.pose.j[j] - b.pose.j[j]));
+    }
+    CHECK(nok == 50 && nits >= 2 && dp < 1e-11,
+          "Newton on the exact model (>= %d iterations) and the repeated construction agree "
+          "on 50 poses to %.1e (rad, mm)", nits, dp);
     /* height/meridian targets */
     rg_target t = {RG_T_HEIGHT, 1.3, 0.7};
     rg_solution s;
@@ -392,6 +422,40 @@ static double quant_max(rg_geometry g, double spd, double spmm, double *ed, doub
     return ec;
 }
 
+static void quantisation_eyes(void)
+{
+    /* biconic, tilted and decentred eye: quantised poses traced land where the model says */
+    rg_geometry g;
+    rg->geometry_default(&g);
+    cornea_set(&g.cornea, RG_BICONIC);
+    double at[3] = {-0.4, 0.3, 0.2};
+    rg->eye_pose(&g.cornea, -3 * RT_DEG, 2 * RT_DEG, 40 * RT_DEG, at);
+    int n = 0, bad = 0;
+    double worst = 0, agree = 0;
+    for (int i = 0; i < 40; i++) {
+        rg_target t = rt_scan(i, 40, 8 * RT_DEG);
+        rg_solution s;
+        rg_quantised q;
+        rg_verify v;
+        rt_path p;
+        if (rg->solve(&g, &t, NULL, &s, err, sizeof err) ||
+            rg->quantise(&g, &t, &s, &q, err, sizeof err) || rt_forward(&g, &q.pose, &p)) {
+            bad++;
+            continue;
+        }
+        n++;
+        worst = fmax(worst, q.err_cornea);
+        agree = fmax(agree, rt_dist(p.spot, q.beam.spot));
+        if (!rg->verify(tr, &g, &q.pose, q.beam.spot, &v, err, sizeof err) && v.hit)
+            agree = fmax(agree, v.err_target);
+        else
+            bad++;
+    }
+    CHECK(bad == 0 && n == 40 && worst < 2 * (RT_DEG / 200) * 80 * 2 && agree < 1e-9,
+          "biconic, tilted decentred eye: 40 quantised poses land within %.2f um, the "
+          "independent model and the tracer agree on the spot to %.1e mm", worst * 1e3, agree);
+}
+
 static void quantisation(void)
 {
     rg_geometry g;
@@ -520,6 +584,7 @@ int main(void)
     solutions();
     stiff();
     quantisation();
+    quantisation_eyes();
     keys();
     return unit_failed();
 }
