@@ -169,3 +169,6 @@ PYEOF
 if command -v python3 > /dev/null; then
     check "rig tty: a bad rig file is asked again, a refused move does not end the session" rig_tty
 fi
+cp "$RIGEX" "$D/x.state"
+check "rig: the log's shared state file may not overwrite the rig file either" rig_bad logstate \
+    "x.state' is the rig file" "$D/x.state" sim "$D/x"

@@ -85,9 +85,15 @@ static int same_file(const char *a, const char *b)
 static int check_log(void *ctx, const char *word, char *msg, size_t cap)
 {
     rdlg *d = ctx;
+    static const char *const ext[] = {"", ".part", ".state", ".state.part"};
+    char name[WORD + 16];
     if (!strcmp(word, "-")) return 0;
-    if (lm_check_output(d->io, word, msg, cap)) return -1;
-    if (same_file(word, d->rig.path)) { snprintf(msg, cap, P(LOG_IS_RIG), word); return -1; }
+    /* the log, the file it grows in and the shared state: none may be an input */
+    for (int i = 0; i < 4; i++) {
+        snprintf(name, sizeof name, "%s%s", word, ext[i]);
+        if (lm_check_output(d->io, name, msg, cap)) return -1;
+        if (same_file(name, d->rig.path)) { snprintf(msg, cap, P(LOG_IS_RIG), name); return -1; }
+    }
     return 0;
 }
 
