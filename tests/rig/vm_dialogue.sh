@@ -15,7 +15,8 @@ run() {   # run REC: the session, answers from the file 'answers'
     wait
     return $rc
 }
-printf '%s\n' vm.rig gpiod home joints -14.9 -15 -20 -20 -15 -15 expose 200 quit > answers
+sed "s/^chip .*/chip $GPIO_CHIP/" vm.rig > chip.rig     # the guest's chip, whatever its name
+printf '%s\n' chip.rig gpiod home joints -14.9 -15 -20 -20 -15 -15 expose 200 quit > answers
 run r1.rec; ok $? "lensmat --rig on the gpio-sim chip: home, move, expose"; cat err >&2
 grep -q 'Chip open: gpiochip' r1.rec; ok $? "the record names the real chip"
 grep -q 'Exposed 200 ms' r1.rec; ok $? "the exposure ran"
