@@ -33,7 +33,7 @@ static int mirror_hit(const rg_gimbal *m, const double c[3], const double n[3],
     v3axpy(h, o, t, d);
     if (ap && m->radius > 0 && v3dist(h, p0) > m->radius) return -1;
     v3reflect(out, d, n);
-    *inc = acos(fmin(1, -dn));
+    *inc = -dn;                 /* the cosine; rg_forward_path makes it an angle */
     return 0;
 }
 
@@ -44,16 +44,28 @@ int rg_mirrors(const rg_geometry *g, const rg_pose *p, rg_beam *b)
 
 int rg_mirrors_ap(const rg_geometry *g, const rg_pose *p, rg_beam *b, int ap)
 {
-    double n1[3], n2[3], c2[3];
+    return rg_mirrors_nn(g, p, b, ap, NULL, NULL);
+}
+
+int rg_mirrors_nn(const rg_geometry *g, const rg_pose *p, rg_beam *b, int ap,
+                  double n1[3], double n2[3])
+{
+    double nn1[3], nn2[3], c2[3];
+    if (!n1) {
+        n1 = nn1;
+        rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);
+    }
+    if (!n2) {
+        n2 = nn2;
+        rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2);
+    }
     b->diag = 0;
-    rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);
     if (mirror_hit(&g->m1, g->m1.center, n1, g->laser_at, g->laser_dir, b->h1, b->d1,
                    &b->inc1, ap)) {
         b->diag |= RG_D_MISS_MIRROR;
         return -1;
     }
     rg_m2_center(g, p->j[RG_J_U], p->j[RG_J_V], c2);
-    rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2);
     if (mirror_hit(&g->m2, c2, n2, b->h1, b->d1, b->h2, b->d2, &b->inc2, ap)) {
         b->diag |= RG_D_MISS_MIRROR;
         return -1;
@@ -115,11 +127,20 @@ int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b)
 
 int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b, int checks)
 {
-    double n1[3], n2[3], c2[3], w[3];
+    double n1[3], n2[3];
+    rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);
+    rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2);
+    return rg_forward_nn(g, p, b, checks, n1, n2);
+}
+
+int rg_forward_nn(const rg_geometry *g, const rg_pose *p, rg_beam *b, int checks,
+                  double n1[3], double n2[3])
+{
+    double c2[3], w[3];
     for (int i = 0; i < 3; i++)
         b->spot[i] = b->normal[i] = b->d3[i] = b->det[i] = NAN;
     b->inc3 = NAN;
-    if (rg_mirrors(g, p, b)) return -1;
+    if (rg_mirrors_nn(g, p, b, 1, n1, n2)) return -1;
     if (rg_cornea_hit(&g->cornea, b->h2, b->d2, b->spot, b->normal, NULL)) {
         b->diag |= RG_D_MISS_CORNEA;
         return -1;
@@ -128,7 +149,6 @@ int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b, int chec
                                   g->cornea.zone * (1 + 1e-12))
         b->diag |= RG_D_OFF_CORNEA;
     v3reflect(b->d3, b->d2, b->normal);
-    b->inc3 = acos(fmin(1, fabs(v3dot(b->d2, b->normal))));
     rg_detector_normal(g, w);
     double dn = v3dot(b->d3, w);
     if (dn > 0) {
@@ -136,11 +156,15 @@ int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b, int chec
         v3sub(rel, g->detector, b->spot);
         v3axpy(b->det, b->spot, v3dot(rel, w) / dn, b->d3);
     }
-    if (!checks) return 0;
+    if (!checks) {
+        b->inc1 = b->inc2 = NAN;
+        return 0;
+    }
+    b->inc1 = acos(fmin(1, b->inc1));
+    b->inc2 = acos(fmin(1, b->inc2));
+    b->inc3 = acos(fmin(1, fabs(v3dot(b->d2, b->normal))));
     /* what stands in the way: m2 across the detector leg and the incoming laser, m1
      * across the legs to and from the cornea */
-    rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);
-    rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2);
     rg_m2_center(g, p->j[RG_J_U], p->j[RG_J_V], c2);
     if (rg_blocks(&g->m2, c2, n2, b->spot, g->detector) ||
         rg_blocks(&g->m2, c2, n2, g->laser_at, b->h1))

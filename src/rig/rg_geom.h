@@ -35,11 +35,17 @@ RG_HIDDEN int rg_gimbal_angles(const rg_gimbal *m, const double n[3], double *a,
 RG_HIDDEN int rg_mirrors(const rg_geometry *g, const rg_pose *p, rg_beam *b);
 /* The same with ap 0: mirrors unbounded (the model's equations past the rims). */
 RG_HIDDEN int rg_mirrors_ap(const rg_geometry *g, const rg_pose *p, rg_beam *b, int ap);
+/* The same with the mirrors' normals given (NULL: from the pose): derivatives move one
+ * joint, so the other mirror's normal need not be turned again. */
+RG_HIDDEN int rg_mirrors_nn(const rg_geometry *g, const rg_pose *p, rg_beam *b, int ap,
+                            double n1[3], double n2[3]);
 /* The whole path, plus blocking tests: 0 or -1. */
 RG_HIDDEN int rg_forward_beam(const rg_geometry *g, const rg_pose *p, rg_beam *b);
 /* The same; checks 0: no blocking or travel tests (derivatives, landing errors). */
 RG_HIDDEN int rg_forward_path(const rg_geometry *g, const rg_pose *p, rg_beam *b,
                               int checks);
+RG_HIDDEN int rg_forward_nn(const rg_geometry *g, const rg_pose *p, rg_beam *b,
+                            int checks, double n1[3], double n2[3]);
 RG_HIDDEN int rg_forward(const rg_geometry *g, const rg_pose *p, rg_beam *b, char *err,
                          size_t errcap);
 /* m2's gimbal centre for a stage position. */

@@ -2,10 +2,10 @@
  * step grids in the order that lets later axes absorb earlier errors -- the stage
  * first, the four angles re-solved (Newton, exact model) so the beam still runs along
  * the backward ray from the quantised centre; then m1's angles, m2's re-solved to
- * hit the target, then m2's -- trying the grid corners around each re-solved pair and
- * keeping the commanded pose that lands nearest the target (30 % smaller worst error
- * than rounding each joint to its nearest step) -- and the real landing errors of
- * the commanded pose on the exact forward model. */
+ * hit the target, then m2's -- trying the grid corners around m1's re-solved pair and
+ * keeping the commanded pose that lands nearest the target (a quarter smaller worst
+ * error than rounding each joint to its nearest step) -- and the real landing errors
+ * of the commanded pose on the exact forward model. */
 #include <stdio.h>
 #include <string.h>
 #include "rig/rg_geom.h"
@@ -63,13 +63,14 @@ int rg_quantise(const rg_geometry *g, const rg_target *t, const rg_solution *s,
     rg_beam b;
     land(g, &q->pose, s->target, &b, &q->err_cornea_resolved, &q->err_detector_resolved,
          0);
-    /* m1 on its grid -- each of the 4 grid corners around the re-solved angles --,
-     * m2's angles re-aimed at the target from where m1 then sends the beam, m2 on its
-     * grid (4 corners again): of the 16 commanded poses the one landing nearest the
-     * target (rounding each joint to its nearest step is one of them) */
+    /* m1 on its grid -- each of the 4 grid corners around its re-solved angles --,
+     * m2's angles re-aimed at the target from where m1 then sends the beam and
+     * rounded to their nearest steps: of the 4 commanded poses the one landing nearest
+     * the target.  (m1's choice decides where m2's rounding falls; trying m2's corners
+     * too, 16 poses, gains under 4 % more.) */
     rg_pose cont = q->pose, best = q->pose;
     double best_err = INFINITY;
-    double a1[2], b1[2], a2[2], b2[2];
+    double a1[2], b1[2];
     int na1 = corners(&g->joint[RG_J_M1A], cont.j[RG_J_M1A], a1);
     int nb1 = corners(&g->joint[RG_J_M1B], cont.j[RG_J_M1B], b1);
     for (int i = 0; i < na1; i++)
@@ -89,17 +90,11 @@ int rg_quantise(const rg_geometry *g, const rg_target *t, const rg_solution *s,
                               30, &res) < 0)
                     p = keep;   /* m2's angles stay as re-solved for the stage */
             }
-            int na2 = corners(&g->joint[RG_J_M2A], p.j[RG_J_M2A], a2);
-            int nb2 = corners(&g->joint[RG_J_M2B], p.j[RG_J_M2B], b2);
-            for (int l = 0; l < na2; l++)
-                for (int m = 0; m < nb2; m++) {
-                    rg_pose c = p;
-                    double ec, ed;
-                    c.j[RG_J_M2A] = a2[l];
-                    c.j[RG_J_M2B] = b2[m];
-                    land(g, &c, s->target, &b, &ec, &ed, 0);
-                    if (ec < best_err) { best_err = ec; best = c; }
-                }
+            p.j[RG_J_M2A] = qstep(&g->joint[RG_J_M2A], p.j[RG_J_M2A]);
+            p.j[RG_J_M2B] = qstep(&g->joint[RG_J_M2B], p.j[RG_J_M2B]);
+            double ec, ed;
+            land(g, &p, s->target, &b, &ec, &ed, 0);
+            if (ec < best_err) { best_err = ec; best = p; }
         }
     q->pose = best;
     for (int k = 0; k < RG_NJOINTS; k++)

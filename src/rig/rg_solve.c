@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <string.h>
 #include <gsl/gsl_linalg.h>
-#include <gsl/gsl_errno.h>
 #include "rig/rg_geom.h"
 #include "rig/rg_vec.h"
 
@@ -18,6 +17,7 @@ void rg_opts_fill(const rg_solve_opts *in, rg_solve_opts *o)
     if (!(o->cond_max > 0)) o->cond_max = 1e4;
     if (!(o->tol > 0)) o->tol = 1e-12;
     if (o->max_iter <= 0) o->max_iter = 30;
+    if (!(o->trace_tol > 0)) o->trace_tol = 1e-6;
 }
 
 /* ---- Newton on the exact model ------------------------------------------------- */
@@ -77,7 +77,6 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
     double F[6], Fn[6], J[36], dx[6];
     if (residual(&c, p, F)) { *res = INFINITY; return -1; }
     double f = maxabs(F, n);
-    gsl_error_handler_t *old = gsl_set_error_handler_off();
     int it = 0, status = -1;
     for (;;) {
         if (f <= tol) { status = it; break; }
@@ -104,7 +103,17 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
         perm.size = n;
         perm.data = pd;
         int sg;
-        if (gsl_linalg_LU_decomp(&A.matrix, &perm, &sg) ||
+        /* GSL reports a singular matrix through its global error handler (abort by
+         * default, and not ours to change in a thread-safe engine): look first */
+        int finite = 1;
+        for (int r = 0; r < n * n; r++) finite &= isfinite(J[r]);
+        if (!finite || gsl_linalg_LU_decomp(&A.matrix, &perm, &sg)) break;
+        double dmax = 0, dmin = INFINITY;
+        for (int r = 0; r < n; r++) {
+            dmax = fmax(dmax, fabs(J[r * n + r]));
+            dmin = fmin(dmin, fabs(J[r * n + r]));
+        }
+        if (!(dmin > 1e-14 * dmax) ||
             gsl_linalg_LU_solve(&A.matrix, &perm, &B.vector, &X.vector))
             break;
         /* damped: halve the step until the residual falls */
@@ -127,7 +136,6 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
         }
         if (!ok) break;     /* no descent: at the rounding floor or stuck */
     }
-    gsl_set_error_handler(old);
     *res = f;
     if (status < 0 && f <= tol * 1e3) status = it;   /* at the rounding floor */
     return status;
@@ -138,10 +146,19 @@ int rg_newton(const rg_geometry *g, rg_pose *p, unsigned free, const double targ
  * detector plane. */
 static int spot4(const rg_geometry *g, const rg_pose *p, const double base[3],
                  const double t1[3], const double t2[3], const double dbase[3],
-                 const double e1[3], const double e2[3], double out[4])
+                 const double e1[3], const double e2[3], double out[4],
+                 const double n1b[3], const double n2b[3], int k)
 {
     rg_beam b;
-    if (rg_forward_path(g, p, &b, 0) || !isfinite(b.det[0])) return -1;
+    double n1[3], n2[3];
+    /* only the moved joint's mirror turns */
+    if (k == RG_J_M1A || k == RG_J_M1B)
+        rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1);
+    else v3copy(n1, n1b);
+    if (k == RG_J_M2A || k == RG_J_M2B)
+        rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2);
+    else v3copy(n2, n2b);
+    if (rg_forward_nn(g, p, &b, 0, n1, n2) || !isfinite(b.det[0])) return -1;
     double d[3];
     v3sub(d, b.spot, base);
     out[0] = v3dot(d, t1);
@@ -160,26 +177,31 @@ int rg_jacobian(const rg_geometry *g, const rg_pose *p, double *J, double *cond,
         snprintf(err, errcap, "the beam of this pose does not reach the detector");
         return RG_EUNREACH;
     }
-    double t1[3], t2[3], w[3], e1[3], e2[3], hint[3] = {0, 0, 1};
+    double t1[3], t2[3], w[3], e1[3], e2[3], hint[3] = {0, 0, 1}, n1b[3], n2b[3];
+    rg_gimbal_normal(&g->m1, p->j[RG_J_M1A], p->j[RG_J_M1B], n1b);
+    rg_gimbal_normal(&g->m2, p->j[RG_J_M2A], p->j[RG_J_M2B], n2b);
     v3basis(b.normal, g->p2_u, t1, t2);
     rg_detector_normal(g, w);
     v3basis(w, hint, e1, e2);
     double At[RG_NJOINTS * 4];          /* J^T, scaled: 6 x 4 */
     for (int k = 0; k < RG_NJOINTS; k++) {
-        double h = 1e-6, sp[4], sm[4];
+        /* forward differences: relative accuracy ~1e-7, plenty for a condition
+         * number and for predicting moves; half the forward passes of central ones */
+        double h = 1e-7, sp[4];     /* spot moves from the base spot */
         rg_pose q = *p;
         q.j[k] += h;
-        int r1 = spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sp);
-        q.j[k] = p->j[k] - h;
-        int r2 = spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sm);
-        if (r1 || r2) {
-            snprintf(err, errcap, "the beam leaves the detector within 1e-6 of joint "
-                     "%s", rg_joint_name(k));
-            return RG_EUNREACH;
+        if (spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sp, n1b, n2b, k)) {
+            q.j[k] = p->j[k] - h;   /* at an edge: the other side */
+            h = -h;
+            if (spot4(g, &q, b.spot, t1, t2, b.det, e1, e2, sp, n1b, n2b, k)) {
+                snprintf(err, errcap, "the beam leaves the detector within 1e-7 of "
+                         "joint %s", rg_joint_name(k));
+                return RG_EUNREACH;
+            }
         }
         double col2 = 0;
         for (int r = 0; r < 4; r++) {
-            J[r * RG_NJOINTS + k] = (sp[r] - sm[r]) / (2 * h);
+            J[r * RG_NJOINTS + k] = sp[r] / h;
             col2 += J[r * RG_NJOINTS + k] * J[r * RG_NJOINTS + k];
         }
         double sc = g->joint[k].steps_per > 0 ? 1 / g->joint[k].steps_per
@@ -192,22 +214,52 @@ int rg_jacobian(const rg_geometry *g, const rg_pose *p, double *J, double *cond,
         gsl_matrix_view Vv = gsl_matrix_view_array(V, 4, 4);
         gsl_vector_view Sv = gsl_vector_view_array(S, 4);
         gsl_vector_view Wv = gsl_vector_view_array(work, 4);
-        gsl_error_handler_t *old = gsl_set_error_handler_off();
-        int bad = gsl_linalg_SV_decomp(&A.matrix, &Vv.matrix, &Sv.vector, &Wv.vector);
-        gsl_set_error_handler(old);
+        /* (finite input: the only error SV_decomp can raise is non-convergence) */
+        int bad = 0;
+        for (int r = 0; r < RG_NJOINTS * 4; r++) bad |= !isfinite(At[r]);
+        if (!bad) bad = gsl_linalg_SV_decomp(&A.matrix, &Vv.matrix, &Sv.vector, &Wv.vector);
         *cond = bad ? INFINITY : (S[3] > 0 ? S[0] / S[3] : INFINITY);
     }
     return RG_OK;
 }
 
 /* ---- the backward solution ------------------------------------------------------- */
-static int fail(rg_solution *s, unsigned bit, char *err, size_t errcap)
+/* The message: what the diagnostics say, and the figures behind them (which joint
+ * wants how much of what travel, the angle to p2, the incidences, the condition). */
+static void message(const rg_geometry *g, const rg_solution *s, char *err, size_t errcap)
 {
     char txt[512];
-    s->diag |= bit;
+    size_t l;
     snprintf(err, errcap, "%s", rg_diag_text(s->diag, txt, sizeof txt));
+#define ADD(...) do { l = strlen(err); if (l < errcap) snprintf(err + l, errcap - l, __VA_ARGS__); } while (0)
+    if (s->diag & RG_D_TRAVEL)
+        for (int k = 0; k < RG_NJOINTS; k++) {
+            const rg_joint *j = &g->joint[k];
+            double u = k == RG_J_U || k == RG_J_V ? 1 : 180 / RG_PI;
+            if (j->lo < j->hi && (s->pose.j[k] < j->lo || s->pose.j[k] > j->hi))
+                ADD(" (%s needs %.4g, travel %.4g..%.4g %s)", rg_joint_name(k),
+                    s->pose.j[k] * u, j->lo * u, j->hi * u, u == 1 ? "mm" : "deg");
+        }
+    if (s->diag & (RG_D_PARALLEL_P2 | RG_D_NEAR_PARALLEL))
+        ADD(" (backward ray %.3g deg from p2)", s->p2_angle * 180 / RG_PI);
+    if ((s->diag & RG_D_GRAZING) && isfinite(s->beam.inc1))
+        ADD(" (incidence m1 %.3g, m2 %.3g, cornea %.3g deg)", s->beam.inc1 * 180 / RG_PI,
+            s->beam.inc2 * 180 / RG_PI, s->beam.inc3 * 180 / RG_PI);
+    else if (s->diag & RG_D_GRAZING)
+        ADD(" (incidence on the cornea %.3g deg)", s->beam.inc3 * 180 / RG_PI);
+    if (s->diag & RG_D_ILLCOND) ADD(" (condition number %.3g)", s->cond);
+    if (s->diag & RG_D_TRACE_MISS) ADD(" (by %.3g mm)", s->traced_err);
+#undef ADD
+}
+
+static int fail_g(const rg_geometry *g, rg_solution *s, unsigned bit, char *err,
+                  size_t errcap)
+{
+    s->diag |= bit;
+    message(g, s, err, errcap);
     return (s->diag & RG_D_FATAL) == RG_D_TRAVEL ? RG_ETRAVEL : RG_EUNREACH;
 }
+#define fail(s, bit, err, cap) fail_g(g, s, bit, err, cap)
 
 int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts,
              rg_solution *s, char *err, size_t errcap)
@@ -217,6 +269,8 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
     memset(s, 0, sizeof *s);
     s->cond = NAN;
     s->p2_angle = NAN;
+    s->beam.inc1 = s->beam.inc2 = s->beam.inc3 = NAN;
+    s->traced_err = NAN;
     int rc = rg_cornea_point(&g->cornea, t, s->target, s->normal, err, errcap);
     if (rc == RG_EUNREACH) { s->diag |= RG_D_OFF_CORNEA; return rc; }
     if (rc) return rc;
@@ -228,7 +282,8 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
     v3norm(r);
     double ci = v3dot(r, N);
     if (!(ci > 1e-9)) return fail(s, RG_D_DETECTOR_SIDE, err, errcap);
-    if (acos(fmin(1, ci)) > o.max_incidence) return fail(s, RG_D_GRAZING, err, errcap);
+    s->beam.inc3 = acos(fmin(1, ci));
+    if (s->beam.inc3 > o.max_incidence) return fail(s, RG_D_GRAZING, err, errcap);
     double *bk = s->back;
     v3scale(bk, N, 2 * ci);
     v3sub(bk, bk, r);
@@ -305,16 +360,20 @@ int rg_solve(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts
         if (rg_jacobian(g, &s->pose, J, &s->cond, e2, sizeof e2)) s->cond = INFINITY;
         if (!(s->cond <= o.cond_max)) s->diag |= RG_D_ILLCOND;
     }
-    if (s->diag & RG_D_FATAL) return fail(s, 0, err, errcap);
-    if (s->diag) {
-        char txt[512];
-        snprintf(err, errcap, "%s", rg_diag_text(s->diag, txt, sizeof txt));
-        if (s->diag & RG_D_ILLCOND) {
-            size_t l = strlen(err);
-            if (l < errcap)
-                snprintf(err + l, errcap - l, " (condition number %.3g)", s->cond);
+    if (o.trace && !(s->diag & RG_D_FATAL)) {
+        /* the independent check, when the caller hands us the tracer */
+        rg_verify v;
+        char e2[256];
+        if (rg_verify_pose(o.trace, g, &s->pose, P, &v, e2, sizeof e2)) {
+            snprintf(err, errcap, "%s", e2);
+            return RG_EIO;
         }
-    } else if (errcap) err[0] = 0;
+        s->traced_err = v.hit ? fmax(v.err_target, v.err_detector) : INFINITY;
+        if (!(s->traced_err <= o.trace_tol)) s->diag |= RG_D_TRACE_MISS;
+    }
+    if (s->diag & RG_D_FATAL) return fail(s, 0, err, errcap);
+    if (s->diag) message(g, s, err, errcap);
+    else if (errcap) err[0] = 0;
     return RG_OK;
 }
 
@@ -335,6 +394,7 @@ const char *rg_diag_text(unsigned diag, char *buf, size_t cap)
         "beam misses the cornea",
         "ill-conditioned pose",
         "backward ray close to parallel to p2",
+        "the traced beam misses the target or the detector (a bug)",
     };
     size_t l = 0;
     if (cap) buf[0] = 0;

@@ -1,7 +1,8 @@
 /* rg_verify.c -- the independent check of a pose: the rig built as a scene of the
  * trace engine (its public table only, handed in by the caller) -- m1 and m2 as
  * mirror discs, the cornea as an axial surface whose Fresnel reflection is followed
- * (a biconic, which the tracer has no surface for: its tangent plane at the target),
+ * (a biconic, which the tracer has no surface for: its tangent plane where the beam
+ * meets it),
  * a detector disc at the detector point -- and one laser ray traced through it. */
 #include <stdio.h>
 #include <string.h>
@@ -99,15 +100,21 @@ int rg_verify_pose(const struct trace_api *tr, const rg_geometry *g, const rg_po
     const rg_cornea *k = &g->cornea;
     double tn[3];
     if (k->model == RG_BICONIC) {
-        /* the tracer has no biconic: the tangent plane at the target reflects a ray
-         * through the target exactly as the surface does */
-        double pe[3], rel[3], ne[3];
-        v3sub(rel, target, k->trans);
+        /* the tracer has no biconic: the tangent plane where this pose's beam meets
+         * the surface (the analytic forward model's spot; the target when the model
+         * finds none) reflects that ray exactly as the surface does -- a quantised
+         * pose lands microns off the target, and the plane there would tilt the
+         * reflected ray by 2 x miss / R */
+        double pe[3], rel[3], ne[3], at[3];
+        rg_beam fb;
+        if (rg_forward_path(g, p, &fb, 0) == 0) v3copy(at, fb.spot);
+        else v3copy(at, target);
+        v3sub(rel, at, k->trans);
         m3tmul(pe, k->rot, rel);
         rg_normal_eye(k, pe, ne);
         m3mul(tn, k->rot, ne);
         s.shape = TRACE_PLANE;
-        v3copy(s.at, target);
+        v3copy(s.at, at);
         v3scale(s.axis, tn, -1);
         s.r_outer = 0.5;
     } else {

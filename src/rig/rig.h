@@ -143,9 +143,12 @@ enum rg_diag {
     RG_D_MISS_CORNEA   = 1 << 11,  /* forward: the beam misses the cornea */
     RG_D_ILLCOND       = 1 << 12,  /* warning: joints-to-spot map ill-conditioned */
     RG_D_NEAR_PARALLEL = 1 << 13,  /* warning: backward ray within 2x the p2 limit */
-    RG_D_FATAL         = (1 << 12) - 1
+    RG_D_TRACE_MISS    = 1 << 14,  /* the trace engine's beam missed target or detector
+                                      by more than trace_tol (a bug: never seen) */
+    RG_D_FATAL         = ((1 << 12) - 1) | (1 << 14)
 };
 
+struct trace_api;              /* src/trace/trace.h: the caller passes the engine table */
 typedef struct rg_solve_opts {
     double min_p2_angle;       /* smallest angle backward ray / p2 (rad; 0: 2 deg) */
     double max_incidence;      /* largest incidence on a mirror (rad; 0: 80 deg) */
@@ -155,6 +158,9 @@ typedef struct rg_solve_opts {
     int no_checks;             /* 1: skip the condition number (baseline timing only) */
     int newton_only;           /* 1: mirror offsets by Newton alone, from the zero-offset
                                   closed form (tests: the two methods must agree) */
+    const struct trace_api *trace;  /* non-NULL: every solution also traced through
+                                       the trace engine (rig_api.verify) */
+    double trace_tol;          /* largest traced miss accepted (mm; 0: 1e-6) */
 } rg_solve_opts;
 
 /* The beam through a pose (forward model, exact: offsets, finite mirrors). */
@@ -178,15 +184,18 @@ typedef struct rg_solution {
     double back[3];            /* unit backward ray, target toward m2 */
     double p2_angle;           /* angle between the backward ray and p2 (rad) */
     double cond;               /* condition number of the joints-to-spot map */
-    int iterations;            /* Newton iterations (0: closed form was exact) */
+    int iterations;            /* offsets: construction passes + Newton steps (0:
+                                  mirrors on their axes, the closed form is exact) */
     double residual;           /* largest model residual at the end (mm) */
     rg_beam beam;              /* the forward model through the pose */
+    double traced_err;         /* with opts->trace: the traced beam's largest miss of
+                                  target and detector point (mm); else NaN */
 } rg_solution;
 
 /* Quantised pose: stage first, angles re-solved for the quantised centre, then m1's
- * angles (each grid corner around them), m2's re-aimed at the target, then m2's (the
- * grid corners again; the nearest landing of the 16 wins); the landing errors of
- * that pose on the exact forward model.  Steps count from the zero pose (joint 0). */
+ * angles (each grid corner around them), m2's re-aimed at the target and rounded (the
+ * nearest landing of the 4 wins); the landing errors of that pose on the exact
+ * forward model.  Steps count from the zero pose (joint 0). */
 typedef struct rg_quantised {
     rg_pose pose;              /* commanded (on the step grid) */
     int64_t steps[RG_NJOINTS]; /* step counts from the zero pose */
@@ -208,7 +217,6 @@ typedef struct rg_verify {
     double reflect_err;        /* largest reflection-law defect seen at any mirror or
                                   the cornea, |d_out - (d_in - 2(d_in.n)n)| */
 } rg_verify;
-struct trace_api;              /* src/trace/trace.h: the caller passes the engine table */
 
 /* ==== end of geometry ============================================================ */
 
@@ -339,7 +347,8 @@ typedef struct rig_api {
                     rg_quantised *q, char *err, size_t errcap);
     /* Independent check through the trace engine: mirrors as TRACE_MIRROR planes, the
      * cornea as a TRACE_AXIAL surface with Fresnel reflection (a biconic: its
-     * tangent plane at the target), a detector disc at the detector point.
+     * tangent plane where the forward model's beam meets it), a detector disc at
+     * the detector point.
      * target: the point the beam should hit (a solution's target).  RG_OK (v
      * filled; v->hit 0 when the traced beam never reached the detector) or RG_EIO
      * (the trace engine failed: message). */

@@ -12,6 +12,8 @@
  *                         of the commanded pose, one thread, the points in scan order
  *                         (a 12-turn spiral); baseline in the same run: the closed
  *                         form alone (mirrors on their axes, no checks);
+ *   rig_plan_points_per_cpu_s  the same per second of this thread's CPU time (what
+ *                         the code costs when other jobs share the machine);
  *   rig_scan_move_ms_per_point  the mean move time of that scan at 2000 steps/s.
  * Targets: a Fermat spiral out to theta 12 deg (heights to 1.6 mm; the zone the example
  * rig reaches within its travel).  "quick" as argv[1]: fewer repetitions. */
@@ -25,6 +27,13 @@ static double now(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec + t.tv_nsec * 1e-9;
+}
+/* CPU time of this thread: what the code costs when the machine is shared */
+static double cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     return t.tv_sec + t.tv_nsec * 1e-9;
 }
 static double median3(double a, double b, double c)
@@ -99,7 +108,7 @@ int main(int argc, char **argv)
     if (rg->geometry_check(&g, err, sizeof err)) { fprintf(stderr, "%s\n", err); return 1; }
 
     /* exactness: every pose of the scan traced */
-    double worst = 0, tt = now();
+    double worst = 0, tt = now(), cmin = INFINITY, cmax = 0;
     int unreach = 0, missed = 0;
     for (int i = 0; i < NPTS; i++) {
         rg_target t = rt_scan(i, NPTS, THMAX);
@@ -111,6 +120,8 @@ int main(int argc, char **argv)
             continue;
         }
         worst = fmax(worst, fmax(v.err_target, v.err_detector));
+        cmin = fmin(cmin, s.cond);
+        cmax = fmax(cmax, s.cond);
     }
     tt = now() - tt;
     if (unreach || missed) {
@@ -119,6 +130,9 @@ int main(int argc, char **argv)
     }
     printf("BENCH rig_solution_err_um %.3g um\n", worst * 1e3);
     printf("BENCH rig_trace_check_points_per_s %.0f points/s\n", NPTS / tt);
+    /* the joints-to-spot map's condition number (one step per joint) over the scan */
+    printf("BENCH rig_cond_min %.0f ratio\n", cmin);
+    printf("BENCH rig_cond_max %.0f ratio\n", cmax);
 
     /* quantised, the example rig's steps */
     double ec, ed;
@@ -163,19 +177,20 @@ int main(int argc, char **argv)
 
     /* speed: the path a scan takes, one thread */
     int reps = quick ? 3 : 20;
-    double rate[3], base[3], move_s = 0;
+    double rate[3], base[3], crate[3], move_s = 0;
     rg_geometry z = g;
     z.m1.offset = z.m2.offset = 0;
     rg_solve_opts fast = {0};
     fast.no_checks = 1;
     for (int k = 0; k < 3; k++) {
         int64_t prev[RG_NJOINTS] = {0};
-        double e = 0, t0 = now();
+        double e = 0, t0 = now(), c0 = cpu_now();
         int n = 0;
         move_s = 0;
         for (int r = 0; r < reps; r++)
             for (int i = 0; i < NPTS; i++) n += point(&g, i, prev, &move_s, &e) == 0;
         rate[k] = n / (now() - t0);
+        crate[k] = n / (cpu_now() - c0);
         if (n != reps * NPTS) { fprintf(stderr, "bench_geom: %d points failed\n", reps * NPTS - n); return 1; }
         t0 = now();
         n = 0;
@@ -189,6 +204,7 @@ int main(int argc, char **argv)
     }
     double pr = median3(rate[0], rate[1], rate[2]), br = median3(base[0], base[1], base[2]);
     printf("BENCH rig_plan_points_per_s %.0f points/s\n", pr);
+    printf("BENCH rig_plan_points_per_cpu_s %.0f points/s\n", median3(crate[0], crate[1], crate[2]));
     printf("BENCH rig_closed_form_points_per_s %.0f points/s\n", br);
     printf("BENCH rig_plan_vs_closed_form %.2f ratio\n", pr / br);
     /* the moves of that path at the example rig's speeds: the pitfall of section 39 */
