@@ -63,8 +63,9 @@ build/asan/unit_%: tests/unit_%.c $(SANLIB)
 build/obj/bench_paraxial: tests/bench_paraxial.c $(LIBOBJ)
 	$(CC) $(BASE) $(OPT) -o $@ $< $(LIBOBJ) $(LIBS)
 
-# libFuzzer target for the answer reader and number parser (clang from Debian): the
-# core sources (not main.c) compiled with the fuzzer's instrumentation.
+# libFuzzer target for the answer reader, the number parser and every dialogue of
+# src/dialogue/table.c (clang from Debian): the core sources (not main.c) compiled
+# with the fuzzer's instrumentation.
 build/fuzz_answers: tests/fuzz_answers.c $(LIBCORE) $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
@@ -104,9 +105,28 @@ fuzz: build/fuzz_answers
 example: lensmat
 	./lensmat --example example.rec
 
+# Installing: PREFIX/bin/lensmat finds its modules in PREFIX/lib/lensmat (engine.c
+# looks in EXEDIR/../lib/lensmat); DESTDIR is prepended to every path (packaging).
+PREFIX  ?= /usr/local
+BINDIR  := $(PREFIX)/bin
+MODDIR  := $(PREFIX)/lib/lensmat
+MANDIR  := $(PREFIX)/share/man/man1
+DOCDIR  := $(PREFIX)/share/doc/lensmat
+install: all
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(MODDIR) $(DESTDIR)$(MANDIR) $(DESTDIR)$(DOCDIR)
+	install -m 755 lensmat $(DESTDIR)$(BINDIR)/lensmat
+	for m in build/lib/lensmat-*.so; do [ -f "$$m" ] || continue; \
+	    install -m 644 "$$m" $(DESTDIR)$(MODDIR)/; done
+	install -m 644 doc/lensmat.1 $(DESTDIR)$(MANDIR)/lensmat.1
+	install -m 644 README.md $(DESTDIR)$(DOCDIR)/README.md
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/lensmat $(DESTDIR)$(MODDIR)/lensmat-*.so \
+	    $(DESTDIR)$(MANDIR)/lensmat.1 $(DESTDIR)$(DOCDIR)/README.md
+	-rmdir $(DESTDIR)$(MODDIR) $(DESTDIR)$(DOCDIR) 2> /dev/null
+
 clean:
 	rm -rf build lensmat example.rec
 
-.PHONY: all check bench fuzz example clean
+.PHONY: all check bench fuzz example clean install uninstall
 .SECONDARY:
 -include $(OBJ:.o=.d) $(SANOBJ:.o=.d)

@@ -4,8 +4,12 @@
  * decimals) accepts |x - printed| <= half a unit of the last printed decimal.  Where
  * the document itself is wrong the test asserts the right value and says so. */
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 #include "unit.h"
 #include "paraxial/paraxial.h"
+#include "dialogue/ask.h"
 
 /* x rounds to `printed` at `dec` decimals (with a little slack for binary ties). */
 static int doc(double x, double printed, int dec)
@@ -270,8 +274,48 @@ static void cornea(void)
           "cornea: radius -> power -> radius");
 }
 
+/* The dialogue layer's pieces the calculation dialogues add: indices by name, and
+ * a group of answers rejected together (the record cut back to the mark). */
+static void answers(void)
+{
+    double v = 0;
+    char dir[] = "/tmp/unit_calcXXXXXX", rec[64], buf[512] = "";
+    FILE *in, *f;
+    lm_io io;
+    lm_mark m;
+    lm_numspec spec = {"the index", LM_POSITIVE, 0};
+    size_t n;
+    int rc;
+    CHECK(lm_parse_index("water", &v) == LM_NUM_OK && v == 1.333, "index: water 1.333");
+    CHECK(lm_parse_index("AIR", &v) == LM_NUM_OK && v == 1.000293, "index: AIR (any case)");
+    CHECK(lm_parse_index("1.5", &v) == LM_NUM_OK && v == 1.5, "index: a number");
+    CHECK(lm_parse_index("glass", &v) == LM_NUM_SYNTAX, "index: unknown medium refused");
+    CHECK(lm_parse_index("nan", &v) == LM_NUM_NAN, "index: nan refused");
+    if (!mkdtemp(dir)) { CHECK(0, "mkdtemp"); return; }
+    snprintf(rec, sizeof rec, "%s/r.rec", dir);
+    in = fmemopen((void *)"Crown 1.50\n-5\n", 14, "r");
+    if (!in || lm_io_open(&io, rec, in, "in", 0)) { CHECK(0, "open a session"); return; }
+    rc = lm_ask_index(&io, NULL, "Q1\n", &spec, &v);
+    CHECK(rc == LM_GO && v == 1.5168, "ask index: crown");
+    lm_mark_set(&io, &m);
+    rc = lm_ask_index(&io, NULL, "Q2\n", &spec, &v);
+    CHECK(rc == LM_GO && v == 1.5, "ask index: 1.50");
+    rc = lm_mark_reject(&io, &m, "the pair", "they do not go together", "again", "Q2\n");
+    CHECK(rc == LM_FAIL, "reject in a replay: LM_FAIL");
+    lm_io_close(&io);
+    fclose(in);
+    if ((f = fopen(rec, "r"))) { n = fread(buf, 1, sizeof buf - 1, f); buf[n] = 0; fclose(f); }
+    CHECK(!strcmp(buf, "Q1\ninput: crown\n(crown: index 1.5168)\nQ2\n"),
+          "reject: the record keeps the accepted answers and ends with the group's "
+          "question");
+    if (strcmp(buf, "Q1\ninput: crown\n(crown: index 1.5168)\nQ2\n")) printf("record: [%s]\n", buf);
+    unlink(rec);
+    rmdir(dir);
+}
+
 int main(void)
 {
+    answers();
     gauss();
     figures();
     media();

@@ -128,8 +128,18 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
             io->rec_ino = st.st_ino;
         }
     }
-    io->interactive = in == stdin && isatty(0) && isatty(1);
-    if (io->interactive) history_setup();
+    /* Interactive means a person types the answers: standard input is a terminal.
+     * Prompts still go to stdout (`lensmat x.rec | tee log` keeps them); readline
+     * echoes and edits on a terminal: stdout if it is one, else stderr, else the
+     * controlling terminal. */
+    io->interactive = in == stdin && isatty(0);
+    if (io->interactive) {
+        history_setup();
+        if (!isatty(1)) {
+            FILE *tty = isatty(2) ? stderr : fopen("/dev/tty", "w");
+            if (tty) rl_outstream = tty;
+        }
+    }
     signals_setup();
     io->cur = "";
     return 0;
@@ -191,8 +201,8 @@ void lm_matrix(lm_io *io, int where, const char *elem_fmt, double a, double b,
     }
 }
 
-/* Read the next answer line.  Returns 0, or -1 at end of input. */
-static int read_line(lm_io *io)
+/* Read one line into io->buf: its length, or -1 at end of input. */
+static ssize_t get_line(lm_io *io)
 {
     ssize_t n;
     fflush(stdout);
@@ -213,34 +223,79 @@ static int read_line(lm_io *io)
         free(io->buf);
         io->buf = l;
         io->cap = strlen(l) + 1;
-    } else {
-        n = getline(&io->buf, &io->cap, io->in);
-        waiting_for_input = 0;
-        if (n < 0) return -1;
+        return (ssize_t)strlen(l);
     }
-    io->line++;
-    io->cur = lm_line_start(io->buf);
-    return 0;
+    n = getline(&io->buf, &io->cap, io->in);
+    waiting_for_input = 0;
+    return n;
 }
 
-/* Fetch the next token, reading lines as needed.  0, -1 at end of input, or -2 for a
- * token too long to be an answer. */
+/* Read the next answer line.  A UTF-8 byte-order mark before the first line and
+ * comment lines (first non-blank byte '#') are skipped; line numbers still count
+ * every line.  Returns 0, -1 at end of input, or -3 for a line holding a NUL byte
+ * (reported here: getline keeps it, and every string function would silently cut
+ * the line there). */
+static int read_line(lm_io *io)
+{
+    for (;;) {
+        ssize_t n = get_line(io);
+        const char *p;
+        if (n < 0) return -1;
+        io->line++;
+        p = io->buf;
+        if (strlen(p) != (size_t)n) {
+            fprintf(stderr, "lensmat: %s:%ld: this line holds a NUL byte (answers are "
+                    "text; is this a binary file?)\n", io->src, io->line);
+            io->cur = "";
+            return -3;
+        }
+        if (io->line == 1 && !strncmp(p, "\xef\xbb\xbf", 3)) p += 3;
+        io->cur = p + strspn(p, " \t");
+        if (*io->cur == '#') continue;
+        io->cur = lm_line_start(p);
+        return 0;
+    }
+}
+
+/* Fetch the next token, reading lines as needed.  0, -1 at end of input, -2 for a
+ * token too long to be an answer, -3 for a line that cannot be read (reported). */
 static int next_token(lm_io *io, char *tok)
 {
     for (;;) {
         int n = lm_next_token(&io->cur, tok, LM_TOKEN_MAX);
         if (n > 0) return 0;
         if (n < 0) return -2;
-        if (read_line(io) < 0) return -1;
+        if ((n = read_line(io)) < 0) return n;
     }
+}
+
+/* The same for a word that may be quoted (lm_next_word): 0, -1, -2 (too long for
+ * cap), -3, or -4 for an unterminated quote, -5 for a \x00 escape. */
+static int next_word(lm_io *io, char *tok, size_t cap)
+{
+    for (;;) {
+        int n = lm_next_word(&io->cur, tok, cap);
+        if (n > 0) return 0;
+        if (n == -1) return -2;
+        if (n < 0) return n - 2;
+        if ((n = read_line(io)) < 0) return n;
+    }
+}
+
+/* --example: show the answer on stdout as if it had been typed, in the form the
+ * record echoes it (which reads back as the same answer). */
+static void show_answer(lm_io *io, const char *tok)
+{
+    if (io->show_answers) printf("%s\n", tok);
 }
 
 /* Report a bad answer.  Terminal: explain, drop the rest of the line, ask again
  * (LM_GO).  Replay: FILE:LINE message and LM_FAIL. */
 static int complain(lm_io *io, const char *what, const char *fmt, const char *tok)
 {
-    char msg[1200];
-    snprintf(msg, sizeof msg, fmt, tok);
+    char raw[1200], msg[4 * sizeof raw];
+    snprintf(raw, sizeof raw, fmt, tok);
+    lm_escape(raw, msg, sizeof msg);    /* no answer's bytes reach the terminal raw */
     if (io->interactive) {
         fprintf(stderr, "lensmat: %s: %s; please answer again.\n", what, msg);
         io->cur = "";
@@ -291,15 +346,32 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
         if (out) lm_say(io, LM_OUT, "%s", out);
         r = next_token(io, tok);
         if (r == -1) return end_of_input(io, spec->what);
+        if (r == -3) return LM_FAIL;
         if (r == -2) {
             if (complain(io, spec->what, "%san answer longer than 255 characters", "")) 
                 return LM_FAIL;
             continue;
         }
         st = lm_parse_number(tok, v);
+        if (st == LM_NUM_SYNTAX && (spec->flags & LM_INDEX) &&
+            lm_parse_index(tok, v) == LM_NUM_OK) {      /* a medium's name */
+            size_t i;
+            for (i = 0; tok[i] && i < sizeof echo - 1; i++)
+                echo[i] = (char)tolower((unsigned char)tok[i]);
+            echo[i] = '\0';
+            lm_say(io, LM_REC, "input: %s\n", echo);
+            show_answer(io, echo);
+            lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
+            return LM_GO;
+        }
         if (st != LM_NUM_OK && st != LM_NUM_PLANE) {
-            if (complain(io, spec->what, st == LM_NUM_SYNTAX ? "'%s' is not a number" :
-                         st == LM_NUM_NAN ? "'%s': nan is not a number" :
+            /* for an index, a word gets the media named; "1,5" just is not a number */
+            int word = (spec->flags & LM_INDEX) && isalpha((unsigned char)tok[0]);
+            if (complain(io, spec->what, st == LM_NUM_SYNTAX && !word ?
+                         "'%s' is not a number" : st == LM_NUM_SYNTAX ?
+                         "'%s' is not a number, nor a medium lensmat knows (air, water, "
+                         "cornea, crown, flint, ...)" : st == LM_NUM_NAN ?
+                         "'%s': nan is not a number" :
                          "'%s' is out of range (|x| <= 1e30)", tok)) return LM_FAIL;
             continue;
         }
@@ -314,6 +386,7 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
         else lm_format_echo(*v, echo, sizeof echo);
         if ((spec->flags & LM_ALLOW_PLANE) && *v == 0.0) *v = INFINITY;
         lm_say(io, LM_REC, "input: %s\n", echo);
+        show_answer(io, echo);
         return LM_GO;
     }
 }
@@ -327,6 +400,7 @@ int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int
         if (out) lm_say(io, LM_OUT, "%s", out);
         r = next_token(io, tok);
         if (r == -1) return end_of_input(io, what);
+        if (r == -3) return LM_FAIL;
         c = r == 0 ? lm_parse_yn(tok) : 0;
         if (!c) {
             if (complain(io, what, "'%s': answer y or n", r == 0 ? tok : "(too long)"))
@@ -335,6 +409,7 @@ int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int
         }
         *yes = c == 'y';
         lm_say(io, LM_REC, "input: %c\n", c);
+        show_answer(io, c == 'y' ? "y" : "n");
         return LM_GO;
     }
 }
@@ -349,6 +424,7 @@ int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
         if (out) lm_say(io, LM_OUT, "%s", out);
         r = next_token(io, tok);
         if (r == -1) return end_of_input(io, what);
+        if (r == -3) return LM_FAIL;
         for (i = 0; r == 0 && choices[i]; i++)
             if (!strcasecmp(tok, choices[i])) break;
         if (r != 0 || !choices[i]) {
@@ -359,40 +435,108 @@ int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
         }
         *idx = i;
         lm_say(io, LM_REC, "input: %s\n", choices[i]);
+        show_answer(io, choices[i]);
         return LM_GO;
     }
 }
 
+/* Word answers may be quoted ("a b.rec"); the record echoes the word in the form that
+ * reads back as it (lm_quote_word), which is the word itself for a plain name. */
 int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
                 int (*check)(void *ctx, const char *word, char *msg, size_t cap),
                 void *ctx, char *buf, size_t cap)
 {
-    char tok[LM_TOKEN_MAX], msg[1024];
+    enum { WORD_MAX = 4096 };
+    char tok[WORD_MAX], echo[4 * WORD_MAX + 3], msg[1024];
     if (rec) lm_say(io, LM_REC, "%s", rec);
     for (;;) {
         int r;
         if (out) lm_say(io, LM_OUT, "%s", out);
-        r = next_token(io, tok);
+        r = next_word(io, tok, sizeof tok);
         if (r == -1) return end_of_input(io, what);
+        if (r == -3) return LM_FAIL;
         if (r == 0 && strlen(tok) >= cap) r = -2;
         msg[0] = '\0';
-        if (r == 0 && check && check(ctx, tok, msg, sizeof msg)) r = -3;
+        if (r == 0 && check && check(ctx, tok, msg, sizeof msg)) r = -6;
         if (r != 0) {
             if (r == -2) snprintf(msg, sizeof msg, "the answer is too long");
+            if (r == -4) snprintf(msg, sizeof msg, "a quote is not closed on its line");
+            if (r == -5) snprintf(msg, sizeof msg, "\\x00: no name holds a NUL byte");
             if (complain(io, what, "%s", msg)) return LM_FAIL;
             continue;
         }
         memcpy(buf, tok, strlen(tok) + 1);
-        lm_say(io, LM_REC, "input: %s\n", tok);
+        lm_quote_word(tok, echo, sizeof echo);
+        lm_say(io, LM_REC, "input: %s\n", echo);
+        show_answer(io, echo);
         return LM_GO;
     }
 }
 
+/* Answers left after the end: on the last line read, or on any later line (a file
+ * of blank lines is read to its end, up to 100 000 lines; comment lines are no
+ * answers). */
 void lm_check_leftover(lm_io *io)
 {
-    char tok[LM_TOKEN_MAX];
+    char tok[LM_TOKEN_MAX], shown[4 * LM_TOKEN_MAX];
+    long lines = 0;
     if (io->interactive) return;
-    if (lm_next_token(&io->cur, tok, sizeof tok) != 0)
-        fprintf(stderr, "lensmat: %s:%ld: warning: answers after the end of the "
-                "dialogue were ignored\n", io->src, io->line);
+    for (;;) {
+        int n = lm_next_token(&io->cur, tok, sizeof tok);
+        if (n != 0) {
+            lm_escape(n > 0 ? tok : "(a long token)", shown, sizeof shown);
+            fprintf(stderr, "lensmat: %s:%ld: warning: answers after the end of the "
+                    "dialogue were ignored (from '%s' on)\n", io->src, io->line, shown);
+            return;
+        }
+        if (++lines > 100000 || read_line(io) != 0) return;
+    }
+}
+
+/* ---- answers checked together, indices by name (see ask.h) ---------------------- */
+#include <ctype.h>
+#include "../paraxial/paraxial.h"
+
+void lm_mark_set(lm_io *io, lm_mark *m)
+{
+    fflush(io->rec);
+    m->rec_off = ftell(io->rec);
+}
+
+int lm_mark_reject(lm_io *io, const lm_mark *m, const char *what, const char *msg,
+                   const char *again, const char *rec_prompt)
+{
+    fflush(io->rec);
+    if (m->rec_off >= 0 && ftruncate(fileno(io->rec), m->rec_off) == 0)
+        fseek(io->rec, m->rec_off, SEEK_SET);
+    else    /* a record that cannot be cut back (a pipe): say so in it */
+        fprintf(io->rec, "(the answers above were rejected: %s)\n", msg);
+    if (io->interactive) {
+        fprintf(stderr, "lensmat: %s: %s; %s.\n", what, msg, again);
+        io->cur = "";
+        return LM_GO;
+    }
+    fprintf(stderr, "lensmat: %s:%ld: %s: %s\n", io->src, io->line > 0 ? io->line : 1,
+            what, msg);
+    if (rec_prompt) fputs(rec_prompt, io->rec);
+    return LM_FAIL;
+}
+
+enum lm_num_status lm_parse_index(const char *tok, double *v)
+{
+    enum lm_num_status st = lm_parse_number(tok, v);
+    double n;
+    if (st == LM_NUM_SYNTAX && (n = px_medium_index(tok)) > 0) {
+        *v = n;
+        return LM_NUM_OK;
+    }
+    return st;
+}
+
+int lm_ask_index(lm_io *io, const char *out, const char *rec, const lm_numspec *spec,
+                 double *v)
+{
+    lm_numspec named = *spec;
+    named.flags |= LM_INDEX;
+    return lm_ask_number(io, out, rec, &named, v);
 }

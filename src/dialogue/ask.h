@@ -18,6 +18,7 @@ typedef struct lm_io {
     long line;              /* line number of the current answer line */
     int interactive;        /* terminal: readline, re-ask on errors */
     int original;           /* --original: keep the original program's bytes */
+    int show_answers;       /* --example: print each answer on stdout, as if typed */
     char *buf;              /* current answer line */
     size_t cap;
     const char *cur;        /* unread part of buf */
@@ -46,7 +47,8 @@ enum {
     LM_AT_LEAST = 8,        /* >= spec.min */
     LM_ALLOW_INF = 16,      /* inf / -inf accepted as such (a distance at infinity);
                                unlike LM_ALLOW_PLANE, 0 stays 0 */
-    LM_NONZERO = 32         /* != 0 */
+    LM_NONZERO = 32,        /* != 0 */
+    LM_INDEX = 64           /* an index: a medium's name is accepted too (lm_ask_index) */
 };
 typedef struct lm_numspec {
     const char *what;       /* "the radius of the lens surface", for messages */
@@ -64,8 +66,9 @@ int lm_ask_yn(lm_io *io, const char *out, const char *rec, const char *what, int
  * its index and the record echoes it as written in `choices`. */
 int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
                   const char *const *choices, int *idx);
-/* The same for one blank-free word (a file name): copied into buf (cap bytes; longer
- * answers are refused), echoed as "input: WORD".  check (may be NULL) returns 0 to
+/* The same for one word (a file name): blank-free, or quoted ("my lens.rec", see
+ * lm_next_word) to hold blanks; copied into buf (cap bytes; longer answers are
+ * refused), echoed as "input: WORD" (quoted again when it needs it, lm_quote_word).  check (may be NULL) returns 0 to
  * accept, else writes why into msg: the answer is then handled like a bad number
  * (terminal: message and ask again; replay: SRC:LINE message, LM_FAIL) and is not
  * echoed, so a record never holds a rejected answer. */
@@ -90,7 +93,34 @@ void lm_run_stop_hooks(void);
  * exist yet), else -1 with why in msg.  Every dialogue checks each output with it
  * before opening anything for writing. */
 int  lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap);
-/* After the last question: warn about answers left unread (replay only). */
+/* After the last question: warn about answers left unread, on the last line read or
+ * on any later one, with that line (replay only). */
 void lm_check_leftover(lm_io *io);
+
+/* ---- answers checked together, indices by name ---------------------------------
+ * A group of answers that are each fine but may not go together (an erector lens
+ * with Galileo's eyepiece, two equal object distances): lm_mark_set before the
+ * group's first question, then, if the group does not hold, lm_mark_reject: the
+ * record loses everything written since the mark (the rejected answers are never
+ * kept).  Terminal: "lensmat: WHAT: MSG; AGAIN." on stderr, the rest of the line
+ * dropped, LM_GO: the dialogue asks the group again from its first question.
+ * Replay: "lensmat: SRC:LINE: WHAT: MSG" and LM_FAIL; the record then ends with
+ * rec_prompt (the first question of the group, may be NULL), exactly as a replay
+ * that ran out of answers there would leave it, so its grep'd answers replay to
+ * the same record. */
+typedef struct lm_mark { long rec_off; } lm_mark;
+void lm_mark_set(lm_io *io, lm_mark *m);
+int  lm_mark_reject(lm_io *io, const lm_mark *m, const char *what, const char *msg,
+                    const char *again, const char *rec_prompt);
+/* An index of refraction: a number, or a medium the paraxial engine names (air,
+ * water, cornea, crown, ...; px_medium_index).  Returns LM_NUM_OK with *v set, or
+ * the number's status. */
+enum lm_num_status lm_parse_index(const char *tok, double *v);
+/* lm_ask_number for an index (spec's flags as there): a medium name is accepted,
+ * echoed as its name (lower case) so the replay is exact, and its index is shown
+ * on stdout and in the record ("(water: index 1.333)"); a number is handled and
+ * echoed exactly as lm_ask_number does. */
+int  lm_ask_index(lm_io *io, const char *out, const char *rec, const lm_numspec *spec,
+                  double *v);
 
 #endif

@@ -24,6 +24,25 @@ int calc_num(calc *c, const char *q, const char *what, unsigned flags, double *v
     return lm_ask_number(c->io, q, q, &spec, v);
 }
 
+int calc_index(calc *c, const char *q, const char *what, double *v)
+{
+    lm_numspec spec = {what, LM_POSITIVE, 0};
+    return lm_ask_index(c->io, q, q, &spec, v);
+}
+
+void calc_mark(calc *c, lm_mark *m) { lm_mark_set(c->io, m); }
+
+int calc_reject(calc *c, const lm_mark *m, const char *what, const char *first_q,
+                const char *again, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return lm_mark_reject(c->io, m, what ? what : P(CHECK_WHAT), msg, again, first_q);
+}
+
 int calc_yn(calc *c, const char *q, const char *what, int *yes)
 {
     return lm_ask_yn(c->io, q, q, what, yes);

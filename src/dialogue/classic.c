@@ -63,6 +63,14 @@ static int ask_num(classic *c, const char *out, const char *rec, const char *wha
     return lm_ask_number(c->io, out, rec, &spec, v);
 }
 
+/* An index: a number or a medium's name (lm_ask_index). */
+static int ask_index(classic *c, const char *out, const char *rec, const char *what,
+                     double *v)
+{
+    lm_numspec spec = {what, LM_POSITIVE, 0};
+    return lm_ask_index(c->io, out, rec, &spec, v);
+}
+
 /* One surface: radius, location, index; prints the matrices as the original did. */
 static int enter_surface(classic *c)
 {
@@ -77,8 +85,8 @@ static int enter_surface(classic *c)
     if ((rc = ask_num(c, P(LOCATION_OUT), P(LOCATION_REC), P(LOCATION_WHAT),
                       c->sys.nsurf ? LM_AT_LEAST : 0, c->sys.z_last, &z)))
         return rc;
-    if ((rc = ask_num(c, P(INDEX_RIGHT_OUT), P(INDEX_RIGHT_REC), P(INDEX_RIGHT_WHAT),
-                      LM_POSITIVE, 0, &n)))
+    if ((rc = ask_index(c, P(INDEX_RIGHT_OUT), P(INDEX_RIGHT_REC), P(INDEX_RIGHT_WHAT),
+                        &n)))
         return rc;
     if (isinf(r))
         lm_say(io, LM_REC, P(SURFACE_ECHO_PLANE), P(PLANE), z);
@@ -203,8 +211,8 @@ static int classic_run(classic *c)
                       LM_NONNEG, 0, &c->nearpoint)))
         return rc;
     lm_say(io, LM_REC, P(NEARPOINT_ECHO), c->nearpoint);
-    if ((rc = ask_num(c, P(INDEX_LEFT_OUT), P(INDEX_LEFT_REC), P(INDEX_LEFT_WHAT),
-                      LM_POSITIVE, 0, &n_obj)))
+    if ((rc = ask_index(c, P(INDEX_LEFT_OUT), P(INDEX_LEFT_REC), P(INDEX_LEFT_WHAT),
+                        &n_obj)))
         return rc;
     lm_say(io, LM_REC, P(INDEX_ECHO), n_obj);
     px_system_init(&c->sys, n_obj);   /* no steps yet: nothing to free */

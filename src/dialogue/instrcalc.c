@@ -49,7 +49,7 @@ static int single_lens(calc *c)
     if ((rc = calc_num(c, MS(R1), MS(R1_WHAT), LM_ALLOW_PLANE, &r1)) ||
         (rc = calc_num(c, MS(R2), MS(R2_WHAT), LM_ALLOW_PLANE, &r2)) ||
         (rc = calc_num(c, MS(T), MS(T_WHAT), LM_NONNEG, &t)) ||
-        (rc = calc_num(c, MS(N), MS(N_WHAT), LM_POSITIVE, &n)) ||
+        (rc = calc_index(c, MS(N), MS(N_WHAT), &n)) ||
         (rc = calc_num(c, MS(B), MS(B_WHAT), LM_POSITIVE, &b)))
         return rc;
     rc = px_thick_lens(1, r1, t, n, r2, 1, &l);
@@ -89,21 +89,42 @@ int lm_microscope(lm_io *io)
 }
 const char *lm_microscope_example(void) { return MS(EXAMPLE); }
 
+/* fo, then the group fe, d: Galileo's (negative) eyepiece must be weaker than the
+ * objective (else the length fo + fe is not positive), and the erector lens is
+ * offered for the astronomical telescope only (Galileo's is erect without one);
+ * either is fixed by the eyepiece or the erector distance, so those are asked
+ * again. */
+static int telescope_answers(calc *c, double *fo, double *fe, double *d)
+{
+    int rc;
+    lm_mark m;
+    if ((rc = calc_num(c, TS(FO), TS(FO_WHAT), LM_POSITIVE, fo))) return rc;
+    for (;;) {
+        calc_mark(c, &m);
+        if ((rc = calc_num(c, TS(FE), TS(FE_WHAT), LM_NONZERO, fe))) return rc;
+        if (*fe < 0 && -*fe >= *fo) {
+            if ((rc = calc_reject(c, &m, NULL, TS(FE), TS(AGAIN_FE), TS(BAD_GALILEO), -*fe, *fo)))
+                return rc;
+            continue;
+        }
+        if ((rc = calc_num(c, TS(D), TS(D_WHAT), LM_NONNEG, d))) return rc;
+        if (*d > 0 && *fe < 0) {
+            if ((rc = calc_reject(c, &m, NULL, TS(FE), TS(AGAIN_FE_D), TS(BAD_ERECTOR), *d, *fe)))
+                return rc;
+            continue;
+        }
+        return LM_GO;
+    }
+}
+
 int lm_telescope(lm_io *io)
 {
     calc cc = {io, PX_CM, "cm"}, *c = &cc;
     double fo, fe, d;
     px_telescope t;
     int rc;
-    if ((rc = calc_unit(c)) ||
-        (rc = calc_num(c, TS(FO), TS(FO_WHAT), LM_POSITIVE, &fo)) ||
-        (rc = calc_num(c, TS(FE), TS(FE_WHAT), LM_NONZERO, &fe)) ||
-        (rc = calc_num(c, TS(D), TS(D_WHAT), LM_NONNEG, &d)))
-        return rc;
-    if (px_telescope_make(fo, fe, d, &t) == PX_BAD) {
-        /* Galileo's eyepiece must be weaker than the objective; erector needs fe > 0 */
-        return calc_fail(c, TS(BAD));
-    }
+    if ((rc = calc_unit(c)) || (rc = telescope_answers(c, &fo, &fe, &d))) return rc;
+    if (px_telescope_make(fo, fe, d, &t) == PX_BAD) return LM_FAIL;   /* checked above */
     if (d > 0) calc_say(c, TS(TERR), t.erector_f);
     else calc_say(c, fe > 0 ? TS(ASTRO) : TS(GALILEO));
     calc_power(c, TS(OBJECTIVE), 1 / fo);
@@ -113,7 +134,9 @@ int lm_telescope(lm_io *io)
     /* C is zero within its rounding (that is what afocal means): print it as 0, not
      * as the 1e-17 of round-off the product leaves */
     calc_matrix(c, t.afocal ? (px_mat){t.m.a, t.m.b, 0.0, t.m.d} : t.m);
-    if (t.afocal) calc_say(c, TS(AFOCAL), CL(t.angular), CL(fo / fe));
+    if (t.afocal)
+        calc_say(c, TS(AFOCAL), CL(t.angular), t.angular > 0 ? TS(ERECT) : TS(INVERTED),
+                 CL(fo / fe));
     else calc_say(c, TS(NOT_AFOCAL), t.m.c);
     return calc_done(c);
 }

@@ -14,6 +14,24 @@ const char *lm_line_start(const char *line);
  * (it is then skipped). */
 int lm_next_token(const char **cur, char *tok, size_t cap);
 
+/* A word answer (a file name) at *cur: a blank-free word as lm_next_token reads it,
+ * or a quoted one, "..." or '...', which may hold blanks; inside quotes \\, \",
+ * \' and \xHH (a byte in hex) are escapes, any other backslash is itself.  Quotes
+ * count only at the start of a word (a"b is the three bytes a"b).  Returns 1 (a word
+ * in tok, possibly empty: ""), 0 at end of line, -1 too long for cap (skipped), -2
+ * an unterminated quote, -3 a \x00 escape (no name holds a NUL byte; the rest of the
+ * line is skipped). */
+int lm_next_word(const char **cur, char *tok, size_t cap);
+/* The form of `word` that lm_next_word reads back as it: the word itself when it has
+ * no blank, control byte or leading quote and is not empty (so plain names keep
+ * their bytes), else "..." with \\, \" and \xHH escapes.  cap >= 4 * strlen + 3
+ * always suffices; returns the length written, or -1 if cap is too small. */
+int lm_quote_word(const char *word, char *out, size_t cap);
+/* `s` for a message: control bytes, DEL, C1 controls and bytes that are not UTF-8
+ * written as \xHH, so no answer can put escape sequences on a terminal; always
+ * NUL-terminated (cut if cap is too small). */
+void lm_escape(const char *s, char *out, size_t cap);
+
 enum lm_num_status {
     LM_NUM_OK = 0,      /* a finite decimal number */
     LM_NUM_PLANE,       /* "inf", "infinity" or "plane": *v = +inf */

@@ -1,10 +1,15 @@
-/* main.c -- the command line: choose a dialogue (one option), open the session
- * (answers from a terminal, a replay file or the embedded example; the record
- * file), run it, and turn its outcome into the exit status. */
+/* main.c -- the command line: choose a dialogue (one option, from the table in
+ * table.c), check the engine module it needs is there, open the session (answers from
+ * a terminal, a replay file or the embedded example; the record file), run it, and
+ * turn its outcome into the exit status. */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "ask.h"
 #include "dialogues.h"
+#include "engine.h"
+#include "table.h"
 #include "prompts_main.h"
 
 #ifndef LENSMAT_VERSION
@@ -12,36 +17,8 @@
 #endif
 #define P(k) main_prompts[MAIN_##k]
 
-typedef struct dialogue {
-    const char *option;             /* the option that chooses it */
-    const char *summary;            /* one line for --help */
-    int (*run)(lm_io *io);
-    const char *(*example)(void);   /* embedded example answers, or NULL */
-} dialogue;
-
-static const dialogue dialogues[] = {
-    {"--classic", "the original lens-entry dialogue (the default)", lm_classic,
-     lm_classic_example},
-    {"--trace", "ray tracing: scene files, a lens's real fan, tessellation table", lm_trace,
-     lm_trace_example},
-    {"--rig", "the cornea rig: home, move, expose, scan (sim or libgpiod; 36-39)", lm_rig, lm_rig_example},
-    {"--thick", "thick lens: R1, R2, t, n, any media (sections 8-10, 21)", lm_thick, lm_thick_example},
-    {"--thin", "thin lens equation: f, do, di from the other two (57)", lm_thin, lm_thin_example},
-    {"--gauss", "Gauss's formula, one refracting surface (section 4)", lm_gauss, lm_gauss_example},
-    {"--pair", "two thin lenses t apart (section 56)", lm_pair, lm_pair_example},
-    {"--magnifier", "simple magnifier (sections 31.7-31.8)", lm_magnifier, lm_magnifier_example},
-    {"--microscope", "single-lens and compound microscopes (31.9-31.10, 58)", lm_microscope, lm_microscope_example},
-    {"--telescope", "astronomical, terrestrial, Galileo telescopes (31.11-31.13)", lm_telescope, lm_telescope_example},
-    {"--vision", "spectacle power for a near or far point (41, 57)", lm_vision, lm_vision_example},
-    {"--cornea", "corneal radius <-> power, measuring accuracy (section 37)", lm_cornea, lm_cornea_example},
-    {"--fit", "lens matrix from measurements (lsq), cardinal or nodal points (14, 24, 26)", lm_fit, lm_fit_example},
-    {"--prescription", "run the classic dialogue from a prescription file (-i FILE)", lm_prescription, lm_prescription_example},
-    {"--to-prescription", "write a classic record or answers (-i FILE) as a prescription", lm_to_prescription, lm_to_prescription_example},
-};
-#define NDIALOGUES (sizeof dialogues / sizeof dialogues[0])
-
 typedef struct options {
-    const dialogue *dlg;
+    const lm_dialogue *dlg;
     const char *outfile, *input;
     int original, example;
 } options;
@@ -49,24 +26,37 @@ typedef struct options {
 static void help(void)
 {
     printf("%s", P(HELP));
-    for (size_t i = 0; i < NDIALOGUES; i++)
-        printf(P(HELP_DIALOGUE), dialogues[i].option, dialogues[i].summary);
+    for (size_t i = 0; i < lm_ndialogues; i++)
+        printf(P(HELP_DIALOGUE), lm_dialogues[i].option, lm_dialogues[i].summary);
     printf("%s", P(HELP_OPTIONS));
 }
 
-static const dialogue *find_dialogue(const char *opt)
+/* An argument for a message: its control bytes escaped. */
+static const char *shown(const char *arg)
 {
-    for (size_t i = 0; i < NDIALOGUES; i++)
-        if (!strcmp(opt, dialogues[i].option)) return &dialogues[i];
-    return NULL;
+    static char buf[2][1024];
+    static int k;
+    k = !k;
+    lm_escape(arg, buf[k], sizeof buf[k]);
+    return buf[k];
 }
 
 /* Returns -1 to go on, else the exit status (after --help, --version or an error). */
 static int parse_args(int argc, char **argv, options *o)
 {
+    int operands = 0;                   /* after "--": every argument is an OUTFILE */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        const dialogue *d;
+        const lm_dialogue *d;
+        if (operands || a[0] != '-' || !a[1]) {
+            if (o->outfile) {
+                fprintf(stderr, P(TOO_MANY), shown(o->outfile), shown(a));
+                return 1;
+            }
+            o->outfile = a;
+            continue;
+        }
+        if (!strcmp(a, "--")) { operands = 1; continue; }
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { help(); return 0; }
         if (!strcmp(a, "--version")) { printf(P(VERSION), LENSMAT_VERSION); return 0; }
         if (!strcmp(a, "--original")) { o->original = 1; continue; }
@@ -76,7 +66,12 @@ static int parse_args(int argc, char **argv, options *o)
             o->input = argv[i];
             continue;
         }
-        if ((d = find_dialogue(a))) {
+        if (!strncmp(a, "--input=", 8)) {
+            if (!a[8]) { fprintf(stderr, P(NEED_ARG), "--input"); return 1; }
+            o->input = a + 8;
+            continue;
+        }
+        if ((d = lm_find_dialogue(a))) {
             if (o->dlg && o->dlg != d) {
                 fprintf(stderr, P(TWO_DIALOGUES), o->dlg->option, a);
                 return 1;
@@ -84,11 +79,14 @@ static int parse_args(int argc, char **argv, options *o)
             o->dlg = d;
             continue;
         }
-        if (a[0] == '-' && a[1]) { fprintf(stderr, P(BAD_OPTION), a); return 1; }
-        if (o->outfile) { fprintf(stderr, P(TOO_MANY), o->outfile, a); return 1; }
-        o->outfile = a;
+        fprintf(stderr, P(BAD_OPTION), shown(a));
+        return 1;
     }
-    if (!o->dlg) o->dlg = &dialogues[0];
+    if (!o->dlg) o->dlg = &lm_dialogues[0];
+    if (o->original && !o->dlg->original) {
+        fprintf(stderr, P(ORIGINAL_NOTHING), o->dlg->option);
+        return 1;
+    }
     return -1;
 }
 
@@ -96,6 +94,7 @@ static int parse_args(int argc, char **argv, options *o)
 static FILE *open_answers(const options *o, const char **name)
 {
     FILE *f;
+    struct stat st;
     if (o->example) {
         const char *ex = o->dlg->example ? o->dlg->example() : NULL;
         if (!ex) { fprintf(stderr, P(NO_EXAMPLE), o->dlg->option); return NULL; }
@@ -105,7 +104,12 @@ static FILE *open_answers(const options *o, const char **name)
     if (!o->input) { *name = "<stdin>"; return stdin; }
     *name = o->input;
     f = fopen(o->input, "r");
-    if (!f) perror(o->input);
+    if (!f) fprintf(stderr, P(CANNOT_READ), shown(o->input), strerror(errno));
+    else if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
+        fprintf(stderr, P(CANNOT_READ), shown(o->input), strerror(EISDIR));
+        fclose(f);
+        f = NULL;
+    }
     return f;
 }
 
@@ -126,8 +130,17 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s", P(NEED_OUTFILE));
         return 1;
     }
+    /* before the first question: a session that could not finish is not begun */
+    if (o.dlg->needs && !lm_engine_present(o.dlg->needs)) {
+        fprintf(stderr, P(NEEDS_MODULE), o.dlg->option, o.dlg->needs);
+        return 1;
+    }
     if (!(in = open_answers(&o, &in_name))) return 1;
-    if (lm_io_open(&io, o.outfile, in, in_name, o.original) < 0) return 1;
+    if (lm_io_open(&io, o.outfile, in, in_name, o.original) < 0) {
+        if (in != stdin) fclose(in);
+        return 1;
+    }
+    io.show_answers = o.example;
     rc = o.dlg->run(&io);
     if (lm_io_close(&io) < 0 && rc == LM_GO) rc = LM_FAIL;
     if (in != stdin) fclose(in);

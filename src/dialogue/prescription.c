@@ -61,6 +61,17 @@ static char *slurp(FILE *in, const char *src, char *err, size_t cap)
         return NULL;
     }
     s[len] = '\0';
+    if (len >= 3 && !memcmp(s, "\xef\xbb\xbf", 3)) {   /* a UTF-8 byte-order mark */
+        len -= 3;
+        memmove(s, s + 3, len + 1);
+    }
+    if ((t = memchr(s, '\0', len))) {   /* every string function would cut there */
+        long line = 1;
+        for (const char *p = s; p < t; p++) line += *p == '\n';
+        snprintf(err, cap, PS(NUL_BYTE), src, line);
+        free(s);
+        return NULL;
+    }
     return s;
 }
 
@@ -180,6 +191,14 @@ static int read_prescription(rx *r, char *s)
     return LM_GO;
 }
 
+/* An error on stderr, an answer's control bytes escaped (lm_escape). */
+static void say_error(const char *err)
+{
+    char shown[4 * 1200];
+    lm_escape(err, shown, sizeof shown);
+    fprintf(stderr, PS(ERROR), shown);
+}
+
 int lm_prescription(lm_io *io)
 {
     rx r;
@@ -193,7 +212,7 @@ int lm_prescription(lm_io *io)
     if (!(s = slurp(io->in, io->src, err, sizeof err))) rc = LM_FAIL;
     else rc = read_prescription(&r, s);
     free(s);
-    if (rc) { fprintf(stderr, PS(ERROR), err); free(r.ans.s); return rc; }
+    if (rc) { say_error(err); free(r.ans.s); return rc; }
     answers = fmemopen(r.ans.s, r.ans.len, "r");
     if (!answers) { free(r.ans.s); return LM_FAIL; }
     snprintf(src, sizeof src, "%s (as classic answers)", io->src);
@@ -230,15 +249,18 @@ static int fail_at(cursor *c, const char *what, const char *fmt, const char *tok
     return LM_FAIL;
 }
 
-/* Move to the next line: 0, or -1 at the end. */
+/* Move to the next line that is not a comment (first non-blank byte '#', as lm_ask
+ * skips them): 0, or -1 at the end. */
 static int next_line(cursor *c)
 {
     char *nl;
-    if (!c->next || !*c->next) return -1;
-    if ((nl = strchr(c->next, '\n'))) *nl = '\0';
-    c->cur = lm_line_start(c->next);
-    c->next = nl ? nl + 1 : NULL;
-    c->line++;
+    do {
+        if (!c->next || !*c->next) return -1;
+        if ((nl = strchr(c->next, '\n'))) *nl = '\0';
+        c->cur = lm_line_start(c->next);
+        c->next = nl ? nl + 1 : NULL;
+        c->line++;
+    } while (c->cur[strspn(c->cur, " \t")] == '#');
     return 0;
 }
 
@@ -442,7 +464,7 @@ int lm_to_prescription(lm_io *io)
     char err[1200], *s = slurp(io->in, io->src, err, sizeof err);
     if (!s || lens_of_text(io->src, s, &lf, err, sizeof err)) {
         free(s);
-        fprintf(stderr, PS(ERROR), err);
+        say_error(err);
         return LM_FAIL;
     }
     free(s);

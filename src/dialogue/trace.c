@@ -10,6 +10,7 @@
 #include <string.h>
 #include "ask.h"
 #include "dialogues.h"
+#include "draw.h"
 #include "engine.h"
 #include "../paraxial/paraxial.h"
 #include "../trace/scene.h"
@@ -240,6 +241,7 @@ static int trace_object(tdlg *t, lens *l)
         return io->interactive ? LM_GO : LM_FAIL;
     }
     report_fan(t, h, out, FAN + 1, z_img, l);
+    lm_draw_remember(&l->tl, z_obj, frac);   /* for the "draw" choice */
     return LM_GO;
 }
 
@@ -456,7 +458,7 @@ static int tess_table(tdlg *t)
 
 int lm_trace(lm_io *io)
 {
-    static const char *const modes[] = {"scene", "lens", "record", "table", NULL};
+    static const char *const modes[] = {"scene", "lens", "record", "table", "draw", NULL};
     tdlg t = {io, NULL, {0}, 0};
     int rc, mode, more;
 
@@ -464,7 +466,7 @@ int lm_trace(lm_io *io)
     do {
         if ((rc = lm_ask_choice(io, P(MODE), P(MODE), P(MODE_WHAT), modes, &mode))) break;
         rc = mode == 0 ? do_scene(&t) : mode == 1 ? do_lens(&t)
-           : mode == 2 ? do_record(&t) : tess_table(&t);
+           : mode == 2 ? do_record(&t) : mode == 3 ? tess_table(&t) : lm_draw_last(io);
         if (rc) break;
         rc = lm_ask_yn(io, P(ANOTHER), P(ANOTHER), P(ANOTHER_WHAT), &more);
     } while (!rc && more);

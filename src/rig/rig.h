@@ -133,13 +133,15 @@ enum rg_diag {
     RG_D_DETECTOR_SIDE = 1 << 1,   /* detector behind the tangent plane at the target */
     RG_D_PARALLEL_P2   = 1 << 2,   /* backward ray (nearly) parallel to p2 */
     RG_D_BEHIND_P2     = 1 << 3,   /* backward ray meets p2 behind the cornea */
-    RG_D_M2_BLOCKS     = 1 << 4,   /* m2 or its mount blocks the ray to the detector */
+    RG_D_M2_BLOCKS     = 1 << 4,   /* m2 or its mount blocks the ray to the detector
+                                      (or the laser on its way to m1) */
     RG_D_M1_BLOCKS     = 1 << 5,   /* m1 or its mount blocks the beam */
     RG_D_MISS_MIRROR   = 1 << 6,   /* beam lands outside a mirror's semi-diameter */
-    RG_D_GRAZING       = 1 << 7,   /* mirror incidence beyond max_incidence */
+    RG_D_GRAZING       = 1 << 7,   /* incidence on a mirror or the cornea beyond
+                                      max_incidence */
     RG_D_GIMBAL        = 1 << 8,   /* a mount cannot turn its mirror to that normal */
     RG_D_TRAVEL        = 1 << 9,   /* a joint outside its travel */
-    RG_D_NO_CONVERGE   = 1 << 10,  /* Newton on the exact model did not converge */
+    RG_D_NO_CONVERGE   = 1 << 10,  /* the exact model (mirror offsets) not solved */
     RG_D_MISS_CORNEA   = 1 << 11,  /* forward: the beam misses the cornea */
     RG_D_ILLCOND       = 1 << 12,  /* warning: joints-to-spot map ill-conditioned */
     RG_D_NEAR_PARALLEL = 1 << 13,  /* warning: backward ray within 2x the p2 limit */
@@ -151,7 +153,7 @@ enum rg_diag {
 struct trace_api;              /* src/trace/trace.h: the caller passes the engine table */
 typedef struct rg_solve_opts {
     double min_p2_angle;       /* smallest angle backward ray / p2 (rad; 0: 2 deg) */
-    double max_incidence;      /* largest incidence on a mirror (rad; 0: 80 deg) */
+    double max_incidence;      /* largest incidence, mirrors and cornea (rad; 0: 80 deg) */
     double cond_max;           /* RG_D_ILLCOND above this (0: 1e4) */
     double tol;                /* Newton residual, mm (0: 1e-12) */
     int max_iter;              /* Newton iterations (0: 30) */

@@ -346,6 +346,14 @@ static void stiff(void)
     rc = rg->solve(&nz, &far, NULL, &s, err, sizeof err);
     CHECK(rc == RG_EUNREACH && (s.diag & RG_D_BEHIND_P2),
           "target whose backward ray leaves p2 behind (theta 55 deg) refused: %s", err);
+    /* grazing at a mirror: the example's ~45.7 deg folds against a 40 deg limit */
+    rg_solve_opts lim = {0};
+    lim.max_incidence = 40 * RT_DEG;
+    rg_target ap0 = {RG_T_ANGLES, 0, 0};
+    rc = rg->solve(&g, &ap0, &lim, &s, err, sizeof err);
+    CHECK(rc == RG_EUNREACH && (s.diag & RG_D_GRAZING) && strstr(err, "incidence m1 45.") &&
+          fabs(s.beam.inc1 / RT_DEG - 45.66) < 0.05,
+          "mirror incidence over the limit refused with the angles: %s", err);
     /* grazing at the cornea just inside the limit is still exact */
     rg_geometry wide = g;
     for (int j = 0; j < RG_NJOINTS; j++) wide.joint[j].lo = wide.joint[j].hi = 0;
