@@ -11,6 +11,8 @@ const char *lm_classic_example(void);
 int lm_trace(lm_io *io);
 int lm_draw(lm_io *io);        const char *lm_draw_example(void);
 const char *lm_trace_example(void);
+int lm_rig(lm_io *io);
+const char *lm_rig_example(void);
 
 /* The calculation dialogues (lenscalc.c, instrcalc.c, fitcalc.c) and prescription
  * files (prescription.c); each has its embedded example. */

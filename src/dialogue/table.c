@@ -12,6 +12,8 @@ const lm_dialogue lm_dialogues[] = {
      lm_trace_example, "trace", 0},
     {"--draw", "pictures: a lens file's layout with real rays, spot diagram, ray fan (PNG, SVG)",
      lm_draw, lm_draw_example, "imaging", 0},
+    {"--rig", "the cornea rig: home, move, expose, scan (sim or libgpiod; 36-39)", lm_rig,
+     lm_rig_example, "rig", 0},
     {"--thick", "thick lens: n1, R1, t, n, R2, n3 (sections 8-10, 21)", lm_thick,
      lm_thick_example, NULL, 0},
     {"--thin", "thin lens equation: f, do, di from the other two (57)", lm_thin,
