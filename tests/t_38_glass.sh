@@ -57,3 +57,33 @@ check "glass: gen_glass.sh refuses a bad line" sh -c "
     printf 'X sellmeier 0.3 2.5 1.5 60 1 2 3\n' > '$WORK/bad.txt' &&
     ! sh '$TOP/scripts/gen_glass.sh' '$WORK/bad.txt' '$WORK/bad.h' 2> '$WORK/gen.err' &&
     grep -q 'bad.txt:1: coefficients must come in pairs' '$WORK/gen.err' && [ ! -f '$WORK/bad.h' ]"
+
+# --colour: Thorlabs AC254-100-A (its embedded example; prescription from Thorlabs'
+# Zemax file, see tests/unit_glass.c): efl at d 100.07 mm against Thorlabs' 100.1,
+# the glasses' Vd as SCHOTT prints them, and an exact replay from the record.
+colour_example() {
+    cd "$WORK" && "$1" --colour --example col.rec > col.out || return 1
+    grep -q '^  efl 100.07, ' col.rec || { grep efl col.rec; return 1; }
+    grep -q 'Abbe number Vd of N-BK7: 64.17' col.rec && grep -q 'Abbe number Vd of SF5: 32.21' col.rec ||
+        return 1
+    grep -q 'longitudinal colour bfd(F) - bfd(C) = -0.119' col.rec || return 1
+    grep input: col.rec > col.in && "$1" --colour col2.rec < col.in > /dev/null && cmp col.rec col2.rec
+}
+check "--colour: AC254-100-A example, efl 100.07, Vd, replay (lensmat)" colour_example "$BIN"
+check "--colour: the same under ASan/UBSan" colour_example "$ASAN"
+# a glass with no index at a wavelength of the session is refused with its range
+colour_refuse() {   # colour_refuse NAME ANSWERS MESSAGE
+    printf "$2" > "$WORK/cb.in"
+    (cd "$WORK" && "$ASAN" --colour -i cb.in cb.rec > /dev/null 2> cb.err); rc=$?
+    if [ "$rc" -eq 2 ] && grep -qF "$3" "$WORK/cb.err"; then pass "$1"
+    else fail "$1 (exit $rc)"; cat "$WORK/cb.err"; fi
+}
+colour_refuse "--colour: diamond at C refused" 'mm\n2\nd\nC\nair\n1\n10\ndiamond\n' \
+    "cb.in:8: the glass: DIAMOND: its formula holds from 0.226 to 0.644 um, not at wavelength 0.656273 um"
+colour_refuse "--colour: 9 wavelengths refused" 'mm\n9\n' "cb.in:2: the number of wavelengths: '9': give 1 to 8"
+colour_refuse "--colour: bad wavelength" 'mm\n1\nviolet\n' "'violet' is not a wavelength"
+colour_refuse "--colour: unknown glass" 'mm\n1\nd\nair\n1\n10\nBK-7\n' "'BK-7' is not a glass lensmat knows"
+# a singlet of a model glass: one wavelength, plane back, bfd = R/(n-1) at d
+check "--colour: model-glass plano-convex, f = R/(n-1)" sh -c "
+    cd '$WORK' && printf 'mm\n1\nd\nair\n2\n51.68\n1.5168/64.17\n0\nplane\nair\n' > pc.in &&
+    '$BIN' --colour -i pc.in pc.rec > /dev/null && grep -q '^  efl 100, ' pc.rec"

@@ -77,6 +77,13 @@ int px_glass_index(const char *name, double l, double *n)
         return PX_OK;
     }
     if (parse_model(name, &nd, &vd)) return px_glass_model(nd, vd, l, n);
+    if (isdigit((unsigned char)name[0])) {   /* a plain number: a constant index */
+        char *end;
+        m = strtod(name, &end);
+        if (*end || !(m > 0) || !isfinite(m) || m > 100) return PX_NO_GLASS;
+        *n = m;
+        return PX_OK;
+    }
     if ((m = px_medium_index(name)) > 0) {    /* the seed's constants (cornea, ...) */
         *n = m;
         return PX_OK;

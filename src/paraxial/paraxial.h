@@ -319,7 +319,9 @@ const px_glass_rec *px_glass_at(int i);
 /* The index of a catalogue glass or a model glass at lambda_um.  A model glass is
  * "ND/VD" (e.g. "1.5168/64.17", 1 < ND < 3, 5 <= VD <= 150): n = A + B/l^2, the line
  * in 1/l^2 through nd at d with nF - nC = (nd - 1)/Vd; valid 0.36-1.0 um.  Returns
- * PX_OK, PX_NO_GLASS, PX_GLASS_RANGE, or PX_BAD (lambda not a positive number). */
+ * PX_OK, PX_NO_GLASS, PX_GLASS_RANGE, or PX_BAD (lambda not a positive number).
+ * A plain number (0 < n <= 100) and a name of px_medium_index not in the catalogue
+ * are constant indices. */
 int px_glass_index(const char *name, double lambda_um, double *n);
 int px_glass_model(double nd, double vd, double lambda_um, double *n);
 /* A wavelength: the shorthands F d C e g (any case) and "hene", or a number, taken
