@@ -103,12 +103,26 @@ static int number(rx *r, long line, const char *tok, int plane, double *v)
     return bad(r, line, plane ? PS(BAD_RADIUS) : PS(BAD_NUMBER), tok);
 }
 
+/* An index token: a number, a medium, a catalogue or model glass, NAME@WAVELENGTH
+ * (lm_index_name, as the classic dialogue takes it); 0 or LM_FAIL with the reason. */
+static int index_token(rx *r, long line, const char *tok, double *v)
+{
+    char echo[LM_TOKEN_MAX + 16], why[300];
+    double lambda;
+    int k;
+    if (lm_parse_number(tok, v) == LM_NUM_OK) return 0;
+    k = lm_index_name(tok, v, echo, sizeof echo, &lambda, why, sizeof why);
+    if (k == 1) return 0;
+    if (k == -1) return bad(r, line, "%s", why);
+    return bad(r, line, PS(BAD_INDEX), tok);
+}
+
 static int keyword(rx *r, long line, const char *key, const char *val)
 {
     double v;
     int near = !strcmp(key, "nearpoint");
     if (near ? r->have_near : r->have_index) return bad(r, line, PS(TWICE), key);
-    if (number(r, line, val, 0, &v)) return LM_FAIL;
+    if (near ? number(r, line, val, 0, &v) : index_token(r, line, val, &v)) return LM_FAIL;
     if (near && v < 0) return bad(r, line, "%s", PS(NEGATIVE));
     if (!near && !(v > 0)) return bad(r, line, "%s", PS(NOT_POSITIVE));
     strcpy(near ? r->near : r->index, val);
@@ -121,7 +135,7 @@ static int surface(rx *r, long line, char tok[3][LM_TOKEN_MAX])
     double rad, z, n;
     if (r->nobj) return bad(r, line, "%s", PS(AFTER_OBJECT));
     if (number(r, line, tok[0], 1, &rad) || number(r, line, tok[1], 0, &z) ||
-        number(r, line, tok[2], 0, &n))
+        index_token(r, line, tok[2], &n))
         return LM_FAIL;
     if (r->nsurf && z < r->z_last) return bad(r, line, "%s", PS(DECREASING));
     if (!(n > 0)) return bad(r, line, "%s", PS(NOT_POSITIVE));
@@ -284,7 +298,7 @@ static int num(cursor *c, const char *what, unsigned flags, double min, double *
     char tok[LM_TOKEN_MAX];
     enum lm_num_status st;
     if (token(c, what, tok)) return LM_FAIL;
-    st = lm_parse_number(tok, v);
+    st = (flags & LM_INDEX) ? lm_parse_index(tok, v) : lm_parse_number(tok, v);
     if (st == LM_NUM_PLANE && (flags & LM_ALLOW_PLANE)) { *v = INFINITY; return LM_GO; }
     if (st != LM_NUM_OK) {
         char msg[LM_TOKEN_MAX + 100];
@@ -322,13 +336,13 @@ static int read_answers(cursor *c, lm_lens_file *lf)
     char tok[LM_TOKEN_MAX];
     int more;
     if (num(c, PS(W_NEARPOINT), LM_NONNEG, 0, &lf->nearpoint) ||
-        num(c, PS(W_INDEX), LM_POSITIVE, 0, &lf->n_object))
+        num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &lf->n_object))
         return LM_FAIL;
     do {
         if (num(c, PS(W_RADIUS), LM_ALLOW_PLANE, 0, &s[0]) ||
             num(c, PS(W_LOCATION), lf->nsurf ? LM_AT_LEAST : 0,
                 lf->nsurf ? lf->surf[lf->nsurf - 1].z : 0, &s[1]) ||
-            num(c, PS(W_INDEX), LM_POSITIVE, 0, &s[2]) ||
+            num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &s[2]) ||
             yn(c, PS(W_ANOTHER_SURFACE), &more))
             return LM_FAIL;
         if (!(ns = grow(lf->surf, lf->nsurf + 1, sizeof *ns))) return fail_at(c, "", "%s", PS(A_MEMORY));
