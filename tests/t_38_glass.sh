@@ -103,10 +103,20 @@ glass_prescription() {
 check "prescription: glass names in index fields, record and back (lensmat)" glass_prescription "$BIN"
 check "prescription: the same under ASan/UBSan" glass_prescription "$ASAN"
 rx_refuse() {   # rx_refuse NAME LINE MESSAGE
-    printf '%s\nobject 1\n' "$2" > "$WORK/rb.rx"
+    printf "$2\nobject 1\n" > "$WORK/rb.rx"
     (cd "$WORK" && "$ASAN" --prescription -i rb.rx rb.rec > /dev/null 2> rb.err); rc=$?
     if [ "$rc" -eq 2 ] && grep -qF "$3" "$WORK/rb.err"; then pass "$1"
     else fail "$1 (exit $rc)"; cat "$WORK/rb.err"; fi
 }
 rx_refuse "prescription: glass outside its range" '62.75 0 N-BK7@9' "rb.rx:1: N-BK7's formula holds from 0.3 to 2.5 um, not at 9 um"
 rx_refuse "prescription: unknown glass" '62.75 0 BK-7' "rb.rx:1: 'BK-7' is not an index (a number, a medium, a glass"
+# "wavelength W" in a prescription: every index named without "@" is taken at W
+check "prescription: wavelength C applies to every glass named" sh -c "
+    cd '$WORK' && printf 'wavelength C\n62.75 0 N-BK7\n-45.71 4 SF5\n-128.23 6.5 1.0\nobject -1000\n' > wl.rx &&
+    '$ASAN' --prescription -i wl.rx wl.rec > /dev/null &&
+    grep -q '^input: N-BK7@C\$' wl.rec && grep -q '^input: SF5@C\$' wl.rec && grep -q '^input: 1\$' wl.rec &&
+    grep -q '(N-BK7@C: index 1.514322 at 656.3 nm)' wl.rec"
+rx_refuse "prescription: wavelength after index" 'index 1\nwavelength C' "rb.rx:2: wavelength comes before index"
+rx_refuse "prescription: bad wavelength" 'wavelength Z' "rb.rx:1: 'Z' is not a wavelength"
+rx_refuse "prescription: wavelength twice" 'wavelength C\nwavelength d' "rb.rx:2: wavelength given twice"
+rx_refuse "prescription: diamond at C" 'wavelength C\n1 0 diamond' "rb.rx:2: DIAMOND's formula holds from 0.226 to 0.644 um"
