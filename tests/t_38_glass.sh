@@ -120,3 +120,7 @@ rx_refuse "prescription: wavelength after index" 'index 1\nwavelength C' "rb.rx:
 rx_refuse "prescription: bad wavelength" 'wavelength Z' "rb.rx:1: 'Z' is not a wavelength"
 rx_refuse "prescription: wavelength twice" 'wavelength C\nwavelength d' "rb.rx:2: wavelength given twice"
 rx_refuse "prescription: diamond at C" 'wavelength C\n1 0 diamond' "rb.rx:2: DIAMOND's formula holds from 0.226 to 0.644 um"
+
+# Seidel sums (src/paraxial/seidel.c): exact-trace, thin-lens and axial-colour checks
+unit "$TOP/build/obj/unit_seidel"
+unit "$TOP/build/asan/unit_seidel"

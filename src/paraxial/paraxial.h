@@ -353,4 +353,28 @@ int px_colour_run(const px_csurf *s, int nsurf, const char *obj_glass,
 /* The same at F, d, C, with long_colour and lat_colour_rel. */
 int px_colour_fdc(const px_csurf *s, int nsurf, const char *obj_glass, px_colour *out);
 
+/* Third-order (Seidel) sums of a prescription by thickness (seidel.c), object at
+ * infinity, aperture stop at surface 1: the marginal ray enters at height y1 parallel
+ * to the axis, the chief ray through the vertex of surface 1 at slope ubar1.
+ * Welford's forms ("Aberrations of Optical Systems", 1986, ch. 8): with A = n i and
+ * Abar = n ibar (i = u + y c), H = n (ubar y - u ybar) the Lagrange invariant,
+ *   SI = -sum A^2 y D(u/n), SII = -sum A Abar y D(u/n), SIII = -sum Abar^2 y D(u/n),
+ *   SIV = -sum H^2 c D(1/n), SV = sum (Abar/A)(SIII_k + SIV_k),
+ *   CI = sum A y D(dn/n), CII = sum Abar y D(dn/n),  dn = nF - nC,
+ * D(x) = x' - x across a surface; indices at d.  Paraxial slopes u = dy/dz; a
+ * refraction n'u' = n u - y c (n' - n).  Per surface and total; also the last
+ * surface's marginal slope u' and index n': the transverse spherical aberration at
+ * the paraxial focus is SI/(2 n' u') with these slopes (Welford's -SI/(2 n' u') with
+ * his sign of u), the axial colour bfd(F) - bfd(C) about -CI/(n' u'^2).  PX_BAD when
+ * a surface has A = 0 but a field term (SV's form fails), or a bad thickness. */
+#define PX_SEIDEL_MAXSURF 64
+typedef struct px_seidel_sums { double s1, s2, s3, s4, s5, c1, c2; } px_seidel_sums;
+typedef struct px_seidel {
+    int nsurf;
+    px_seidel_sums surf[PX_SEIDEL_MAXSURF], total;
+    double u_last, n_last, h;  /* image-space marginal slope and index; H */
+} px_seidel;
+int px_seidel_run(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
+                  double ubar1, px_seidel *out);
+
 #endif
