@@ -67,6 +67,9 @@ colour_example() {
     grep -q 'Abbe number Vd of N-BK7: 64.17' col.rec && grep -q 'Abbe number Vd of SF5: 32.21' col.rec ||
         return 1
     grep -q 'longitudinal colour bfd(F) - bfd(C) = -0.119' col.rec || return 1
+    # the Seidel sums' axial colour agrees with the F-C paraxial shift (first order)
+    grep -q "axial colour -CI/(n'u'^2) = -0.118" col.rec || return 1
+    [ "$(grep -c '^  [123] ' col.rec)" -eq 3 ] && grep -q '^  total ' col.rec || return 1
     grep input: col.rec > col.in && "$1" --colour col2.rec < col.in > /dev/null && cmp col.rec col2.rec
 }
 check "--colour: AC254-100-A example, efl 100.07, Vd, replay (lensmat)" colour_example "$BIN"
@@ -85,7 +88,7 @@ colour_refuse "--colour: bad wavelength" 'mm\n1\nviolet\n' "'violet' is not a wa
 colour_refuse "--colour: unknown glass" 'mm\n1\nd\nair\n1\n10\nBK-7\n' "'BK-7' is not a glass lensmat knows"
 # a singlet of a model glass: one wavelength, plane back, bfd = R/(n-1) at d
 check "--colour: model-glass plano-convex, f = R/(n-1)" sh -c "
-    cd '$WORK' && printf 'mm\n1\nd\nair\n2\n51.68\n1.5168/64.17\n0\nplane\nair\n' > pc.in &&
+    cd '$WORK' && printf 'mm\n1\nd\nair\n2\n51.68\n1.5168/64.17\n0\nplane\nair\nn\n' > pc.in &&
     '$BIN' --colour -i pc.in pc.rec > /dev/null && grep -q '^  efl 100, ' pc.rec"
 
 # Prescription files: an index field may be a glass; the classic record echoes it;
@@ -124,3 +127,5 @@ rx_refuse "prescription: diamond at C" 'wavelength C\n1 0 diamond' "rb.rx:2: DIA
 # Seidel sums (src/paraxial/seidel.c): exact-trace, thin-lens and axial-colour checks
 unit "$TOP/build/obj/unit_seidel"
 unit "$TOP/build/asan/unit_seidel"
+colour_refuse "--colour: field angle beyond 60 degrees" 'mm\n1\nd\nair\n1\n10\nN-BK7\ny\n1\n70\n' \
+    "cb.in:10: the field angle: the field angle must lie between -60 and 60 degrees"

@@ -97,6 +97,41 @@ static void report_wavelength(calc *c, const colour_session *s, const char *obj,
              CL(f->z_n2.v), CL(f->z_f2.v));
 }
 
+/* The optional Seidel sums: pupil semi-diameter and field angle asked. */
+static int seidel(calc *c, const px_csurf *surf, int nsurf, const char *obj)
+{
+    px_seidel q;
+    double y, deg;
+    int rc, yes;
+    lm_mark m;
+    if ((rc = calc_yn(c, CO(SEIDEL_Q), CO(SEIDEL_Q_WHAT), &yes)) || !yes) return rc;
+    if ((rc = calc_num(c, CO(PUPIL), CO(PUPIL_WHAT), LM_POSITIVE, &y))) return rc;
+    for (;;) {
+        calc_mark(c, &m);
+        if ((rc = calc_num(c, CO(FIELD), CO(FIELD_WHAT), 0, &deg))) return rc;
+        if (fabs(deg) <= 60) break;
+        if ((rc = calc_reject(c, &m, CO(FIELD_WHAT), CO(FIELD), CO(AGAIN_FIELD), "%s",
+                              CO(FIELD_BAD))))
+            return rc;
+    }
+    calc_say(c, CO(SEIDEL_HEAD), y, deg);
+    if (px_seidel_run(surf, nsurf, obj, y, tan(deg * 3.14159265358979323846 / 180), &q) != PX_OK) {
+        calc_say(c, "%s", CO(SEIDEL_BAD));
+        return LM_GO;
+    }
+    for (int k = 0; k < nsurf; k++) {
+        const px_seidel_sums *e = &q.surf[k];
+        calc_say(c, CO(SEIDEL_ROW), k + 1, CL(e->s1), CL(e->s2), CL(e->s3), CL(e->s4),
+                 CL(e->s5), CL(e->c1), CL(e->c2));
+    }
+    calc_say(c, CO(SEIDEL_TOTAL), "total", CL(q.total.s1), CL(q.total.s2), CL(q.total.s3),
+             CL(q.total.s4), CL(q.total.s5), CL(q.total.c1), CL(q.total.c2));
+    if (q.u_last != 0)
+        calc_say(c, CO(SEIDEL_DERIVED), CL(q.total.s1 / (2 * q.n_last * q.u_last)), c->uname,
+                 CL(-q.total.c1 / (q.n_last * q.u_last * q.u_last)), c->uname);
+    return LM_GO;
+}
+
 int lm_colour(lm_io *io)
 {
     calc cc = {io, PX_MM, "mm"}, *c = &cc;
@@ -163,6 +198,7 @@ int lm_colour(lm_io *io)
                  strcasecmp(glass[i], "vacuum"))
             calc_say(c, CO(NO_ABBE), glass[i]);
     }
+    if ((rc = seidel(c, surf, nsurf, obj))) return rc;
     return calc_done(c);
 }
 const char *lm_colour_example(void) { return CO(EXAMPLE); }
