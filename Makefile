@@ -19,6 +19,8 @@ LIBS    := -lreadline -lm
 
 PROMPTS := $(wildcard prompts/*.txt)
 GEN     := $(patsubst prompts/%.txt,build/gen/prompts_%.h,$(PROMPTS))
+# The glass catalogue (data/glass.txt), compiled in like the prompts.
+GEN     += build/gen/glass_data.h
 # The core: the dialogue layer and the paraxial engine (libc, libm, readline only).
 CORE    := $(wildcard src/dialogue/*.c src/paraxial/*.c)
 LIBCORE := $(filter-out src/dialogue/main.c,$(CORE))
@@ -39,6 +41,10 @@ $(DEPS): scripts/install-deps.sh
 build/gen/prompts_%.h: prompts/%.txt scripts/gen_prompts.sh
 	@mkdir -p $(@D)
 	sh scripts/gen_prompts.sh $* $< $@
+
+build/gen/glass_data.h: data/glass.txt scripts/gen_glass.sh
+	@mkdir -p $(@D)
+	sh scripts/gen_glass.sh data/glass.txt $@
 
 build/obj/%.o: src/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
@@ -61,6 +67,9 @@ build/asan/unit_%: tests/unit_%.c $(SANLIB)
 	$(CC) $(BASE) $(SAN) -Itests -o $@ $< $(SANLIB) $(LIBS)
 # The paraxial engine's benchmark (scripts/bench_paraxial.sh), linked the same way.
 build/obj/bench_paraxial: tests/bench_paraxial.c $(LIBOBJ)
+	$(CC) $(BASE) $(OPT) -o $@ $< $(LIBOBJ) $(LIBS)
+# The glass catalogue's achromat benchmark (scripts/bench_glass.sh).
+build/obj/bench_glass: tests/bench_glass.c $(LIBOBJ)
 	$(CC) $(BASE) $(OPT) -o $@ $< $(LIBOBJ) $(LIBS)
 
 # libFuzzer target for the answer reader, the number parser and every dialogue of
@@ -94,6 +103,7 @@ build/bench/%: tests/bench/%.c | $(DEPS)
 
 bench: lensmat build/original/lensmat build/bench/benchrun build/bench/baseline \
        build/obj/bench_paraxial \
+       build/obj/bench_glass \
        $(MODULE_BENCH_BINS)
 	@sh scripts/bench.sh
 

@@ -337,7 +337,7 @@ static const char *violates(const lm_numspec *spec, enum lm_num_status st, doubl
 int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec *spec,
                   double *v)
 {
-    char tok[LM_TOKEN_MAX], echo[64];
+    char tok[LM_TOKEN_MAX], echo[LM_TOKEN_MAX + 16];
     if (rec) lm_say(io, LM_REC, "%s", rec);
     for (;;) {
         int r;
@@ -353,24 +353,35 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
             continue;
         }
         st = lm_parse_number(tok, v);
-        if (st == LM_NUM_SYNTAX && (spec->flags & LM_INDEX) &&
-            lm_parse_index(tok, v) == LM_NUM_OK) {      /* a medium's name */
-            size_t i;
-            for (i = 0; tok[i] && i < sizeof echo - 1; i++)
-                echo[i] = (char)tolower((unsigned char)tok[i]);
-            echo[i] = '\0';
-            lm_say(io, LM_REC, "input: %s\n", echo);
-            show_answer(io, echo);
-            lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
-            return LM_GO;
+        if (st == LM_NUM_SYNTAX && (spec->flags & LM_INDEX)) {
+            char why[300];
+            double lambda;
+            int k = lm_index_name(tok, v, echo, sizeof echo, &lambda, why, sizeof why);
+            if (k == 1 && lambda == 0) {               /* a medium's name */
+                lm_say(io, LM_REC, "input: %s\n", echo);
+                show_answer(io, echo);
+                lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
+                return LM_GO;
+            }
+            if (k == 1) {                              /* a glass at a wavelength */
+                lm_say(io, LM_REC, "input: %s\n", echo);
+                show_answer(io, echo);
+                lm_say(io, LM_BOTH, "(%s: index %.6f at %.1f nm)\n", echo, *v,
+                       lambda * 1000);
+                return LM_GO;
+            }
+            if (k == -1) {
+                if (complain(io, spec->what, "%s", why)) return LM_FAIL;
+                continue;
+            }
         }
         if (st != LM_NUM_OK && st != LM_NUM_PLANE) {
             /* for an index, a word gets the media named; "1,5" just is not a number */
             int word = (spec->flags & LM_INDEX) && isalpha((unsigned char)tok[0]);
             if (complain(io, spec->what, st == LM_NUM_SYNTAX && !word ?
                          "'%s' is not a number" : st == LM_NUM_SYNTAX ?
-                         "'%s' is not a number, nor a medium lensmat knows (air, water, "
-                         "cornea, crown, flint, ...)" : st == LM_NUM_NAN ?
+                         "'%s' is not a number, nor a medium or glass lensmat knows (air, "
+                         "water, cornea, crown, N-BK7, SF2, 1.5168/64.17, ...)" : st == LM_NUM_NAN ?
                          "'%s': nan is not a number" :
                          "'%s' is out of range (|x| <= 1e30)", tok)) return LM_FAIL;
             continue;
@@ -522,11 +533,76 @@ int lm_mark_reject(lm_io *io, const lm_mark *m, const char *what, const char *ms
     return LM_FAIL;
 }
 
+/* NAME or NAME@WAVELENGTH: the seed's media by their bare names keep their constant
+ * indices (the classic's values: "water" is 1.333); a catalogue glass, a model glass
+ * "nd/Vd", or any name with "@" takes the catalogue's formula, at the d line unless a
+ * wavelength is named.  The echo is the catalogue's spelling (media: lower case) and
+ * the wavelength as given (shorthands canonical), so a replay reads the same. */
+int lm_index_name(const char *tok, double *v, char *echo, size_t cap, double *lambda,
+                  char *why, size_t wcap)
+{
+    char name[LM_TOKEN_MAX];
+    const char *at = strchr(tok, '@'), *wl = at ? at + 1 : NULL;
+    const px_glass_rec *g;
+    double n, l = PX_LAMBDA_D;
+    size_t len = at ? (size_t)(at - tok) : strlen(tok);
+    int r;
+    *lambda = 0;
+    if (len == 0 || len >= sizeof name) return 0;
+    memcpy(name, tok, len);
+    name[len] = '\0';
+    if (!at && (n = px_medium_index(name)) > 0) {
+        size_t i;
+        for (i = 0; name[i] && i < cap - 1; i++) echo[i] = (char)tolower((unsigned char)name[i]);
+        echo[i] = '\0';
+        *v = n;
+        return 1;
+    }
+    g = px_glass_find(name);
+    if (!g && !isdigit((unsigned char)name[0])) {
+        if (!at) return 0;
+        snprintf(why, wcap, "'%.60s' is not a glass lensmat knows (N-BK7, F2, "
+                 "F_SILICA, water, ...: data/glass.txt; or nd/Vd)", name);
+        return -1;
+    }
+    if (wl && px_wavelength(wl, &l) != PX_OK) {
+        snprintf(why, wcap, "'%.60s' is not a wavelength (F, d, C, e, g, hene, or a "
+                 "number: nm above 100, else um)", wl);
+        return -1;
+    }
+    r = px_glass_index(name, l, &n);
+    if (r == PX_NO_GLASS) {
+        if (!at && !strchr(name, '/')) return 0;
+        snprintf(why, wcap, "'%.60s' is neither a catalogue glass nor a model glass "
+                 "nd/Vd (1 < nd < 3, 5 <= Vd <= 150)", name);
+        return -1;
+    }
+    if (r == PX_GLASS_RANGE) {
+        if (g) snprintf(why, wcap, "%s's formula holds from %g to %g um, not at %g um",
+                        g->name, g->lmin, g->lmax, l);
+        else snprintf(why, wcap, "a model glass holds from 0.36 to 1 um, not at %g um", l);
+        return -1;
+    }
+    if (r != PX_OK) return 0;
+    if (wl) {
+        static const char *const lines[] = {"F", "d", "C", "e", "g", "hene"};
+        const char *w = wl;
+        for (size_t i = 0; i < sizeof lines / sizeof *lines; i++)
+            if (!strcasecmp(wl, lines[i])) w = lines[i];
+        snprintf(echo, cap, "%s@%s", g ? g->name : name, w);
+    } else snprintf(echo, cap, "%s", g ? g->name : name);
+    *v = n;
+    *lambda = l;
+    return 1;
+}
+
 enum lm_num_status lm_parse_index(const char *tok, double *v)
 {
     enum lm_num_status st = lm_parse_number(tok, v);
-    double n;
-    if (st == LM_NUM_SYNTAX && (n = px_medium_index(tok)) > 0) {
+    char echo[LM_TOKEN_MAX], why[300];
+    double n, l;
+    if (st == LM_NUM_SYNTAX && lm_index_name(tok, &n, echo, sizeof echo, &l, why,
+                                             sizeof why) == 1) {
         *v = n;
         return LM_NUM_OK;
     }

@@ -116,6 +116,13 @@ int  lm_mark_reject(lm_io *io, const lm_mark *m, const char *what, const char *m
  * water, cornea, crown, ...; px_medium_index).  Returns LM_NUM_OK with *v set, or
  * the number's status. */
 enum lm_num_status lm_parse_index(const char *tok, double *v);
+/* An index by name: a medium (bare name, the seed's constant), a catalogue glass or
+ * a model glass "nd/Vd" (src/paraxial/glass.c), optionally "@WAVELENGTH" (F d C e g
+ * hene, nm or um; default d).  1: *v, the echo for the record and *lambda (um; 0 for
+ * a medium's constant) set; 0: not a name; -1: a name whose index cannot be given
+ * (unknown glass after "@", bad wavelength, outside the formula's range): why says. */
+int lm_index_name(const char *tok, double *v, char *echo, size_t cap, double *lambda,
+                  char *why, size_t wcap);
 /* lm_ask_number for an index (spec's flags as there): a medium name is accepted,
  * echoed as its name (lower case) so the replay is exact, and its index is shown
  * on stdout and in the record ("(water: index 1.333)"); a number is handled and

@@ -14,6 +14,7 @@
 #include "ask.h"
 #include "dialogues.h"
 #include "lex.h"
+#include "../paraxial/paraxial.h"
 #include "prompts_prescription.h"
 
 #define PS(k) prescription_prompts[PRESCRIPTION_##k]
@@ -82,14 +83,15 @@ typedef struct rx {
     char *err;                /* "FILE:LINE: why" */
     size_t errcap;
     text ans;                 /* the classic dialogue's answers */
-    int have_near, have_index, nsurf, nobj;
+    int have_near, have_index, have_wl, nsurf, nobj;
     double z_last;
     char near[LM_TOKEN_MAX], index[LM_TOKEN_MAX];
+    char wl[32];              /* "wavelength W": the glasses' default wavelength */
 } rx;
 
 static int bad(rx *r, long line, const char *fmt, const char *arg)
 {
-    char msg[512];
+    char msg[1200];   /* room for any token: the compiler counts a line's four */
     snprintf(msg, sizeof msg, fmt, arg);
     snprintf(r->err, r->errcap, PS(BAD_LINE), r->src, line, msg);
     return LM_FAIL;
@@ -103,12 +105,53 @@ static int number(rx *r, long line, const char *tok, int plane, double *v)
     return bad(r, line, plane ? PS(BAD_RADIUS) : PS(BAD_NUMBER), tok);
 }
 
+/* An index token: a number, a medium, a catalogue or model glass, NAME@WAVELENGTH
+ * (lm_index_name, as the classic dialogue takes it); 0 or LM_FAIL with the reason. */
+static int index_token(rx *r, long line, const char *tok, double *v)
+{
+    char echo[LM_TOKEN_MAX + 16], why[300];
+    double lambda;
+    int k;
+    if (lm_parse_number(tok, v) == LM_NUM_OK) return 0;
+    k = lm_index_name(tok, v, echo, sizeof echo, &lambda, why, sizeof why);
+    if (k == 1) return 0;
+    if (k == -1) return bad(r, line, "%s", why);
+    return bad(r, line, PS(BAD_INDEX), tok);
+}
+
+/* With "wavelength W", an index named without "@" is taken at W: NAME -> NAME@W
+ * (numbers stay numbers).  Writes the answer into out (LM_TOKEN_MAX); 0 or LM_FAIL. */
+static int at_wavelength(rx *r, long line, const char *tok, char *out)
+{
+    double v;
+    int n;
+    if (!r->have_wl || strchr(tok, '@') || lm_parse_number(tok, &v) == LM_NUM_OK)
+        n = snprintf(out, LM_TOKEN_MAX, "%s", tok);
+    else n = snprintf(out, LM_TOKEN_MAX, "%s@%s", tok, r->wl);
+    if (n >= LM_TOKEN_MAX) return bad(r, line, "%s", PS(TOO_LONG));
+    return 0;
+}
+
 static int keyword(rx *r, long line, const char *key, const char *val)
 {
     double v;
+    char named[LM_TOKEN_MAX];
+    if (!strcmp(key, "wavelength")) {
+        if (r->have_wl) return bad(r, line, PS(TWICE), key);
+        if (r->have_index) return bad(r, line, "%s", PS(WL_FIRST));
+        if (px_wavelength(val, &v) != PX_OK || strlen(val) >= sizeof r->wl)
+            return bad(r, line, PS(BAD_WL), val);
+        strcpy(r->wl, val);
+        r->have_wl = 1;
+        return LM_GO;
+    }
+    if (strcmp(key, "nearpoint")) {
+        if (at_wavelength(r, line, val, named)) return LM_FAIL;
+        val = named;
+    }
     int near = !strcmp(key, "nearpoint");
     if (near ? r->have_near : r->have_index) return bad(r, line, PS(TWICE), key);
-    if (number(r, line, val, 0, &v)) return LM_FAIL;
+    if (near ? number(r, line, val, 0, &v) : index_token(r, line, val, &v)) return LM_FAIL;
     if (near && v < 0) return bad(r, line, "%s", PS(NEGATIVE));
     if (!near && !(v > 0)) return bad(r, line, "%s", PS(NOT_POSITIVE));
     strcpy(near ? r->near : r->index, val);
@@ -119,9 +162,12 @@ static int keyword(rx *r, long line, const char *key, const char *val)
 static int surface(rx *r, long line, char tok[3][LM_TOKEN_MAX])
 {
     double rad, z, n;
+    char named[LM_TOKEN_MAX];
     if (r->nobj) return bad(r, line, "%s", PS(AFTER_OBJECT));
+    if (at_wavelength(r, line, tok[2], named)) return LM_FAIL;
+    strcpy(tok[2], named);
     if (number(r, line, tok[0], 1, &rad) || number(r, line, tok[1], 0, &z) ||
-        number(r, line, tok[2], 0, &n))
+        index_token(r, line, tok[2], &n))
         return LM_FAIL;
     if (r->nsurf && z < r->z_last) return bad(r, line, "%s", PS(DECREASING));
     if (!(n > 0)) return bad(r, line, "%s", PS(NOT_POSITIVE));
@@ -144,7 +190,8 @@ static int one_line(rx *r, long line, char *buf)
         n++;
     }
     if (n == 0) return LM_GO;
-    if (n == 2 && (!strcmp(tok[0], "nearpoint") || !strcmp(tok[0], "index"))) {
+    if (n == 2 && (!strcmp(tok[0], "nearpoint") || !strcmp(tok[0], "index") ||
+                   !strcmp(tok[0], "wavelength"))) {
         if (r->nsurf) return bad(r, line, "%s", PS(KEYS_FIRST));
         return keyword(r, line, tok[0], tok[1]);
     }
@@ -284,7 +331,7 @@ static int num(cursor *c, const char *what, unsigned flags, double min, double *
     char tok[LM_TOKEN_MAX];
     enum lm_num_status st;
     if (token(c, what, tok)) return LM_FAIL;
-    st = lm_parse_number(tok, v);
+    st = (flags & LM_INDEX) ? lm_parse_index(tok, v) : lm_parse_number(tok, v);
     if (st == LM_NUM_PLANE && (flags & LM_ALLOW_PLANE)) { *v = INFINITY; return LM_GO; }
     if (st != LM_NUM_OK) {
         char msg[LM_TOKEN_MAX + 100];
@@ -322,13 +369,13 @@ static int read_answers(cursor *c, lm_lens_file *lf)
     char tok[LM_TOKEN_MAX];
     int more;
     if (num(c, PS(W_NEARPOINT), LM_NONNEG, 0, &lf->nearpoint) ||
-        num(c, PS(W_INDEX), LM_POSITIVE, 0, &lf->n_object))
+        num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &lf->n_object))
         return LM_FAIL;
     do {
         if (num(c, PS(W_RADIUS), LM_ALLOW_PLANE, 0, &s[0]) ||
             num(c, PS(W_LOCATION), lf->nsurf ? LM_AT_LEAST : 0,
                 lf->nsurf ? lf->surf[lf->nsurf - 1].z : 0, &s[1]) ||
-            num(c, PS(W_INDEX), LM_POSITIVE, 0, &s[2]) ||
+            num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &s[2]) ||
             yn(c, PS(W_ANOTHER_SURFACE), &more))
             return LM_FAIL;
         if (!(ns = grow(lf->surf, lf->nsurf + 1, sizeof *ns))) return fail_at(c, "", "%s", PS(A_MEMORY));

@@ -39,6 +39,8 @@ const lm_dialogue lm_dialogues[] = {
      lm_prescription, lm_prescription_example, NULL, 1},
     {"--to-prescription", "write a classic record or answers (-i FILE) as a prescription",
      lm_to_prescription, lm_to_prescription_example, NULL, 0},
+    {"--colour", "per wavelength: glasses by name, focal lengths, colour, Abbe numbers",
+     lm_colour, lm_colour_example, NULL, 0},
 };
 const size_t lm_ndialogues = sizeof lm_dialogues / sizeof lm_dialogues[0];
 

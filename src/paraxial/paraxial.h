@@ -291,4 +291,90 @@ double px_cornea_dradius(double power, double dpower, double n);  /* |dR| */
 double px_cornea_doc_radius(double p, double n);
 double px_cornea_doc_dradius(double p, double dp, double n);
 
+/* ---- glasses and wavelengths (src/paraxial/glass.c, colour.c) --------------------
+ * The catalogue is data/glass.txt, compiled in.  Wavelengths are in micrometres. */
+#define PX_LAMBDA_F 0.4861327     /* hydrogen F */
+#define PX_LAMBDA_D 0.5875618     /* helium d: where nd and Vd are given */
+#define PX_LAMBDA_C 0.6562725     /* hydrogen C */
+#define PX_LAMBDA_E 0.5460740     /* mercury e */
+#define PX_LAMBDA_G 0.4358343     /* mercury g */
+#define PX_LAMBDA_HENE 0.6328     /* helium-neon laser (the cornea rig's) */
+enum { PX_GLASS_SELLMEIER, PX_GLASS_SELLMEIER_L, PX_GLASS_CONST };
+typedef struct px_glass_rec {
+    const char *name;
+    int model;                 /* PX_GLASS_* */
+    double lmin, lmax;         /* validity range, um */
+    const char *nd, *vd;       /* published values as printed ("-": none) */
+    int ncoef;
+    double coef[8];
+} px_glass_rec;
+/* Result codes of the look-ups below, besides PX_OK: */
+enum { PX_NO_GLASS = 4,        /* no such glass, or not "nd/Vd" */
+       PX_GLASS_RANGE = 5 };   /* the wavelength lies outside the glass's range */
+/* The catalogue's entry for a name (case-insensitive), or NULL; and by number
+ * (0 <= i < px_glass_count()) for listings. */
+const px_glass_rec *px_glass_find(const char *name);
+int px_glass_count(void);
+const px_glass_rec *px_glass_at(int i);
+/* The index of a catalogue glass or a model glass at lambda_um.  A model glass is
+ * "ND/VD" (e.g. "1.5168/64.17", 1 < ND < 3, 5 <= VD <= 150): n = A + B/l^2, the line
+ * in 1/l^2 through nd at d with nF - nC = (nd - 1)/Vd; valid 0.36-1.0 um.  Returns
+ * PX_OK, PX_NO_GLASS, PX_GLASS_RANGE, or PX_BAD (lambda not a positive number).
+ * A plain number (0 < n <= 100) and a name of px_medium_index not in the catalogue
+ * are constant indices. */
+int px_glass_index(const char *name, double lambda_um, double *n);
+int px_glass_model(double nd, double vd, double lambda_um, double *n);
+/* A wavelength: the shorthands F d C e g (any case) and "hene", or a number, taken
+ * as nm when above 100, else um (0.6328, 632.8).  PX_OK with *um set, or PX_BAD. */
+int px_wavelength(const char *tok, double *um);
+/* Abbe number (nd - 1)/(nF - nC) of a glass (PX_GLASS_RANGE if F or C is outside). */
+int px_glass_abbe(const char *name, double *vd);
+
+/* A prescription by thickness, per wavelength (colour.c): surface i has radius r
+ * (0 or +-inf: plane), the medium `glass` (a catalogue or model glass name) to its
+ * right, and thickness t to the next surface (the last surface's t is ignored).
+ * Object medium obj_glass.  For each wavelength: every first-order quantity
+ * (px_first: efl, bfd, ffd, cardinal points; surface 1 at z = 0). */
+typedef struct px_csurf { double r, t; const char *glass; } px_csurf;
+#define PX_COLOUR_MAXWL 8
+typedef struct px_colour {
+    int nwl;
+    double lambda[PX_COLOUR_MAXWL];
+    px_first first[PX_COLOUR_MAXWL];
+    /* with wavelengths F, d, C at 0, 1, 2 (px_colour_fdc): */
+    double long_colour;        /* bfd(F) - bfd(C): longitudinal colour, object at inf */
+    double lat_colour_rel;     /* (efl(F) - efl(C))/efl(d): lateral colour per unit
+                                  image height, object at infinity */
+    int bad_surface;           /* on failure: the surface (0-based) whose glass failed,
+                                  -1 for the object medium */
+} px_colour;
+int px_colour_run(const px_csurf *s, int nsurf, const char *obj_glass,
+                  const double *lambda, int nwl, px_colour *out);
+/* The same at F, d, C, with long_colour and lat_colour_rel. */
+int px_colour_fdc(const px_csurf *s, int nsurf, const char *obj_glass, px_colour *out);
+
+/* Third-order (Seidel) sums of a prescription by thickness (seidel.c), object at
+ * infinity, aperture stop at surface 1: the marginal ray enters at height y1 parallel
+ * to the axis, the chief ray through the vertex of surface 1 at slope ubar1.
+ * Welford's forms ("Aberrations of Optical Systems", 1986, ch. 8): with A = n i and
+ * Abar = n ibar (i = u + y c), H = n (ubar y - u ybar) the Lagrange invariant,
+ *   SI = -sum A^2 y D(u/n), SII = -sum A Abar y D(u/n), SIII = -sum Abar^2 y D(u/n),
+ *   SIV = -sum H^2 c D(1/n), SV = sum (Abar/A)(SIII_k + SIV_k),
+ *   CI = sum A y D(dn/n), CII = sum Abar y D(dn/n),  dn = nF - nC,
+ * D(x) = x' - x across a surface; indices at d.  Paraxial slopes u = dy/dz; a
+ * refraction n'u' = n u - y c (n' - n).  Per surface and total; also the last
+ * surface's marginal slope u' and index n': the transverse spherical aberration at
+ * the paraxial focus is SI/(2 n' u') with these slopes (Welford's -SI/(2 n' u') with
+ * his sign of u), the axial colour bfd(F) - bfd(C) about -CI/(n' u'^2).  PX_BAD when
+ * a surface has A = 0 but a field term (SV's form fails), or a bad thickness. */
+#define PX_SEIDEL_MAXSURF 64
+typedef struct px_seidel_sums { double s1, s2, s3, s4, s5, c1, c2; } px_seidel_sums;
+typedef struct px_seidel {
+    int nsurf;
+    px_seidel_sums surf[PX_SEIDEL_MAXSURF], total;
+    double u_last, n_last, h;  /* image-space marginal slope and index; H */
+} px_seidel;
+int px_seidel_run(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
+                  double ubar1, px_seidel *out);
+
 #endif

@@ -1,0 +1,123 @@
+/* glass.c -- the glass catalogue (data/glass.txt, compiled in by scripts/gen_glass.sh),
+ * indices of catalogue and model glasses at a wavelength, wavelength shorthands and
+ * Abbe numbers.  Pure functions: no I/O. */
+#include <ctype.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include "paraxial.h"
+#include "glass_data.h"
+
+#define NGLASS ((int)(sizeof px_glass_table / sizeof px_glass_table[0]))
+
+int px_glass_count(void) { return NGLASS; }
+
+const px_glass_rec *px_glass_at(int i)
+{
+    return i >= 0 && i < NGLASS ? &px_glass_table[i] : NULL;
+}
+
+const px_glass_rec *px_glass_find(const char *name)
+{
+    for (int i = 0; i < NGLASS; i++)
+        if (!strcasecmp(name, px_glass_table[i].name)) return &px_glass_table[i];
+    return NULL;
+}
+
+/* n at l (um) from the record's formula; l inside the range. */
+static double formula(const px_glass_rec *g, double l)
+{
+    double l2 = l * l, n2 = 1;
+    if (g->model == PX_GLASS_CONST) return g->coef[0];
+    for (int i = 0; i + 1 < g->ncoef; i += 2) {
+        double c = g->coef[i + 1];
+        if (g->model == PX_GLASS_SELLMEIER_L) c *= c;
+        n2 += g->coef[i] * l2 / (l2 - c);
+    }
+    return sqrt(n2);
+}
+
+/* Model glass: n = A + B/l^2 through nd at d, nF - nC = (nd - 1)/vd. */
+#define MODEL_LMIN 0.36
+#define MODEL_LMAX 1.0
+int px_glass_model(double nd, double vd, double l, double *n)
+{
+    double b, a;
+    if (!(nd > 1 && nd < 3) || !(vd >= 5 && vd <= 150)) return PX_NO_GLASS;
+    if (!(l > 0) || !isfinite(l)) return PX_BAD;
+    if (l < MODEL_LMIN || l > MODEL_LMAX) return PX_GLASS_RANGE;
+    b = (nd - 1) / vd / (1 / (PX_LAMBDA_F * PX_LAMBDA_F) - 1 / (PX_LAMBDA_C * PX_LAMBDA_C));
+    a = nd - b / (PX_LAMBDA_D * PX_LAMBDA_D);
+    *n = a + b / (l * l);
+    return PX_OK;
+}
+
+/* "ND/VD" with both numbers complete: 1 and the two values, else 0. */
+static int parse_model(const char *s, double *nd, double *vd)
+{
+    char *end;
+    if (!isdigit((unsigned char)*s)) return 0;
+    *nd = strtod(s, &end);
+    if (end == s || *end != '/') return 0;
+    s = end + 1;
+    if (!isdigit((unsigned char)*s)) return 0;
+    *vd = strtod(s, &end);
+    return end != s && *end == '\0';
+}
+
+int px_glass_index(const char *name, double l, double *n)
+{
+    const px_glass_rec *g = px_glass_find(name);
+    double nd, vd, m;
+    if (!(l > 0) || !isfinite(l)) return PX_BAD;
+    if (g) {
+        if (l < g->lmin || l > g->lmax) return PX_GLASS_RANGE;
+        *n = formula(g, l);
+        return PX_OK;
+    }
+    if (parse_model(name, &nd, &vd)) return px_glass_model(nd, vd, l, n);
+    if (isdigit((unsigned char)name[0])) {   /* a plain number: a constant index */
+        char *end;
+        m = strtod(name, &end);
+        if (*end || !(m > 0) || !isfinite(m) || m > 100) return PX_NO_GLASS;
+        *n = m;
+        return PX_OK;
+    }
+    if ((m = px_medium_index(name)) > 0) {    /* the seed's constants (cornea, ...) */
+        *n = m;
+        return PX_OK;
+    }
+    return PX_NO_GLASS;
+}
+
+int px_wavelength(const char *tok, double *um)
+{
+    static const struct { const char *name; double l; } lines[] = {
+        {"F", PX_LAMBDA_F}, {"d", PX_LAMBDA_D}, {"C", PX_LAMBDA_C},
+        {"e", PX_LAMBDA_E}, {"g", PX_LAMBDA_G}, {"hene", PX_LAMBDA_HENE},
+    };
+    char *end;
+    double v;
+    for (size_t i = 0; i < sizeof lines / sizeof *lines; i++)
+        if (!strcasecmp(tok, lines[i].name)) { *um = lines[i].l; return PX_OK; }
+    if (!isdigit((unsigned char)tok[0]) && tok[0] != '.') return PX_BAD;
+    v = strtod(tok, &end);
+    if (end == tok || *end || !(v > 0) || !isfinite(v)) return PX_BAD;
+    if (v > 100) v /= 1000;                  /* nanometres */
+    if (v < 0.1 || v > 100) return PX_BAD;   /* 100 nm .. 100 um */
+    *um = v;
+    return PX_OK;
+}
+
+int px_glass_abbe(const char *name, double *vd)
+{
+    double nd, nf, nc;
+    int r;
+    if ((r = px_glass_index(name, PX_LAMBDA_D, &nd)) != PX_OK ||
+        (r = px_glass_index(name, PX_LAMBDA_F, &nf)) != PX_OK ||
+        (r = px_glass_index(name, PX_LAMBDA_C, &nc)) != PX_OK) return r;
+    if (nf == nc) return PX_BAD;             /* no dispersion: Vd infinite */
+    *vd = (nd - 1) / (nf - nc);
+    return PX_OK;
+}
