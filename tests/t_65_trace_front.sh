@@ -461,3 +461,15 @@ if command -v python3 > /dev/null; then
     check "stop: SIGTERM during the tessellation table ends within 1 s, exit 143, record intact" \
         table_stopped "$BIN"
 fi
+
+# An index may be a medium's or a glass's name in --trace too (issue 8): echoed as the
+# name, and the replay of the grep'd record gives the same record.
+trace_index_name() {
+    d=$WORK/tindex; rm -rf "$d"
+    trace_session "$BIN" "$d" lens 1 50 0 N-BK7 12 y -50 5 water 12 n 200 1 n || return 1
+    grep -q '^input: water$' "$d/r.rec" && grep -q '^(water: index 1.333)$' "$d/r.rec" &&
+    grep -qi '^input: n-bk7' "$d/r.rec" &&
+    (cd "$d" && grep input: r.rec > again && "$BIN" --trace -i again r2.rec > /dev/null) &&
+    cmp "$d/r.rec" "$d/r2.rec"
+}
+check "lens: an index given as a medium or glass name (water, N-BK7), exact replay" trace_index_name

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "ask.h"
 #include "drawcalc.h"
 #include "../paraxial/paraxial.h"
 #include "../trace/scene.h"
@@ -17,6 +18,9 @@
 #define FAN_RAYS 9          /* rays of a layout fan per object point */
 #define SPOT_RINGS 16       /* hexapolar rings of a spot bundle: 817 rays per field */
 #define PLOT_RAYS 61        /* rays of a ray-fan plot per field */
+
+/* The tessellation table polls this between batches: a signal arrived (ask.h). */
+static int table_stop(void *ctx) { (void)ctx; return lm_stop_requested() != 0; }
 
 static void set_err(char *err, size_t cap, const char *fmt, const char *arg)
 {
@@ -418,6 +422,7 @@ int dw_table(const scene_api *sa, const imaging_api *im, const dw_scene *s, long
     sp.grid = grid;
     sp.levels = levels;
     sp.nlevels = DW_TESS_LEVELS;
+    sp.stop = table_stop;          /* SIGINT/SIGTERM end the table's traces */
     if (sa->tess_table(&sp, rows, err)) return -1;
     for (int m = 0; m < 3; m++) {
         for (int i = 0; i < DW_TESS_LEVELS; i++) {

@@ -249,7 +249,7 @@ static int enter_surface(tdlg *t, lens *l)
                           check_location, &e, word, sizeof word)))
         return rc;
     lm_parse_number(word, &e.s.z);
-    if ((rc = ask_num(t, P(INDEX_RIGHT), P(INDEX_RIGHT_WHAT), LM_POSITIVE, 0, &e.s.n_right)) ||
+    if ((rc = ask_num(t, P(INDEX_RIGHT), P(INDEX_RIGHT_WHAT), LM_POSITIVE | LM_INDEX, 0, &e.s.n_right)) ||
         (rc = lm_ask_word(t->io, P(SEMI), P(SEMI), P(SEMI_WHAT), check_surface_semi, &e,
                           word, sizeof word)))
         return rc;
@@ -369,7 +369,7 @@ static int do_lens(tdlg *t)
     int rc, more;
 
     if (!l) return LM_FAIL;
-    if ((rc = ask_num(t, P(INDEX_LEFT), P(INDEX_LEFT_WHAT), LM_POSITIVE, 0, &l->tl.n_object)))
+    if ((rc = ask_num(t, P(INDEX_LEFT), P(INDEX_LEFT_WHAT), LM_POSITIVE | LM_INDEX, 0, &l->tl.n_object)))
         goto out;
     px_system_init(&l->sys, l->tl.n_object);
     do {
@@ -580,7 +580,7 @@ static int tess_table(tdlg *t)
     if ((rc = ask_num(t, P(T_R1), P(T_R1_WHAT), LM_ALLOW_PLANE, 0, &sp.r1)) ||
         (rc = ask_num(t, P(T_R2), P(T_R2_WHAT), LM_ALLOW_PLANE, 0, &sp.r2)) ||
         (rc = ask_num(t, P(T_THICK), P(T_THICK_WHAT), LM_POSITIVE, 0, &sp.thickness)) ||
-        (rc = ask_num(t, P(T_INDEX), P(T_INDEX_WHAT), LM_POSITIVE, 0, &sp.n)) ||
+        (rc = ask_num(t, P(T_INDEX), P(T_INDEX_WHAT), LM_POSITIVE | LM_INDEX, 0, &sp.n)) ||
         (rc = lm_ask_word(io, P(T_SEMI), P(T_SEMI), P(T_SEMI_WHAT), check_table_semi, &sp,
                           word, sizeof word)))
         return rc;
