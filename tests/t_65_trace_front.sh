@@ -466,7 +466,7 @@ fi
 # name, and the replay of the grep'd record gives the same record.
 trace_index_name() {
     d=$WORK/tindex; rm -rf "$d"
-    trace_session "$BIN" "$d" lens 1 50 0 N-BK7 12 y -50 5 water 12 n 200 1 n || return 1
+    trace_session "$BIN" "$d" lens 1 50 0 N-BK7 12 y -50 5 water 12 n 200 1 n n || return 1
     grep -q '^input: water$' "$d/r.rec" && grep -q '^(water: index 1.333)$' "$d/r.rec" &&
     grep -qi '^input: n-bk7' "$d/r.rec" &&
     (cd "$d" && grep input: r.rec > again && "$BIN" --trace -i again r2.rec > /dev/null) &&
