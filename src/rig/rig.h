@@ -37,6 +37,7 @@ typedef struct rg_cornea {
     double asph[8];
     double rot[9];              /* pose of the eye: row-major rotation, eye to rig */
     double trans[3];            /* apex position in the rig frame */
+    double zone;                /* measurable zone: largest height (mm; 0: the cap) */
 } rg_cornea;
 typedef struct rg_gimbal {      /* a two-axis mirror mount */
     double center[3];           /* the point the two rotation axes meet */
@@ -45,19 +46,180 @@ typedef struct rg_gimbal {      /* a two-axis mirror mount */
     double offset;              /* mirror surface from the axes' point along the normal
                                    (thickness, gimbal offset); 0: on the axes */
     double radius;              /* mirror semi-diameter (blocking tests) */
+    double mount_radius;        /* mount body: cylinder behind the mirror (0: radius) */
+    double mount_depth;         /* its depth behind the surface (0: none) */
 } rg_gimbal;
+/* One joint's resolution and travel, in the joint's units (rad or mm). */
+typedef struct rg_joint {
+    double steps_per;          /* steps per rad (angles) or per mm (stage); 0: continuous */
+    double lo, hi;             /* travel limits (lo < hi; both 0: unlimited) */
+} rg_joint;
 typedef struct rg_geometry {
     double laser_at[3], laser_dir[3];   /* the fixed beam */
     rg_gimbal m1;                       /* centre fixed on the beam line */
     rg_gimbal m2;                       /* centre moves on the plane p2 */
-    double p2_at[3], p2_u[3], p2_v[3];  /* p2: origin and its two stage axes (unit) */
+    double p2_at[3], p2_u[3], p2_v[3];  /* p2: a point of it and its two stage axes */
     double detector[3];                 /* the fixed detector point */
     rg_cornea cornea;
+    rg_joint joint[6];                  /* per joint (RG_J_*): steps and travel; the
+                                           rig-file reader fills these from its axes */
 } rg_geometry;
 /* Joint values: m1's two angles, m2's stage position on p2, m2's two angles. */
 enum { RG_J_M1A, RG_J_M1B, RG_J_U, RG_J_V, RG_J_M2A, RG_J_M2B, RG_NJOINTS };
 typedef struct rg_pose { double j[RG_NJOINTS]; } rg_pose;   /* rad, mm, rad */
-/* (the geometry part's further declarations go here) */
+
+/* --- frames and conventions ------------------------------------------------------
+ * Eye frame: apex at the origin, optical axis +z pointing INTO the eye, so the
+ * cornea is z = f(x, y) >= 0 and its outward normal at the apex is -z; light comes
+ * from z < 0.  cornea.rot / cornea.trans map it to the rig frame:
+ *     p_rig = rot * p_eye + trans.
+ * Sag (s^2 = x^2 + y^2):
+ *   RG_SPHERE   z = s^2 / (R (1 + sqrt(1 - s^2/R^2)))
+ *   RG_CONIC    z = s^2 / (R (1 + sqrt(1 - (1+Q) s^2/R^2)))   (Q: -1 parabola)
+ *   RG_ASPHERE  the conic + sum_i asph[i] s^(4+2i)             (section 33: A2 s^4 ...)
+ *   RG_BICONIC  with (x', y') the eye frame turned by `axis` about z (x' along the
+ *               flat meridian):  z = (x'^2/R + y'^2/R2) /
+ *                 (1 + sqrt(1 - (1+Q) x'^2/R^2 - (1+Q2) y'^2/R2^2))
+ * A target point on the cornea (rg_target) is given by
+ *   RG_T_ANGLES  theta, phi: spherical coordinates about the apex centre of
+ *                curvature (0,0,R) (section 38): the point where the ray from that
+ *                centre at polar angle theta from -z and azimuth phi (from +x toward
+ *                +y) meets the surface; for a sphere, exactly the sphere's (theta,phi);
+ *   RG_T_HEIGHT  height h (mm from the axis) and meridian phi: (h cos phi, h sin phi,
+ *                f(x, y)) in the eye frame.
+ * Gimbals: n(a, b) = Rot(axis1, a) Rot(axis2, b) normal0 (the inner axis turns with
+ * the outer one: axis2 is its direction at the zero pose).  The mirror surface is
+ * the plane through center + offset * n with normal n (n: the reflecting side).
+ * Stage: m2's gimbal centre at stage (u, v) is m2.center + u p2_u + v p2_v (m2.center
+ * lies on p2: its centre at u = v = 0).  Joint 0 everywhere = the zero pose.
+ *
+ * --- rig-file keys of the geometry (parsed by rg_geometry_key) --------------------
+ * One key and its values per line; lengths in mm, angles in degrees:
+ *   laser_at X Y Z          laser_dir X Y Z        the fixed beam
+ *   m1_center X Y Z         m2_center X Y Z        gimbal centres (m2's at u = v = 0,
+ *                                                  on p2)
+ *   mN_axis1 X Y Z          mN_axis2 X Y Z         outer and inner rotation axes
+ *   mN_normal X Y Z                                mirror normal at the zero pose
+ *   mN_offset D             mN_radius R            surface off the axes; semi-diameter
+ *   mN_mount_radius R       mN_mount_depth D       mount body (blocking tests)
+ *   p2_at X Y Z   p2_u X Y Z   p2_v X Y Z          stage plane and axes
+ *   detector X Y Z
+ *   cornea sphere|conic|asphere|biconic
+ *   cornea_R R   cornea_Q Q   cornea_R2 R   cornea_Q2 Q   cornea_axis DEG
+ *   cornea_asph A4 A6 ...   (up to RG_MAXASPH)        cornea_zone H (0: whole cap)
+ *   eye_at X Y Z            apex position in the rig frame
+ *   eye_rot RX RY RZ        eye rotation, degrees, about x then y then z
+ *   joint NAME STEPS_PER LO HI   NAME one of m1a m1b u v m2a m2b (rg_joint_names):
+ *                           steps per degree (angles) or per mm (u, v; 0: continuous)
+ *                           and travel limits in degrees or mm
+ * Vectors need not be unit (normalised by rg_geometry_check).  Keys the machine
+ * owns (axes, lines, laser) are not geometry keys: rg_geometry_key says "not mine"
+ * (returns 1) so the reader can try its own table. */
+#define RG_MAXASPH 7
+
+/* Names of the joints in rig files and messages: "m1a" "m1b" "u" "v" "m2a" "m2b". */
+
+enum rg_target_kind { RG_T_ANGLES, RG_T_HEIGHT };
+typedef struct rg_target {
+    int kind;                  /* enum rg_target_kind */
+    double a, b;               /* theta, phi (rad) or h (mm), phi (rad) */
+} rg_target;
+
+/* Diagnostics: bits of rg_solution.diag / rg_beam.diag.  RG_D_FATAL bits make solve
+ * fail (RG_EUNREACH, or RG_ETRAVEL for RG_D_TRAVEL alone); the others are warnings
+ * the caller states (RG_D_ILLCOND with the condition number). */
+enum rg_diag {
+    RG_D_OFF_CORNEA    = 1 << 0,   /* target beyond the zone or the conic's edge */
+    RG_D_DETECTOR_SIDE = 1 << 1,   /* detector behind the tangent plane at the target */
+    RG_D_PARALLEL_P2   = 1 << 2,   /* backward ray (nearly) parallel to p2 */
+    RG_D_BEHIND_P2     = 1 << 3,   /* backward ray meets p2 behind the cornea */
+    RG_D_M2_BLOCKS     = 1 << 4,   /* m2 or its mount blocks the ray to the detector
+                                      (or the laser on its way to m1) */
+    RG_D_M1_BLOCKS     = 1 << 5,   /* m1 or its mount blocks the beam */
+    RG_D_MISS_MIRROR   = 1 << 6,   /* beam lands outside a mirror's semi-diameter */
+    RG_D_GRAZING       = 1 << 7,   /* incidence on a mirror or the cornea beyond
+                                      max_incidence */
+    RG_D_GIMBAL        = 1 << 8,   /* a mount cannot turn its mirror to that normal */
+    RG_D_TRAVEL        = 1 << 9,   /* a joint outside its travel */
+    RG_D_NO_CONVERGE   = 1 << 10,  /* the exact model (mirror offsets) not solved */
+    RG_D_MISS_CORNEA   = 1 << 11,  /* forward: the beam misses the cornea */
+    RG_D_ILLCOND       = 1 << 12,  /* warning: joints-to-spot map ill-conditioned */
+    RG_D_NEAR_PARALLEL = 1 << 13,  /* warning: backward ray within 2x the p2 limit */
+    RG_D_TRACE_MISS    = 1 << 14,  /* the trace engine's beam missed target or detector
+                                      by more than trace_tol (a bug: never seen) */
+    RG_D_FATAL         = ((1 << 12) - 1) | (1 << 14)
+};
+
+struct trace_api;              /* src/trace/trace.h: the caller passes the engine table */
+typedef struct rg_solve_opts {
+    double min_p2_angle;       /* smallest angle backward ray / p2 (rad; 0: 2 deg) */
+    double max_incidence;      /* largest incidence, mirrors and cornea (rad; 0: 80 deg) */
+    double cond_max;           /* RG_D_ILLCOND above this (0: 1e4) */
+    double tol;                /* Newton residual, mm (0: 1e-12) */
+    int max_iter;              /* Newton iterations (0: 30) */
+    int no_checks;             /* 1: skip the condition number (baseline timing only) */
+    int newton_only;           /* 1: mirror offsets by Newton alone, from the zero-offset
+                                  closed form (tests: the two methods must agree) */
+    const struct trace_api *trace;  /* non-NULL: every solution also traced through
+                                       the trace engine (rig_api.verify) */
+    double trace_tol;          /* largest traced miss accepted (mm; 0: 1e-6) */
+} rg_solve_opts;
+
+/* The beam through a pose (forward model, exact: offsets, finite mirrors). */
+typedef struct rg_beam {
+    unsigned diag;             /* RG_D_* found along the way */
+    double h1[3], h2[3];       /* where the beam meets m1's and m2's surfaces */
+    double d1[3], d2[3];       /* directions leaving m1 and m2 */
+    double spot[3];            /* on the cornea (rig frame) */
+    double normal[3];          /* outward cornea normal there */
+    double d3[3];              /* direction reflected by the cornea */
+    double det[3];             /* where it crosses the detector plane (through the
+                                  detector point, normal along apex->detector: a
+                                  camera looking at the eye); NaN: never */
+    double inc1, inc2, inc3;   /* incidence angles at m1, m2, cornea (rad) */
+} rg_beam;
+
+typedef struct rg_solution {
+    rg_pose pose;
+    unsigned diag;             /* RG_D_* */
+    double target[3], normal[3];   /* target point and outward normal (rig frame) */
+    double back[3];            /* unit backward ray, target toward m2 */
+    double p2_angle;           /* angle between the backward ray and p2 (rad) */
+    double cond;               /* condition number of the joints-to-spot map */
+    int iterations;            /* offsets: construction passes + Newton steps (0:
+                                  mirrors on their axes, the closed form is exact) */
+    double residual;           /* largest model residual at the end (mm) */
+    rg_beam beam;              /* the forward model through the pose */
+    double traced_err;         /* with opts->trace: the traced beam's largest miss of
+                                  target and detector point (mm); else NaN */
+} rg_solution;
+
+/* Quantised pose: stage first, angles re-solved for the quantised centre, then m1's
+ * angles (each grid corner around them), m2's re-aimed at the target and rounded (the
+ * nearest landing of the 4 wins); the landing errors of that pose on the exact
+ * forward model.  Steps count from the zero pose (joint 0). */
+typedef struct rg_quantised {
+    rg_pose pose;              /* commanded (on the step grid) */
+    int64_t steps[RG_NJOINTS]; /* step counts from the zero pose */
+    unsigned diag;
+    double err_cornea;         /* |spot - target| (mm) */
+    double err_detector;       /* miss at the detector point, in its plane (mm) */
+    double err_cornea_resolved;    /* the same before angles are quantised (mm) */
+    double err_detector_resolved;
+    rg_beam beam;
+} rg_quantised;
+
+/* Result of a forward trace through the trace engine (independent check). */
+typedef struct rg_verify {
+    int hit;                   /* 1: the traced beam reached the detector via m1, m2
+                                  and a cornea reflection */
+    double spot[3], det[3];    /* traced points on the cornea and the detector plane */
+    double err_target;         /* |traced spot - target| (mm) */
+    double err_detector;       /* |traced detector hit - detector point| (mm) */
+    double reflect_err;        /* largest reflection-law defect seen at any mirror or
+                                  the cornea, |d_out - (d_in - 2(d_in.n)n)| */
+} rg_verify;
+
 /* ==== end of geometry ============================================================ */
 
 
@@ -70,7 +232,63 @@ typedef struct rig_api {
     int abi;                                   /* RIG_ABI */
     const char *(*version)(void);
     /* ---- geometry ---- */
-    /* (geometry entry points, in this block) */
+    /* Every geometry function is pure (no global state, thread-safe). */
+    /* The example rig geometry (README "Rig geometry"): a conic cornea, m1 folding a
+     * beam along -x, m2 on the stage plane z = -60, detector 20 deg off axis. */
+    void (*geometry_default)(rg_geometry *g);
+    /* Set one rig-file key (see the list above) from its words (argv[0] is the
+     * key).  0: done; 1: not a geometry key; RG_EINVAL: bad value (message). */
+    int (*geometry_key)(rg_geometry *g, int argc, const char *const *argv,
+                        char *err, size_t errcap);
+    /* Normalise vectors, check consistency (m2 on p2, axes not parallel, radii,
+     * travel lo < hi, asphere count).  RG_OK or RG_EINVAL with a message. */
+    int (*geometry_check)(rg_geometry *g, char *err, size_t errcap);
+    /* Eye pose from rotations about x, y, z (rad, applied in that order) and the
+     * apex position. */
+    void (*eye_pose)(rg_cornea *c, double rx, double ry, double rz, const double at[3]);
+    /* Joint names "m1a" "m1b" "u" "v" "m2a" "m2b" (NULL past RG_NJOINTS). */
+    const char *(*joint_name)(int joint);
+
+    /* Target to a point and outward normal on the placed cornea (rig frame).
+     * RG_OK or RG_EUNREACH (off the cornea) with a message. */
+    int (*cornea_point)(const rg_cornea *c, const rg_target *t, double p[3],
+                        double n[3], char *err, size_t errcap);
+    /* Backward solution (section 38): closed form, Newton on the exact model when a
+     * mirror has an offset, then the diagnostics and the condition number.  opts may
+     * be NULL.  RG_OK (warnings in s->diag), RG_EUNREACH or RG_ETRAVEL (message
+     * names the reason; s->diag has the bits; s->pose is the best attempt). */
+    int (*solve)(const rg_geometry *g, const rg_target *t, const rg_solve_opts *opts,
+                 rg_solution *s, char *err, size_t errcap);
+    /* Forward model of a pose (exact: offsets, finite mirrors, the placed cornea).
+     * RG_OK or RG_EUNREACH (beam misses a mirror or the cornea: b->diag). */
+    int (*forward)(const rg_geometry *g, const rg_pose *p, rg_beam *b,
+                   char *err, size_t errcap);
+    /* Normal of a gimbal at angles (a, b), and the angles for a normal (the solution
+     * nearer the zero pose).  gimbal_angles: RG_OK or RG_EUNREACH. */
+    void (*gimbal_normal)(const rg_gimbal *m, double a, double b, double n[3]);
+    int (*gimbal_angles)(const rg_gimbal *m, const double n[3], double *a, double *b);
+    /* Jacobian of the spot (2 tangent coordinates on the cornea at the spot, 2 on the
+     * detector plane, mm) with respect to the joints (rad, mm), row-major 4 x 6, and
+     * the condition number of the map after scaling each joint by one step
+     * (column-equilibrated when a joint is continuous).  RG_OK or RG_EUNREACH. */
+    int (*jacobian)(const rg_geometry *g, const rg_pose *p, double J[4 * RG_NJOINTS],
+                    double *cond, char *err, size_t errcap);
+    /* Quantise a solution to the joints' steps (stage first, angles re-solved for
+     * the quantised centre, then angles) and measure its landing errors. */
+    int (*quantise)(const rg_geometry *g, const rg_target *t, const rg_solution *s,
+                    rg_quantised *q, char *err, size_t errcap);
+    /* Independent check through the trace engine: mirrors as TRACE_MIRROR planes, the
+     * cornea as a TRACE_AXIAL surface with Fresnel reflection (a biconic: its
+     * tangent plane where the forward model's beam meets it), a detector disc at
+     * the detector point.
+     * target: the point the beam should hit (a solution's target).  RG_OK (v
+     * filled; v->hit 0 when the traced beam never reached the detector) or RG_EIO
+     * (the trace engine failed: message). */
+    int (*verify)(const struct trace_api *tr, const rg_geometry *g, const rg_pose *p,
+                  const double target[3], rg_verify *v, char *err, size_t errcap);
+    /* One line naming each RG_D_* bit set in diag ("m2 blocks the detector ray; ..."),
+     * written to buf; returns buf. */
+    const char *(*diag_text)(unsigned diag, char *buf, size_t cap);
     /* ---- the machine ---- */
     /* (machine entry points, in this block) */
 } rig_api;

@@ -1,0 +1,9 @@
+#!/bin/sh
+# bench_rig.sh -- the cornea rig's geometry figures (tests/rig/bench_geom.c): exactness
+# of the traced solutions, quantised landing error of the example rig, the table of
+# landing error against steps per degree / per mm, and points planned per second
+# (one thread).  BENCH_QUICK=1: fewer repetitions of the speed runs.
+B=build/obj/rig_tests/bench_geom
+[ -x "$B" ] || { echo "bench_rig: $B not built (make bench builds it)" >&2; exit 1; }
+echo "# bench_rig on: $(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //'), $(nproc) cores"
+if [ -n "$BENCH_QUICK" ]; then exec "$B" quick; else exec "$B"; fi
