@@ -140,7 +140,7 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     }
     double k_rej = o->reject_k > 0 ? o->reject_k : 5;
     int rounds = o->reject_rounds == 0 ? 3 : o->reject_rounds < 0 ? 0 : o->reject_rounds;
-    int max_iter = o->max_iter > 0 ? o->max_iter : 100;
+    int max_iter = o->max_iter > 0 ? o->max_iter : 1000;
     int rc = 0, iters = 0;
     for (int round = 0;; round++) {
         c.n = 0;
@@ -214,6 +214,28 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     res->cond = a.cond;
     res->undetermined = a.undetermined;
     memcpy(res->why, a.why, sizeof res->why);
+    /* chi^2 test: a fit far above its noise is a local minimum, the wrong model or
+     * a sigma too small; what its weakest direction mixes is then not trustworthy */
+    int dof = M - c.nf;
+    res->chi2_z = dof > 0 ? (chi2 - dof) / sqrt(2.0 * dof) : 0;
+    if (res->chi2_z > 4) {
+        res->poor = 1;
+        const double *v = &res->vt[(c.nf - 1) * c.nf];
+        size_t l = strlen(res->why);
+        if (l + 200 > sizeof res->why) l = sizeof res->why - 200;   /* room for this */
+        l += snprintf(res->why + l, sizeof res->why - l,
+                      "POOR FIT: chi2/dof %.3g, %.1f sd above 1 (local minimum, wrong "
+                      "model or sigma too small); not trustworthy:", res->chi2_dof,
+                      res->chi2_z);
+        for (int q = 0; q < c.nf; q++)
+            if (fabs(v[q]) > 0.3 && l + 12 < sizeof res->why) {
+                res->undetermined |= 1u << c.idx[q];
+                res->cov[c.idx[q] * (CN_NPARAM + 1)] = INFINITY;
+                l += snprintf(res->why + l, sizeof res->why - l, " %s",
+                              cn_param_name(c.idx[q]));
+            }
+        if (l + 1 < sizeof res->why) strcat(res->why, "\n");
+    }
     cn_clinical_of(o->model, &p, res->cov, res->undetermined, &res->k);
 out:
     free(use);
@@ -286,7 +308,7 @@ const char *cn_report(const cn_result *r, char *buf, size_t cap)
     OUT("singular values (scaled columns):");
     for (int i = 0; i < r->nfree; i++) OUT(" %.3g", r->sv[i]);
     OUT("   condition %.3g\n", r->cond);
-    if (r->undetermined) OUT("%s", r->why);
+    if (r->undetermined || r->poor) OUT("%s", r->why);
 #undef OUT
     return buf;
 }

@@ -101,12 +101,15 @@ typedef struct cn_result {
     int idx[CN_NPARAM];            /* free parameter of each column */
     double sv[CN_NPARAM];          /* singular values, largest first */
     double vt[CN_NPARAM * CN_NPARAM];   /* right singular vectors, row k: direction of
-                                           sv[k] over the free columns, in parameter
-                                           units (normalised) */
+                                           sv[k] over the free columns (row length
+                                           nfree), in column-scaled units */
     double cond;                   /* sv[0] / sv[nfree-1] */
     unsigned undetermined;         /* bit CN_*: parameter not determined (a singular
                                       direction below rcond, or sd over its limit) */
     char why[512];                 /* one line per undetermined parameter / direction */
+    int poor;                      /* 1: chi^2 more than 4 sd above its dof (the
+                                      weakest direction's parameters then marked) */
+    double chi2_z;                 /* (chi^2 - dof) / sqrt(2 dof) */
     cn_clinical k;
 } cn_result;
 

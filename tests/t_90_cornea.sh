@@ -1,0 +1,9 @@
+# t_90_cornea.sh -- the cornea analysis engine (src/cornea/): the fit against synthetic
+# truth from the rig geometry's forward model (t_fit), the stiff and degenerate scans
+# (t_stiff); normal and sanitizer builds.
+for b in t_fit t_stiff; do
+    unit "$TOP/build/obj/cornea_tests/$b"
+    unit "$TOP/build/asan/cornea_tests/$b"
+done
+check "lensmat-cornea.so exports cornea_get_api alone" sh -c \
+    "test \"\$(nm -D --defined-only '$TOP/build/lib/lensmat-cornea.so' | grep ' T ' | awk '{print \$3}')\" = cornea_get_api"
