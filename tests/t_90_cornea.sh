@@ -1,7 +1,8 @@
 # t_90_cornea.sh -- the cornea analysis engine (src/cornea/): the fit against synthetic
 # truth from the rig geometry's forward model (t_fit), the stiff and degenerate scans
-# (t_stiff); normal and sanitizer builds.
-for b in t_fit t_stiff; do
+# (t_stiff), the final parameters traced through the trace engine (t_trace); normal
+# and sanitizer builds.
+for b in t_fit t_stiff t_trace; do
     unit "$TOP/build/obj/cornea_tests/$b"
     unit "$TOP/build/asan/cornea_tests/$b"
 done

@@ -10,6 +10,7 @@ static const cornea_api api = {
     .plane = cn_plane_of,
     .params_from_cornea = cn_params_from_cornea,
     .forward = cn_forward,
+    .cornea_from_params = cn_cornea_from_params,
     .ray_of_pose = cn_ray_of_pose,
     .simulate = cn_simulate,
     .fit = cn_fit,

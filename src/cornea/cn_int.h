@@ -18,6 +18,8 @@ int cn_forward(int model, const cn_params *p, const double apex0[3], const cn_pl
                const cn_ray *r, double *u, double *v, double spot[3], double normal[3]);
 void cn_params_from_cornea(const rg_cornea *c, const double apex0[3], double rx,
                            double ry, cn_params *p);
+void cn_cornea_from_params(const rig_api *rg, int model, const cn_params *p,
+                           const double apex0[3], rg_cornea *c);
 int cn_ray_of_pose(const rig_api *rg, const rg_geometry *g, const rg_pose *pose,
                    cn_ray *r, char *err, size_t errcap);
 int cn_simulate(const rig_api *rg, const rg_geometry *g, const rg_cornea *truth,

@@ -172,3 +172,20 @@ int cn_ray_of_pose(const rig_api *rg, const rg_geometry *g, const rg_pose *pose,
     unit3(r->d);
     return CN_OK;
 }
+
+void cn_cornea_from_params(const rig_api *rg, int model, const cn_params *p,
+                           const double apex0[3], rg_cornea *c)
+{
+    cn_surf s;
+    cn_surface(model, p, &s);
+    memset(c, 0, sizeof *c);
+    c->model = model == CN_SPHERE ? RG_SPHERE : model == CN_CONIC ? RG_CONIC : RG_BICONIC;
+    c->R = 1 / s.cf;
+    c->Q = s.qf;
+    c->R2 = 1 / s.cs;
+    c->Q2 = s.qs;
+    c->axis = s.alpha;
+    double at[3];
+    for (int i = 0; i < 3; i++) at[i] = apex0[i] + p->p[CN_DX + i];
+    rg->eye_pose(c, p->p[CN_TX], p->p[CN_TY], 0, at);
+}

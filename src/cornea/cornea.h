@@ -145,6 +145,9 @@ typedef struct cornea_api {
      * relative to nominal apex `apex0`; and back (biconic or conic). */
     void (*params_from_cornea)(const rg_cornea *c, const double apex0[3], double rx,
                                double ry, cn_params *p);
+    /* And back: the rg_cornea (zone 0) of parameters, for the rig and the tracer. */
+    void (*cornea_from_params)(const rig_api *rg, int model, const cn_params *p,
+                               const double apex0[3], rg_cornea *c);
     /* The analytic forward model: the ray off the cornea of p onto the plane.
      * 0 (u, v filled; spot/normal optional) or CN_EFIT (misses the cornea). */
     int (*forward)(int model, const cn_params *p, const double apex0[3],

@@ -28,18 +28,18 @@ build/asan/lib/lensmat-cornea.so: $(CN_SOBJ)
 	@mkdir -p $(@D)
 	$(CC) -shared $(SAN) -o $@ $(CN_SOBJ) $(CN_LIBS)
 
-build/obj/cornea_tests/%: tests/cornea/%.c build/lib/lensmat-cornea.so \
+build/obj/cornea_tests/%: tests/cornea/%.c build/lib/lensmat-cornea.so build/lib/lensmat-trace.so \
                           build/lib/lensmat-rig.so src/cornea/cornea.h src/rig/rig.h \
                           $(wildcard tests/cornea/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(OPT) -Itests -o $@ $< build/lib/lensmat-cornea.so \
-	    build/lib/lensmat-rig.so -Wl,-rpath,$(abspath build/lib) -lm
-build/asan/cornea_tests/%: tests/cornea/%.c build/asan/lib/lensmat-cornea.so \
+	    build/lib/lensmat-rig.so build/lib/lensmat-trace.so -Wl,-rpath,$(abspath build/lib) -lm
+build/asan/cornea_tests/%: tests/cornea/%.c build/asan/lib/lensmat-cornea.so build/asan/lib/lensmat-trace.so \
                            build/asan/lib/lensmat-rig.so src/cornea/cornea.h \
                            src/rig/rig.h $(wildcard tests/cornea/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(SAN) -Itests -o $@ $< build/asan/lib/lensmat-cornea.so \
-	    build/asan/lib/lensmat-rig.so -Wl,-rpath,$(abspath build/asan/lib) -lm
+	    build/asan/lib/lensmat-rig.so build/asan/lib/lensmat-trace.so -Wl,-rpath,$(abspath build/asan/lib) -lm
 
 all: build/lib/lensmat-cornea.so
 MODULE_TEST_BINS  += build/lib/lensmat-cornea.so build/asan/lib/lensmat-cornea.so $(CN_TBIN)

@@ -86,6 +86,27 @@ int main(int argc, char **argv)
             plan1000 = tp / nseeds;
         }
     }
+    /* the accuracy the rig can have, asked before building: N = 1000 at the truth */
+    {
+        cn_scan_opts so = {.npoints = 1000, .theta_max = 12 * CT_DEG, .quantise = 1};
+        char err[256];
+        cn_predict pr;
+        int n = cn->simulate(rg, &g, &eye, &so, sp, 10000, err, sizeof err);
+        if (n > 0 && !cn->predict(&g, sp, n, CN_BICONIC, 0, &t, CT_SIGMA, &pr, err, sizeof err)) {
+            printf("# predicted (1000 points, sigma %.2f um): singular values", CT_SIGMA * 1e3);
+            for (int k = 0; k < pr.nfree; k++) printf(" %.3g", pr.sv[k]);
+            printf(", condition %.3g\n# predicted sd:", pr.cond);
+            for (int k = 0; k < CN_NPARAM; k++) printf(" %s %.3g", cn->param_name(k), pr.sd[k]);
+            printf("\n# predicted sd: R %.3f um, mean K %.4f D, cylinder %.4f D, axis %.4f deg\n",
+                   pr.k.sd_R * 1e3, pr.k.sd_Km, pr.k.sd_cyl, pr.k.sd_axis);
+            printf("# weakest direction:");
+            for (int c = 0; c < pr.nfree; c++)
+                if (fabs(pr.vt[(pr.nfree - 1) * pr.nfree + c]) > 0.1)
+                    printf(" %+.2f %s", pr.vt[(pr.nfree - 1) * pr.nfree + c],
+                           cn->param_name(pr.idx[c]));
+            printf("\n");
+        }
+    }
     printf("# result hash (N 1000, seed 1000): %016llx\n", (unsigned long long)hash);
     printf("BENCH cornea_radius_err_um %.3f um\n", fig_r * 1e3);
     printf("BENCH cornea_radius_flat_steep_err_um %.3f um\n", fig_rf * 1e3);
