@@ -296,12 +296,16 @@ const char *cn_report(const cn_result *r, char *buf, size_t cap)
         OUT("R flat %.5f +- %.5f mm (Q %.4f +- %.4f)   R steep %.5f +- %.5f mm "
             "(Q %.4f +- %.4f)\n", k->R_flat, k->sd_R_flat, k->Q_flat, k->sd_Q_flat,
             k->R_steep, k->sd_R_steep, k->Q_steep, k->sd_Q_steep);
-    OUT("Sim K (n 1.3375): K1 %.3f +- %.3f D @ %.1f   K2 %.3f +- %.3f D @ %.1f   "
-        "axis +- %.2f deg\n", k->K1, k->sd_K1, k->K1_axis, k->K2, k->sd_K2, k->K2_axis,
-        k->sd_axis);
-    OUT("mean K %.3f +- %.3f D   cylinder %.3f +- %.3f D @ %.1f   corneal power "
-        "(n 1.376) %.3f +- %.3f D\n", k->Km, k->sd_Km, k->cyl, k->sd_cyl, k->K2_axis,
-        k->P, k->sd_P);
+    if (r->model == CN_BICONIC) {
+        OUT("Sim K (n 1.3375): K1 %.3f +- %.3f D @ %.1f   K2 %.3f +- %.3f D @ %.1f   "
+            "axis +- %.2f deg\n", k->K1, k->sd_K1, k->K1_axis, k->K2, k->sd_K2,
+            k->K2_axis, k->sd_axis);
+        OUT("mean K %.3f +- %.3f D   cylinder %.3f +- %.3f D @ %.1f   corneal power "
+            "(n 1.376) %.3f +- %.3f D\n", k->Km, k->sd_Km, k->cyl, k->sd_cyl, k->K2_axis,
+            k->P, k->sd_P);
+    } else
+        OUT("K (n 1.3375) %.3f +- %.3f D (no cylinder in this model)   corneal power "
+            "(n 1.376) %.3f +- %.3f D\n", k->Km, k->sd_Km, k->P, k->sd_P);
     OUT("eye: apex shift %.4f %.4f %.4f mm (+- %.4f %.4f %.4f), tilt %.3f %.3f deg "
         "(+- %.3f %.3f)\n", k->dx, k->dy, k->dz, k->sd_dx, k->sd_dy, k->sd_dz, k->tx,
         k->ty, k->sd_tx, k->sd_ty);
