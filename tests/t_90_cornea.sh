@@ -34,3 +34,17 @@ for bin in "$TOP/lensmat" "$TOP/build/asan/lensmat"; do
     elif grep -q 'scan points' "$WORK/cs.err"; then pass "--cornea-scan refuses 5 points: $(head -1 "$WORK/cs.err")"
     else fail "--cornea-scan: no message for 5 points"; cat "$WORK/cs.err"; fi
 done
+# SIGINT during a 10 000-point fit: the fit polls the stop flag, lensmat exits 130
+cs_stop() {
+    printf 'biconic\n10000\n12\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n' \
+        > "$WORK/cs4.in"
+    (cd "$WORK" && exec "$TOP/lensmat" --cornea-scan cs4.rec < cs4.in > cs4.out 2> cs4.err) &
+    p=$!
+    sleep 0.4
+    kill -INT "$p"
+    wait "$p"
+    rc=$?
+    [ "$rc" -eq 130 ] || { echo "exit $rc"; cat "$WORK/cs4.err"; return 1; }
+    ! grep -q '^Errors:' "$WORK/cs4.out"
+}
+check "--cornea-scan stops on SIGINT mid-fit (exit 130, no report)" cs_stop
