@@ -283,3 +283,181 @@ if [ -x "$TOP/build/fuzz_trace_scene" ]; then
 else
     fail "build/fuzz_trace_scene not built"
 fi
+
+# ---- wrong lenses refused at their question (issue 8) --------------------------------
+# lens_refused ANSWERS MESSAGE: a replay stops with MESSAGE (exit 2) and the refused
+# answer is not recorded (the last answer given is the refused one).
+lens_refused() {
+    d=$TW/refuse; rm -rf "$d"; mkdir -p "$d"
+    printf "$1" > "$d/in"
+    (cd "$d" && "$BIN" --trace -i in r.rec > out 2> err); rc=$?
+    [ "$rc" -eq 2 ] || { echo "exit $rc"; cat "$d/err"; return 1; }
+    grep -qF "$2" "$d/err" || { echo "want: $2"; cat "$d/err"; return 1; }
+    n=$(grep -c '^input: ' "$d/r.rec"); want=$(($(printf "$1" | wc -l) - 1))
+    [ "$n" -eq "$want" ] || { echo "$n answers recorded, want $want"; return 1; }
+}
+check "lens: both surfaces at z = 0 refused at the location" lens_refused \
+    'lens\n1\n50\n0\n1.5\n12\ny\n-50\n0\n' \
+    "in:9: the location of the lens surface: '0': surface 2 would touch surface 1 on the axis and cross it (edge thickness -2.92271 at height 12)"
+check "lens: crossing surfaces refused at the semi-diameter" lens_refused \
+    'lens\n1\n50\n0\n1.5\n12\ny\n-50\n1\n1\n12\n' \
+    "in:11: the semi-diameter of the lens surface: '12': surfaces 1 and 2 would cross at height 7.05337 (edge thickness -1.92271 at the semi-diameter 12): give at most 7.05337"
+check "lens: a semi-diameter beyond |radius| refused at its question" lens_refused \
+    'lens\n1\n50\n0\n1.5\n60\n' \
+    "in:6: the semi-diameter of the lens surface: '60' is larger than 50, the |radius| of this surface"
+check "table: crossing surfaces refused at the semi-diameter" lens_refused \
+    'table\n50\n-50\n1\n1.5\n12\n' \
+    "in:6: the semi-diameter: '12': surfaces 1 and 2 would cross at height 7.05337"
+lens_cross_ok() {   # the same lens with semi-diameter 7 traces
+    d=$TW/crossok; rm -rf "$d"
+    trace_session "$BIN" "$d" lens 1 50 0 1.5 12 y -50 1 1 7 n inf 1 n n || { cat "$d/err"; return 1; }
+    grep -q 'meets the paraxial image' "$d/r.rec"
+}
+check "lens: the crossing lens with a semi-diameter under the crossing traces" lens_cross_ok
+
+# Fraction 1 is the rim of surface 1: from an object at 200 the edge ray is traced and
+# met surface 1 at 12 (the heights were once aimed at the vertex plane: vignetted).
+fan_rim() {
+    grep -A16 '^Object point on the axis at z= -200' "$TW/lens/e.rec" > "$TW/lens/e200"
+    grep -q '^  12  *64\.87' "$TW/lens/e200" || { cat "$TW/lens/e200"; return 1; }
+    ! grep -q vignetted "$TW/lens/e200"
+}
+check "lens fan: fraction 1 reaches the rim of surface 1 from a near object" fan_rim
+
+# ---- stopping: SIGTERM / SIGINT mid-trace (issue 8) ----------------------------------
+# A 4.5 M-ray scene writing hits: the signal is sent once the hits file has grown; the
+# trace must end within 1 s with 128 + N, its outputs only as .part, the record with
+# every answer and the stop said.
+trace_stopped() {
+    python3 - "$1" "$TW/stop$2" "$2" <<'PYEOF'
+import os, signal, subprocess, sys, time
+bin_, d, sig = sys.argv[1], sys.argv[2], int(sys.argv[3])
+os.makedirs(d, exist_ok=True)
+for f in os.listdir(d): os.remove(os.path.join(d, f))
+open(os.path.join(d, "big.scene"), "w").write(
+    "cap refract 1 1.5 vertex 0 0 0 radius 50 aperture 12\n"
+    "cap refract 1.5 1 vertex 0 0 8 radius -50 aperture 12\n"
+    "plane detect at 0 0 55 normal 0 0 1 disc 30\n"
+    "source collimated from 0 0 -10 dir 0 0 1 radius 10 grid 2400\n"
+    "output hits h.csv\noutput summary s.sum\n")
+open(os.path.join(d, "in"), "w").write("scene\nbig.scene\nn\n")
+p = subprocess.Popen([bin_, "--trace", "-i", "in", "r.rec"], cwd=d,
+                     stdout=subprocess.DEVNULL, stderr=open(os.path.join(d, "err"), "w"))
+part = os.path.join(d, "h.csv.part")
+t_end = time.time() + 60
+while time.time() < t_end and p.poll() is None:
+    if os.path.exists(part) and os.path.getsize(part) > 200000: break
+    time.sleep(0.01)
+fails = []
+if p.poll() is not None: fails.append("the trace ended before the signal (exit %d)" % p.returncode)
+t0 = time.time()
+p.send_signal(sig)
+try: rc = p.wait(timeout=30)
+except subprocess.TimeoutExpired: p.kill(); rc = p.wait(); fails.append("did not stop in 30 s")
+dt = time.time() - t0
+if dt > 1.0: fails.append("stopped %.2f s after the signal" % dt)
+if rc != 128 + sig: fails.append("exit %d, want %d" % (rc, 128 + sig))
+names = sorted(os.listdir(d))
+if "h.csv" in names or "s.sum" in names: fails.append("an output has its final name: %s" % names)
+if "h.csv.part" not in names: fails.append("no .part left: %s" % names)
+rec = open(os.path.join(d, "r.rec")).read()
+if "input: scene\n" not in rec or "input: big.scene\n" not in rec: fails.append("record lost answers")
+if "the trace stopped: interrupted" not in rec: fails.append("record does not say the trace stopped")
+print("\n".join(fails) or "ok (stopped %.3f s after the signal)" % dt)
+sys.exit(1 if fails else 0)
+PYEOF
+}
+if command -v python3 > /dev/null; then
+    check "stop: SIGTERM mid-trace ends within 1 s, exit 143, outputs .part, record intact" trace_stopped "$BIN" 15
+    check "stop asan: SIGINT mid-trace ends within 1 s, exit 130" trace_stopped "$ASAN" 2
+fi
+
+# ---- caps that cross, media that disagree, outputs over inputs (issue 8) -------------
+CAP1='cap refract 1 1.5168 vertex 0 0 0 radius 50 aperture 12'
+mk crosscap.scene "$CAP1" 'cap refract 1.5168 1 vertex 0 0 1 radius -50 aperture 12' "$DET" "$SRC"
+mk touchcap.scene 'cap refract 1.5168 1 vertex 0 0 0 axis 0 0 -1 radius 50 aperture 12' \
+    'cap refract 1 1.5168 vertex 0 0 0 axis 0 0 -1 radius -50 aperture 12' "$DET" "$SRC"
+mk outscene.scene "$DET" "$SRC" 'output hits outscene.scene'
+mk outmesh.scene 'mesh absorb file good.t' "$SRC" 'output segments good.t'
+mk g.n.part '1 1.5' '1 1.5'
+mk outmedia.scene 'mesh media g.n.part file good.t' "$SRC" 'output summary g.n'
+mk outtwice.scene "$DET" "$SRC" 'output hits same.txt' 'output summary same.txt'
+mk outrec.scene "$DET" "$SRC" 'output summary outrec.rec'
+mk outin.scene "$DET" "$SRC" 'output segments outin.in'
+mk mmbad.scene 'mismatch maybe' "$DET" "$SRC"
+check "bad: caps whose sags cross within the apertures" bad_case crosscap \
+    "crosscap.scene:1: and crosscap.scene:2: the surfaces cross at height 7.05337 from their axis (edge thickness -1.92271 at 12): negative edge thickness"
+check "bad: caps on a reversed axis touching at the vertex and crossing" bad_case touchcap \
+    "touchcap.scene:1: and touchcap.scene:2: the surfaces cross at height 0 from their axis"
+check "bad: an output over the scene file" bad_case outscene \
+    "outscene.scene: output hits outscene.scene would overwrite the scene file outscene.scene"
+check "bad: an output over a mesh file" bad_case outmesh \
+    "output segments good.t would overwrite the mesh file good.t"
+check "bad: an output's .part over a media file" bad_case outmedia \
+    "output summary g.n would overwrite the media file g.n.part"
+check "bad: two outputs in one file" bad_case outtwice \
+    "output summary same.txt would overwrite output same.txt"
+check "bad: an output over the record" bad_case outrec "outrec.scene: output outrec.rec: "
+check "bad: an output over the answers" bad_case outin "outin.scene: output outin.in: "
+check "bad: mismatch takes warn or error" bad_case mmbad "mmbad.scene:1: mismatch: expected warn or error"
+good_t_intact() { [ "$(wc -l < "$TW/bad/good.t")" -eq 6 ] && [ ! -e "$TW/bad/good.t.part" ]; }
+check "bad: the refused outputs left the inputs as they were" good_t_intact
+
+# A cap declared 'refract 1.6 1' after '1 1.5168': said after the trace with the
+# surfaces' lines and the count; 'mismatch error' makes it an error (outputs .part).
+MM2='cap refract 1.6 1 vertex 0 0 8 radius -50 aperture 12'
+MMDET='plane detect at 0 0 55 normal 0 0 1 disc 30'
+MMSRC='source collimated from 0 0 -10 dir 0 0 1 radius 10 grid 21'
+mismatch_warn() {
+    d=$TW/mm; rm -rf "$d"; mkdir -p "$d"
+    printf '%s\n' "$CAP1" "$MM2" "$MMDET" "$MMSRC" > "$d/mm.scene"
+    trace_session "$BIN" "$d" scene mm.scene n || { cat "$d/err"; return 1; }
+    grep -q '^Warning: [1-9][0-9]* rays met a surface whose index' "$d/r.rec" &&
+    grep -q "the first: mm.scene:1: gives 1.5168 after it, mm.scene:2: expects 1.6 before it" "$d/r.rec" &&
+    grep -q 'mismatch error' "$d/out" || { cat "$d/out"; return 1; }
+}
+check "mismatch: media that disagree are said on screen with file:line and the count" mismatch_warn
+mismatch_error() {
+    d=$TW/mm; printf '%s\n' 'mismatch error' 'output hits h.csv' >> "$d/mm.scene"
+    (cd "$d" && printf 'scene\nmm.scene\nn\n' | "$BIN" --trace e.rec > e.out 2> e.err); rc=$?
+    [ "$rc" -eq 2 ] && [ ! -e "$d/h.csv" ] && [ -e "$d/h.csv.part" ] &&
+    grep -q "rays met a surface .*first mm.scene:1: .*(the scene says .mismatch error.)" "$d/e.err" ||
+        { echo "exit $rc"; cat "$d/e.err"; return 1; }
+}
+check "mismatch error: the trace fails, outputs left as .part" mismatch_error
+consistent_quiet() {   # the consistent singlet says nothing of media
+    trace_session "$BIN" "$TW/mmok" scene "$SCENES/singlet.scene" n &&
+        ! grep -qi 'media\|mismatch' "$TW/mmok/out"
+}
+check "mismatch: a consistent scene says nothing about media" consistent_quiet
+
+# The tessellation table stops on a signal too (its traces poll the stop flag per
+# batch of 4096 rays): a 1001 x 1001 bundle takes many seconds; SIGTERM after 0.5 s.
+table_stopped() {
+    d=$WORK/tablestop; rm -rf "$d"; mkdir -p "$d"
+    printf 'table\n50\n-50\n8\n1.5168\n12\n1001\nn\n' > "$d/in"
+    python3 - "$1" "$d" <<'PYEOF'
+import os, signal, subprocess, sys, time
+bin_, d = sys.argv[1], sys.argv[2]
+p = subprocess.Popen([bin_, "--trace", "-i", "in", "r.rec"], cwd=d,
+                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+time.sleep(0.5)
+fails = []
+if p.poll() is not None: fails.append("the table ended before the signal (exit %d)" % p.returncode)
+t0 = time.time()
+p.send_signal(signal.SIGTERM)
+try: rc = p.wait(timeout=30)
+except subprocess.TimeoutExpired: p.kill(); rc = p.wait(); fails.append("did not stop in 30 s")
+dt = time.time() - t0
+if dt > 1.0: fails.append("stopped %.2f s after the signal" % dt)
+if rc != 143: fails.append("exit %d, want 143" % rc)
+rec = open(os.path.join(d, "r.rec")).read()
+if "input: 1001\n" not in rec: fails.append("record lost answers")
+print("\n".join(fails) or "ok (%.3f s)" % dt)
+sys.exit(1 if fails else 0)
+PYEOF
+}
+if command -v python3 > /dev/null; then
+    check "stop: SIGTERM during the tessellation table ends within 1 s, exit 143, record intact" \
+        table_stopped "$BIN"
+fi

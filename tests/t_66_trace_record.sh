@@ -40,10 +40,10 @@ near_axis_ok() {
 # are 30 and 100 left of the first surface (z = 0), as the dialogue lists them.
 record_doublet() {
     d=$RW/d; rm -rf "$d"
-    trace_session "$1" "$d" record ../doublet.rec 4 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
+    trace_session "$1" "$d" record ../doublet.rec 2 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
     [ ! -s "$d/err" ] || { cat "$d/err"; return 1; }
     grep -q '^Lens file: 4 surfaces, index left of the first surface 1 $' "$d/r.rec" &&
-    grep -q '^Surface 3: radius -4.5, location 1.2, index right 1.6, semi-diameter 4 $' "$d/r.rec" &&
+    grep -q '^Surface 3: radius -4.5, location 1.2, index right 1.6, semi-diameter 2 $' "$d/r.rec" &&
     grep -q '^Object planes of the file, as distances left of the first surface: 30 100$' "$d/r.rec" ||
         { echo "lens echo"; cat "$d/r.rec"; return 1; }
     same_images "$RW/doublet.rec" "$d/r.rec" && near_axis_ok "$d/r.rec" 2
@@ -68,7 +68,7 @@ check "trace record: thick lens from grep'd answers, images = classic's, virtual
 record_prescription() {
     d=$RW/p; rm -rf "$d"; mkdir -p "$d"
     "$BIN" --to-prescription -i "$RW/doublet.rec" "$d/doublet.lens" || return 1
-    trace_session "$BIN" "$d" record doublet.lens 4 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
+    trace_session "$BIN" "$d" record doublet.lens 2 30 1 y 100 0.5 n n || { cat "$d/err"; return 1; }
     sed -n '/^Lens file:/,$p' "$RW/d/r.rec" > "$d/from-record"
     sed -n '/^Lens file:/,$p' "$d/r.rec" > "$d/from-prescription"
     [ -s "$d/from-record" ] && cmp "$d/from-record" "$d/from-prescription" &&
@@ -76,13 +76,14 @@ record_prescription() {
 }
 check "trace record: the doublet's prescription file traces as its record" record_prescription
 
-# A hand-written prescription with a plane surface: the semi-diameter's limit is the
-# one sphere's radius; the object at infinity.
+# A hand-written prescription with a plane surface: the semi-diameter's limit is
+# where the concave R -20 four units behind the plane meets it (sag -4 at 12), not
+# the sphere's radius; the object at infinity.
 record_plane() {
     d=$RW/pl; rm -rf "$d"; mkdir -p "$d"
     printf 'index 1\nplane 0 1.5\n-20 4 1\nobject -50\n' > "$d/pc.lens"
     trace_session "$BIN" "$d" record pc.lens 10 inf 1 n n || { cat "$d/err"; return 1; }
-    grep -q 'at most 20, the smallest |radius|' "$d/r.rec" &&
+    grep -q 'at most 12: surfaces 1 and 2 cross above that height' "$d/r.rec" &&
         grep -q '^Surface 1: plane, location 0' "$d/r.rec" && near_axis_ok "$d/r.rec" 1
 }
 check "trace record: prescription with a plane surface, object at infinity" record_plane
@@ -120,13 +121,21 @@ check "trace record bad: a missing file" rr_bad nosuch.rec '' "nosuch.rec: canno
 rr_dir() { mkdir -p "$RW/bad/adir" && rr_bad adir '' "adir: not a regular file"; }
 check "trace record bad: a folder" rr_dir
 check "trace record bad: semi-diameter beyond the smallest radius" rr_bad ok.in \
-    '25\n1\n3\n0\n1.5\ny\n-3\n0.5\n1\nn\n-5\nn\n' \
+    '25\n1\n3\n0\n1.5\ny\n-3\n6\n1\nn\n-5\nn\n' \
     "ok.in.in:3: the semi-diameter of the surfaces: '3.5' is larger than 3" '3.5\n'
+# R 3 and -3 half a unit apart cross where 2 sag = 0.5 (s = 1.198957881); both at 0
+# they touch on the axis and cross at any height: that file is refused at once.
+check "trace record bad: semi-diameter where the surfaces cross" rr_bad cross.in \
+    '25\n1\n3\n0\n1.5\ny\n-3\n0.5\n1\nn\n-5\nn\n' \
+    "cross.in.in:3: the semi-diameter of the surfaces: '1.2': surfaces 1 and 2 cross above 1.198957881 (negative edge thickness)" '1.2\n'
+check "trace record bad: surfaces touching on the axis and crossing" rr_bad touch.in \
+    '25\n1\n3\n0\n1.5\ny\n-3\n0\n1\nn\n-5\nn\n' \
+    "touch.in: surfaces 1 and 2 touch on the axis (at z= 0) and cross off it"
 
 # ---- replay: record -> grep input: -> replay -> the same record ---------------------
 replay_record() {
     d=$RW/rep; rm -rf "$d"; mkdir -p "$d"; cp "$RW/doublet.rec" "$RW/thick.in" "$d/" || return 1
-    (cd "$d" && printf 'record\ndoublet.rec\n4.5\n30\n1\nn\ny\nrecord\nthick.in\n3\ninf\n1\nn\nn\n' > in &&
+    (cd "$d" && printf 'record\ndoublet.rec\n2\n30\n1\nn\ny\nrecord\nthick.in\n3\ninf\n1\nn\nn\n' > in &&
         "$1" --trace -i in a.rec > a.out 2> a.err && grep input: a.rec > in2 &&
         "$1" --trace b.rec < in2 > b.out 2> b.err) || { cat "$d/a.err" "$d/b.err"; return 1; }
     [ "$(grep -c '^input: ' "$d/a.rec")" -eq 14 ] || { echo "answers in the record"; return 1; }
@@ -148,13 +157,13 @@ os.makedirs(d, exist_ok=True)
 shutil.copy(rec, os.path.join(d, "doublet.rec"))
 with open(os.path.join(d, "broken.lens"), "w") as f: f.write("3 0 1.5\n-3 x 1\nobject -2\n")
 rc, out = drive([bin_, "--trace", "t.rec"],
-                [b"record\n", b"broken.lens\n", b"doublet.rec\n", b"9\n", b"4\n", b"30\n",
+                [b"record\n", b"broken.lens\n", b"doublet.rec\n", b"9\n", b"2.17\n", b"30\n",
                  b"1\n", b"n\n", b"n\n"], cwd=d, home=d, timeout=60)
 rec = open(os.path.join(d, "t.rec")).read()
 fails = []
 if rc != 0: fails.append("exit %d" % rc)
 if "broken.lens:2: 'x' is not a number; please answer again" not in out: fails.append("no re-ask for the file")
-if "'9' is larger than 4.5" not in out: fails.append("no re-ask for the semi-diameter")
+if "'9': surfaces 1 and 2 cross above 2.179449472" not in out: fails.append("no re-ask for the semi-diameter")
 if "broken" in rec or "input: 9" in rec: fails.append("a refused answer was recorded")
 if "input: doublet.rec" not in rec or "meets the paraxial image" not in rec: fails.append("record")
 print("\n".join(fails) or "ok", out[-800:] if fails else "")

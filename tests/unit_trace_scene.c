@@ -147,7 +147,7 @@ static void triangle_files(void)
     TRI_BAD("0 0 0\n1 0 0\n0 1 0\n5 5 5\n5 5 5\n5 5 5\n", "b.t:4: triangle 2 (lines 4-6) is degenerate");
     TRI_BAD("0 0 0\n1 0 0\n0 1 0\n0 0 1\n", "the file ends inside triangle 2 (1 of its 3");
     TRI_BAD("# nothing\n", "no triangles");
-    TRI_BAD("0 0 0\n1e-300 0 0\n0 1e-300 0\n", "degenerate");
+    TRI_BAD("0 0 0\n1e-300 0 0\n0 1e-300 0\n", "'1e-300' is out of range (0, or 1e-30");
     TRI_BAD("0 0 0\n1 0 0\n0 1e-13 0\n", "zero area");
 
     rc = sc_parse_media("1 1.5\n1.5 1 # glass to air\n", 27, "g.n", 2, &media, err);

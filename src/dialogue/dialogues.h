@@ -9,7 +9,10 @@ const char *lm_classic_usage(void);
 const char *lm_classic_usage_more(void);
 const char *lm_classic_example(void);
 int lm_trace(lm_io *io);
+int lm_draw(lm_io *io);        const char *lm_draw_example(void);
 const char *lm_trace_example(void);
+int lm_rig(lm_io *io);
+const char *lm_rig_example(void);
 
 /* The calculation dialogues (lenscalc.c, instrcalc.c, fitcalc.c) and prescription
  * files (prescription.c); each has its embedded example. */
@@ -26,6 +29,7 @@ int lm_cornea_scan(lm_io *io); const char *lm_cornea_scan_example(void);
 int lm_fit(lm_io *io);         const char *lm_fit_example(void);
 int lm_prescription(lm_io *io);    const char *lm_prescription_example(void);
 int lm_to_prescription(lm_io *io); const char *lm_to_prescription_example(void);
+int lm_spot(lm_io *io);        const char *lm_spot_example(void);   /* spot.c: --spot */
 
 /* A lens read from a file (prescription.c): a classic record, its grep'd or plain
  * answers, or a prescription file.  lm_read_lens: LM_GO, or LM_FAIL with

@@ -10,6 +10,7 @@
 #include <string.h>
 #include "ask.h"
 #include "dialogues.h"
+#include "draw.h"
 #include "engine.h"
 #include "../paraxial/paraxial.h"
 #include "../trace/scene.h"
@@ -65,6 +66,21 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
         return -1;
     }
     t->have_scene = 1;
+    /* its outputs (and the .part files written first) must not be the answers or
+     * the record (the scene's own inputs the loader checked) */
+    const char *out[3] = {t->scene.out_segments, t->scene.out_hits, t->scene.out_summary};
+    for (int i = 0; i < 3; i++) {
+        char part[WORD + 8], why[512];
+        if (!out[i]) continue;
+        snprintf(part, sizeof part, "%s.part", out[i]);
+        if (lm_check_output(t->io, out[i], why, sizeof why) ||
+            lm_check_output(t->io, part, why, sizeof why)) {
+            snprintf(msg, cap, "%s: output %s: %s", word, out[i], why);
+            t->api->free(&t->scene);
+            t->have_scene = 0;
+            return -1;
+        }
+    }
     return 0;
 }
 
@@ -88,11 +104,25 @@ static void report_summary(tdlg *t, const trace_summary *s)
     lm_say(io, LM_BOTH, P(CUTS), (ull)s->cut_depth, (ull)s->cut_power,
            (ull)s->cut_reflection);
     if (s->failures) lm_say(io, LM_BOTH, P(WARN_FAILURES), (ull)s->failures);
-    if (s->medium_mismatch) lm_say(io, LM_BOTH, P(WARN_MISMATCH), (ull)s->medium_mismatch);
+    if (s->medium_mismatch) {
+        lm_say(io, LM_BOTH, P(WARN_MISMATCH), (ull)s->medium_mismatch);
+        if (t->scene.nmismatch)
+            lm_say(io, LM_BOTH, P(MISMATCH_WHERE), t->scene.nmismatch,
+                   t->scene.mismatch_where);
+        else lm_say(io, LM_BOTH, "%s", P(MISMATCH_UNLOCATED));
+        lm_say(io, LM_BOTH, "%s", P(MISMATCH_ERROR));
+    }
     if (fabs(bal) > 1e-9 * (s->emitted > 1 ? s->emitted : 1))
         lm_say(io, LM_BOTH, P(WARN_BALANCE), bal);
     lm_say(io, LM_OUT, P(TIMING_OUT), s->build_ms, s->trace_ms,
            s->trace_ms > 0 ? (double)s->rays / (s->trace_ms / 1e3) : 0.0);
+}
+
+/* The stop callback long traces poll: a signal arrived (ask.h). */
+static int stop_requested(void *ctx)
+{
+    (void)ctx;
+    return lm_stop_requested() != 0;
 }
 
 /* Returns LM_GO, LM_QUIT or LM_FAIL (a trace that fails is an error in a replay). */
@@ -109,10 +139,13 @@ static int do_scene(tdlg *t)
         return rc;
     lm_say(t->io, LM_BOTH, P(SCENE_LOADED), sc->name, sc->nsurf, sc->nsource, sc->depth,
            sc->cutoff);
+    t->scene.stop = stop_requested;
+    t->scene.stop_ctx = NULL;
     rc = t->api->run(sc, &res, err);
     if (rc) {
         lm_say(t->io, LM_REC, P(TRACE_FAILED_OUT), err);
         fprintf(stderr, "lensmat: %s\n", err);
+        if (res.stopped) return LM_FAIL;     /* main exits with 128 + the signal */
         if (!t->io->interactive) return LM_FAIL;
         return LM_GO;
     }
@@ -143,17 +176,85 @@ static void add_surface(tdlg *t, lens *l, const trace_lens_surface *s)
     px_system_refract(&l->sys, s->radius, s->n_right);
 }
 
+/* A number answer whose check needs the other answers, asked as a word so that a bad
+ * one is refused before it is echoed.  0 with *v, or -1 with why in msg. */
+static int word_number(const char *word, double *v, char *msg, size_t cap)
+{
+    enum lm_num_status st = lm_parse_number(word, v);
+    if (st == LM_NUM_OK) return 0;
+    snprintf(msg, cap, "'%s': %s", word, lm_num_status_text(st));
+    return -1;
+}
+
+/* The surface being entered, for the checks of its location and semi-diameter. */
+typedef struct entering {
+    const lens *l;
+    trace_lens_surface s;       /* the answers so far */
+} entering;
+
+/* The location: not left of the previous surface, and not touching it on the axis
+ * with its sag left of the previous one's (no semi-diameter could help then). */
+static int check_location(void *ctx, const char *word, char *msg, size_t cap)
+{
+    entering *e = ctx;
+    int n = e->l->tl.nsurf;
+    double v, h, rim, edge;
+    if (word_number(word, &v, msg, cap)) return -1;
+    if (!n) return 0;
+    const trace_lens_surface *a = &e->l->surf[n - 1];
+    if (v < a->z) {
+        snprintf(msg, cap, P(LOCATION_LEFT), word, a->z);
+        return -1;
+    }
+    trace_lens_surface b = {e->s.radius, v, 1, a->semi_diameter};
+    if (trace_lens_cross(a, &b, &h, &rim, &edge) && h == 0) {
+        snprintf(msg, cap, P(LOCATION_TOUCH), word, n + 1, n, edge, rim);
+        return -1;
+    }
+    return 0;
+}
+
+/* The semi-diameter: > 0, at most |radius| (a sphere ends there), and the surface must
+ * not cross the previous one within the two semi-diameters. */
+static int check_surface_semi(void *ctx, const char *word, char *msg, size_t cap)
+{
+    entering *e = ctx;
+    int n = e->l->tl.nsurf;
+    double v, h, rim, edge;
+    if (word_number(word, &v, msg, cap)) return -1;
+    if (!(v > 0)) {
+        snprintf(msg, cap, P(SEMI_ALL_BAD), word);
+        return -1;
+    }
+    if (isfinite(e->s.radius) && v > fabs(e->s.radius)) {
+        snprintf(msg, cap, P(SEMI_BIG), word, fabs(e->s.radius));
+        return -1;
+    }
+    trace_lens_surface b = e->s;
+    b.semi_diameter = v;
+    if (n && trace_lens_cross(&e->l->surf[n - 1], &b, &h, &rim, &edge)) {
+        snprintf(msg, cap, P(SEMI_CROSS), word, n, n + 1, h, edge, rim, h);
+        return -1;
+    }
+    return 0;
+}
+
 static int enter_surface(tdlg *t, lens *l)
 {
-    trace_lens_surface s;
+    entering e = {l, {0, 0, 0, 0}};
+    char word[64];
     int rc;
-    if ((rc = ask_num(t, P(RADIUS), P(RADIUS_WHAT), LM_ALLOW_PLANE, 0, &s.radius)) ||
-        (rc = ask_num(t, P(LOCATION), P(LOCATION_WHAT), l->tl.nsurf ? LM_AT_LEAST : 0,
-                      l->sys.z_last, &s.z)) ||
-        (rc = ask_num(t, P(INDEX_RIGHT), P(INDEX_RIGHT_WHAT), LM_POSITIVE, 0, &s.n_right)) ||
-        (rc = ask_num(t, P(SEMI), P(SEMI_WHAT), LM_POSITIVE, 0, &s.semi_diameter)))
+    if ((rc = ask_num(t, P(RADIUS), P(RADIUS_WHAT), LM_ALLOW_PLANE, 0, &e.s.radius)) ||
+        (rc = lm_ask_word(t->io, P(LOCATION), P(LOCATION), P(LOCATION_WHAT),
+                          check_location, &e, word, sizeof word)))
         return rc;
-    add_surface(t, l, &s);
+    lm_parse_number(word, &e.s.z);
+    if ((rc = ask_num(t, P(INDEX_RIGHT), P(INDEX_RIGHT_WHAT), LM_POSITIVE, 0, &e.s.n_right)) ||
+        (rc = lm_ask_word(t->io, P(SEMI), P(SEMI), P(SEMI_WHAT), check_surface_semi, &e,
+                          word, sizeof word)))
+        return rc;
+    lm_parse_number(word, &e.s.semi_diameter);
+    add_surface(t, l, &e.s);
     return LM_GO;
 }
 
@@ -194,12 +295,12 @@ static void report_fan(tdlg *t, const double *h, const trace_fan_ray *r, int n, 
         const char *why = r[i].status == 1 ? P(FAN_VIGNETTED) : r[i].status == 2 ? P(FAN_TIR)
                         : P(FAN_PARALLEL);
         if (r[i].status) lm_say(io, LM_BOTH, P(FAN_MISS), h[i], why);
-        else lm_say(io, LM_BOTH, P(FAN_ROW), h[i], r[i].z_cross, lm_clean(io, r[i].lsa),
+        else lm_say(io, LM_BOTH, P(FAN_ROW), r[i].h, r[i].z_cross, lm_clean(io, r[i].lsa),
                     lm_clean(io, r[i].y_image));
     }
     if (!r[0].status) {
         double scale = fabs(z_img - l->sys.z_last);
-        lm_say(io, LM_BOTH, P(FAN_AGREE), h[0], fabs(r[0].lsa) / (scale > 0 ? scale : 1));
+        lm_say(io, LM_BOTH, P(FAN_AGREE), r[0].h, fabs(r[0].lsa) / (scale > 0 ? scale : 1));
     }
 }
 
@@ -240,6 +341,7 @@ static int trace_object(tdlg *t, lens *l)
         return io->interactive ? LM_GO : LM_FAIL;
     }
     report_fan(t, h, out, FAN + 1, z_img, l);
+    lm_draw_remember(&l->tl, z_obj, frac);   /* for the "draw" choice */
     return LM_GO;
 }
 
@@ -284,12 +386,37 @@ out:
     return rc;
 }
 
+/* The largest semi-diameter lf's surfaces can share: *max (inf: planes only) is the
+ * smallest |radius| (a sphere ends there), or lower where two consecutive surfaces
+ * would cross (*cross: the first of them, 1-based; 0 if none).  -1 if two surfaces
+ * cross on the axis, where no semi-diameter helps (*cross says which). */
+static int lens_file_limit(const lm_lens_file *lf, double *max, int *cross)
+{
+    double h, rim, edge;
+    *max = INFINITY;
+    *cross = 0;
+    for (int i = 0; i < lf->nsurf; i++)
+        if (isfinite(lf->surf[i].radius)) *max = fmin(*max, fabs(lf->surf[i].radius));
+    if (isinf(*max)) return 0;
+    for (int i = 1; i < lf->nsurf; i++) {
+        trace_lens_surface a = {lf->surf[i - 1].radius, lf->surf[i - 1].z, 1, *max};
+        trace_lens_surface b = {lf->surf[i].radius, lf->surf[i].z, 1, *max};
+        if (!trace_lens_cross(&a, &b, &h, &rim, &edge)) continue;
+        *cross = i;
+        if (h == 0) return -1;
+        *max = h;
+    }
+    return 0;
+}
+
 /* The record question's check: the file must read as a lens (a classic record, its
  * answers, or a prescription; messages with file and line) of at most MAXSURF
- * surfaces. */
+ * surfaces, none touching the next on the axis and crossing it. */
 static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
 {
     lm_lens_file *lf = ctx;
+    double max;
+    int cross;
     lm_lens_file_free(lf);
     if (lm_read_lens(word, lf, msg, cap)) return -1;
     if (lf->nsurf > MAXSURF) {
@@ -297,36 +424,50 @@ static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
         lm_lens_file_free(lf);
         return -1;
     }
+    if (lens_file_limit(lf, &max, &cross)) {
+        snprintf(msg, cap, P(RECORD_TOUCH), word, cross, cross + 1, lf->surf[cross].z);
+        lm_lens_file_free(lf);
+        return -1;
+    }
     return 0;
 }
 
-/* The semi-diameter's check: > 0 and at most *ctx (the smallest |radius|). */
+typedef struct semi_limit {
+    double max;
+    int cross;          /* the limit is where surfaces cross, cross + 1 cross (0: none) */
+} semi_limit;
+
+/* The semi-diameter's check: > 0 and at most the limit. */
 static int check_semi(void *ctx, const char *word, char *msg, size_t cap)
 {
-    double v, max = *(const double *)ctx;
+    const semi_limit *lim = ctx;
+    double v;
     if (lm_parse_number(word, &v) != LM_NUM_OK || !(v > 0)) {
         snprintf(msg, cap, P(SEMI_ALL_BAD), word);
         return -1;
     }
-    if (v > max) {
-        snprintf(msg, cap, P(SEMI_ALL_BIG), word, max);
+    if (v > lim->max) {
+        if (lim->cross) snprintf(msg, cap, P(SEMI_ALL_CROSSES), word, lim->cross,
+                                 lim->cross + 1, lim->max);
+        else snprintf(msg, cap, P(SEMI_ALL_BIG), word, lim->max);
         return -1;
     }
     return 0;
 }
 
-/* One semi-diameter for every surface of lf: *semi.  The largest a sphere allows
- * (the smallest |radius|) is said in the question. */
+/* One semi-diameter for every surface of lf: *semi.  The largest allowed (the smallest
+ * |radius|, or where two surfaces would cross) is said in the question. */
 static int ask_semi_all(tdlg *t, const lm_lens_file *lf, double *semi)
 {
-    double max = INFINITY;
+    semi_limit lim;
     char q[512], word[64];
     int rc;
-    for (int i = 0; i < lf->nsurf; i++)
-        if (isfinite(lf->surf[i].radius)) max = fmin(max, fabs(lf->surf[i].radius));
-    if (isinf(max)) snprintf(q, sizeof q, "%s", P(SEMI_ALL_PLANE));
-    else snprintf(q, sizeof q, P(SEMI_ALL), max);
-    if ((rc = lm_ask_word(t->io, q, q, P(SEMI_ALL_WHAT), check_semi, &max, word,
+    lens_file_limit(lf, &lim.max, &lim.cross);
+    if (isinf(lim.max)) snprintf(q, sizeof q, "%s", P(SEMI_ALL_PLANE));
+    else if (lim.cross) snprintf(q, sizeof q, P(SEMI_ALL_CROSS), lim.max, lim.cross,
+                                 lim.cross + 1);
+    else snprintf(q, sizeof q, P(SEMI_ALL), lim.max);
+    if ((rc = lm_ask_word(t->io, q, q, P(SEMI_ALL_WHAT), check_semi, &lim, word,
                           sizeof word)))
         return rc;
     lm_parse_number(word, semi);
@@ -382,6 +523,29 @@ static int check_grid(void *ctx, const char *word, char *msg, size_t cap)
     return 0;
 }
 
+/* The table's semi-diameter: > 0, at most each |radius|, and the two surfaces must
+ * not cross within it (sp holds r1, r2 and the thickness). */
+static int check_table_semi(void *ctx, const char *word, char *msg, size_t cap)
+{
+    const sc_tess_spec *sp = ctx;
+    double v, h, rim, edge, r = fmin(fabs(sp->r1), fabs(sp->r2));
+    if (word_number(word, &v, msg, cap)) return -1;
+    if (!(v > 0)) {
+        snprintf(msg, cap, P(SEMI_ALL_BAD), word);
+        return -1;
+    }
+    if (v > r) {
+        snprintf(msg, cap, P(SEMI_ALL_BIG), word, r);
+        return -1;
+    }
+    trace_lens_surface a = {sp->r1, 0, sp->n, v}, b = {sp->r2, sp->thickness, 1, v};
+    if (trace_lens_cross(&a, &b, &h, &rim, &edge)) {
+        snprintf(msg, cap, P(SEMI_CROSS), word, 1, 2, h, edge, rim, h);
+        return -1;
+    }
+    return 0;
+}
+
 static void table_rows(tdlg *t, const sc_tess_row *rows, int n)
 {
     lm_io *io = t->io;
@@ -417,8 +581,11 @@ static int tess_table(tdlg *t)
         (rc = ask_num(t, P(T_R2), P(T_R2_WHAT), LM_ALLOW_PLANE, 0, &sp.r2)) ||
         (rc = ask_num(t, P(T_THICK), P(T_THICK_WHAT), LM_POSITIVE, 0, &sp.thickness)) ||
         (rc = ask_num(t, P(T_INDEX), P(T_INDEX_WHAT), LM_POSITIVE, 0, &sp.n)) ||
-        (rc = ask_num(t, P(T_SEMI), P(T_SEMI_WHAT), LM_POSITIVE, 0, &sp.aperture)) ||
-        (rc = lm_ask_word(io, P(T_GRID), P(T_GRID), P(T_GRID_WHAT), check_grid, NULL, word,
+        (rc = lm_ask_word(io, P(T_SEMI), P(T_SEMI), P(T_SEMI_WHAT), check_table_semi, &sp,
+                          word, sizeof word)))
+        return rc;
+    lm_parse_number(word, &sp.aperture);
+    if ((rc = lm_ask_word(io, P(T_GRID), P(T_GRID), P(T_GRID_WHAT), check_grid, NULL, word,
                           sizeof word)))
         return rc;
     lm_parse_number(word, &g);
@@ -444,9 +611,10 @@ static int tess_table(tdlg *t)
     lm_say(io, LM_BOTH, P(T_LENS), sp.r1, sp.r2, sp.thickness, sp.n, sp.aperture,
            sp.z_detector, sp.beam_radius, sp.grid, sp.grid);
     if (need_engine(t)) return LM_FAIL;
+    sp.stop = stop_requested;
     if (t->api->tess_table(&sp, rows, err)) {
         lm_say(io, LM_BOTH, P(T_FAILED), err);
-        return io->interactive ? LM_GO : LM_FAIL;
+        return io->interactive && !lm_stop_requested() ? LM_GO : LM_FAIL;
     }
     table_rows(t, rows, 1 + 3 * NL);
     return LM_GO;
@@ -456,7 +624,7 @@ static int tess_table(tdlg *t)
 
 int lm_trace(lm_io *io)
 {
-    static const char *const modes[] = {"scene", "lens", "record", "table", NULL};
+    static const char *const modes[] = {"scene", "lens", "record", "table", "draw", NULL};
     tdlg t = {io, NULL, {0}, 0};
     int rc, mode, more;
 
@@ -464,7 +632,7 @@ int lm_trace(lm_io *io)
     do {
         if ((rc = lm_ask_choice(io, P(MODE), P(MODE), P(MODE_WHAT), modes, &mode))) break;
         rc = mode == 0 ? do_scene(&t) : mode == 1 ? do_lens(&t)
-           : mode == 2 ? do_record(&t) : tess_table(&t);
+           : mode == 2 ? do_record(&t) : mode == 3 ? tess_table(&t) : lm_draw_last(io);
         if (rc) break;
         rc = lm_ask_yn(io, P(ANOTHER), P(ANOTHER), P(ANOTHER_WHAT), &more);
     } while (!rc && more);

@@ -224,7 +224,77 @@ typedef struct rg_verify {
 
 
 /* ==== the machine ================================================================ */
-/* (the machine part's declarations go here) */
+/* The rig file (rg_file.c; format in README "Rig files"): the chip, one block per
+ * joint axis (STEP/DIR/ENABLE outputs, home switch input, steps per degree or mm,
+ * travel, speed, acceleration), the laser-enable output, the interlock input, the
+ * heartbeat output and the geometry keys (rg_geometry, read by the geometry part). */
+#define RG_ERRMAX 512
+#define RG_NAMEMAX 64
+typedef struct rg_line {
+    int offset;                 /* line offset on the chip; -1: none */
+    int active_low;             /* 1: the active state is the low level */
+    int at;                     /* rig-file line that named it (messages) */
+} rg_line;
+typedef struct rg_axis {
+    rg_line step, dir, enable, home;    /* enable and home may be absent (-1) */
+    int linear;                 /* 1: a stage in mm (u, v); 0: an angle in degrees */
+    double steps_per;           /* steps per degree or per mm (> 0) */
+    double min, max;            /* travel, degrees or mm */
+    double speed, accel;        /* maximum speed (/s) and acceleration (/s^2) */
+    double home_at;             /* the joint value where the home switch trips */
+    int home_dir;               /* -1 or +1: the way homing seeks the switch */
+    double home_speed;          /* homing speed (/s) */
+    int dir_invert;             /* 1: positive moves drive DIR inactive */
+    int sim_home_broken;        /* simulator: this home switch never trips */
+    int at;                     /* rig-file line of its "axis" line; 0: missing */
+} rg_axis;
+typedef struct rg_rig {
+    char path[256];
+    char chip[RG_NAMEMAX];      /* gpiod chip name, path or number */
+    rg_axis axis[RG_NJOINTS];   /* indexed by RG_J_* */
+    rg_line laser;              /* laser-enable output (required) */
+    rg_line interlock;          /* interlock input (required): active = closed = safe */
+    rg_line heartbeat;          /* charge-pump output toggled while the laser is on */
+    double max_on_ms;           /* longest exposure */
+    double tick_us;             /* control step: one step edge pair per axis at most */
+    double heartbeat_timeout_ms;/* the pump circuit's hold time (simulator, README) */
+    double home_timeout_s;      /* a home switch that never trips: give up */
+    double settle_ms;           /* wait after a move before the laser may go on */
+    int sim_realtime;           /* simulator paced by the real clock (kill tests) */
+    int sim_interlock_open;     /* simulator: the interlock is open from the start */
+    double sim_interlock_open_ms; /* simulator: it opens at this time (ms); < 0 never */
+    int geom_keys;              /* number of geometry lines read */
+    rg_geometry geom;
+} rg_rig;
+
+enum rg_backend { RG_BACKEND_SIM, RG_BACKEND_GPIOD, RG_BACKEND_NULL };
+typedef struct rg_open_opts {
+    int backend;                /* enum rg_backend; NULL: do-nothing lines, real clock */
+    const char *chip;           /* gpiod: overrides the rig file's chip; NULL: keep */
+    const char *sim_log;        /* simulator: event log (written as LOG.part, renamed
+                                   when the machine closes or stops); NULL: none */
+    const char *sim_state;      /* simulator: its chip state in this shared file, so a
+                                   watchdog outside the process sees the lines; NULL */
+    int realtime;               /* 1: try SCHED_FIFO and mlockall */
+} rg_open_opts;
+typedef struct rg_machine rg_machine;
+typedef int (*rg_stop_fn)(void *ctx);   /* non-zero: stop now */
+typedef struct rg_timing {              /* step-edge lateness on the real clock */
+    long edges;
+    double p50_us, p99_us, max_us;
+} rg_timing;
+/* The simulator's chip state (a shared file when rg_open_opts.sim_state is set): what
+ * a watchdog process reads.  Levels are logical (1 = active). */
+typedef struct rg_sim_shared {
+    char magic[8];              /* "lmrigsim" */
+    volatile int64_t now_ns;            /* simulated time */
+    volatile int32_t laser, interlock, light, pid;
+    volatile int32_t enable[RG_NJOINTS];
+    volatile int64_t steps[RG_NJOINTS]; /* motor positions, steps */
+    volatile int64_t heartbeat_edges;   /* toggles so far */
+    volatile int64_t heartbeat_last_ns; /* simulated time of the last toggle */
+    volatile int64_t timeout_ns;        /* the pump's hold time */
+} rg_sim_shared;
 /* ==== end of the machine ========================================================= */
 
 
@@ -290,7 +360,42 @@ typedef struct rig_api {
      * written to buf; returns buf. */
     const char *(*diag_text)(unsigned diag, char *buf, size_t cap);
     /* ---- the machine ---- */
-    /* (machine entry points, in this block) */
+    /* The rig file: 0, or RG_EINVAL with "FILE:LINE: why" in err (cap bytes). */
+    int (*rig_load)(const char *path, rg_rig *rig, char *err, size_t cap);
+    int (*rig_parse)(const char *text, size_t len, const char *name, rg_rig *rig,
+                     char *err, size_t cap);
+    /* Joints (rad, mm) to motor steps, each checked against travel: 0 or RG_ETRAVEL. */
+    int (*pose_steps)(const rg_rig *rig, const rg_pose *p, long steps[RG_NJOINTS],
+                      char *err, size_t cap);
+    /* Open the lines (laser off, drivers disabled), check the interlock reads. */
+    int (*open)(const rg_rig *rig, const rg_open_opts *o, rg_machine **m, char *err,
+                size_t cap);
+    const char *(*sched_note)(const rg_machine *m);   /* what real-time scheduling got */
+    int (*home)(rg_machine *m, rg_stop_fn stop, void *ctx, char *err, size_t cap);
+    /* A coordinated trapezoidal move to joint values p; refused before the first
+     * pulse if any joint is outside travel or the machine is not homed. */
+    int (*move)(rg_machine *m, const rg_pose *p, rg_stop_fn stop, void *ctx, char *err,
+                size_t cap);
+    /* The move's profile without moving: its duration (s); RG_ETRAVEL as move. */
+    int (*plan_move)(const rg_rig *rig, const long from[RG_NJOINTS],
+                     const long to[RG_NJOINTS], double *seconds, char *err, size_t cap);
+    int (*move_steps)(rg_machine *m, const long steps[RG_NJOINTS], rg_stop_fn stop,
+                      void *ctx, char *err, size_t cap);
+    /* Laser on for ms (<= max_on_ms), only with the interlock closed and every axis
+     * at rest; off within one control step when the interlock opens (RG_EINTERLOCK). */
+    int (*expose)(rg_machine *m, double ms, rg_stop_fn stop, void *ctx, char *err,
+                  size_t cap);
+    void (*position)(const rg_machine *m, long steps[RG_NJOINTS], rg_pose *p);
+    /* Where the motors really are: 1 on the simulator (its motor model), 0 where the
+     * chip has no feedback (steps then hold the commanded position). */
+    int (*motors)(const rg_machine *m, long steps[RG_NJOINTS]);
+    int (*homed)(const rg_machine *m);
+    void (*timing)(const rg_machine *m, rg_timing *t);
+    /* Laser off, then drivers disabled, lines released, log closed: 0 or RG_EIO. */
+    int (*close)(rg_machine *m);
+    /* Async-signal-safe: every open machine's laser off, then its drivers disabled
+     * (and the simulator's log completed).  For a signal handler or stop hook. */
+    void (*emergency_off)(void);
 } rig_api;
 
 typedef const rig_api *(*rig_get_api_fn)(int abi);

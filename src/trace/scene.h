@@ -83,6 +83,14 @@ typedef struct sc_scene {
     char *out_segments, *out_hits, *out_summary;
     char *name;               /* the scene file, for messages */
     char *dir;                /* its folder: mesh files are relative to it */
+    /* Set by the caller before run(): polled between batches and every few thousand
+     * records (a few ms of work); non-zero stops the trace (sc_result.stopped). */
+    int (*stop)(void *ctx);
+    void *stop_ctx;
+    int mismatch_error;       /* `mismatch error`: rays meeting a surface whose index
+                                 on their side differs from theirs fail the trace */
+    int nmismatch;            /* media that disagree, found when the scene is read */
+    char mismatch_where[256]; /* the first such pair: "FILE:LINE and FILE:LINE" ... */
 } sc_scene;
 
 /* One ray as the sources emit it. */
@@ -115,6 +123,8 @@ void sc_point_rays(const sc_source *s, sc_ray *out);
  * (hexapolar rings, vertices on the surface), rectangles into 2 level^2, spheres
  * into 4 level (level - 1) (level >= 2).  Oriented as the surface's normal. */
 int  sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, char *err);
+/* Coincident surfaces: 0, or -1 with both FILE:LINEs in err (scene_geom.c). */
+int  sc_check_coincident(const sc_scene *sc, char *err);
 
 /* ---- running (inside the module: needs the engine) ----------------------------- */
 
@@ -123,6 +133,8 @@ int  sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, cha
 typedef struct sc_result {
     trace_summary sum;
     int progress_shown;       /* a progress line was drawn on stderr */
+    int stopped;              /* the stop callback stopped it (outputs left as .part) */
+    int mismatch_failed;      /* `mismatch error` and rays met disagreeing media */
 } sc_result;
 
 /* The error-against-run-time table: a spherical singlet modelled analytically and as
@@ -136,6 +148,8 @@ typedef struct sc_tess_spec {
     int nlevels;
     const int *levels;                       /* tessellation levels (rings per cap) */
     int threads;
+    int (*stop)(void *ctx);                  /* polled during the traces (may be NULL) */
+    void *stop_ctx;
 } sc_tess_spec;
 
 enum sc_model { SC_MODEL_ANALYTIC, SC_MODEL_MESH, SC_MODEL_MESH_NORMAL, SC_MODEL_MESH_FULL };

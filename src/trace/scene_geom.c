@@ -115,15 +115,17 @@ static int tess_axial(const sc_surface *f, int level, mesh *m)
         double rin = a * (k - 1) / level, rout = a * k / level;
         while (i < (k == 1 ? 0 : nin) || j < nout) {
             double p[3], q[3], r[3];
+            /* angles by index, the seam's last index being index 0 (2 pi is not 0
+             * for sin): neighbours share their vertices bit for bit */
             double ai = 2 * PI * (double)(i + 1) / (double)nin;
             double aj = 2 * PI * (double)(j + 1) / (double)nout;
-            axial_point(f, u, v, rin, 2 * PI * (double)i / (double)nin, p);
-            axial_point(f, u, v, rout, 2 * PI * (double)j / (double)nout, q);
+            axial_point(f, u, v, rin, 2 * PI * (double)(i % nin) / (double)nin, p);
+            axial_point(f, u, v, rout, 2 * PI * (double)(j % nout) / (double)nout, q);
             if (j < nout && (k == 1 || i == nin || aj <= ai)) {
-                axial_point(f, u, v, rout, aj, r);
+                axial_point(f, u, v, rout, 2 * PI * (double)((j + 1) % nout) / (double)nout, r);
                 j++;
             } else {
-                axial_point(f, u, v, rin, ai, r);
+                axial_point(f, u, v, rin, 2 * PI * (double)((i + 1) % nin) / (double)nin, r);
                 i++;
             }
             if (put(m, p, q, r)) return -1;
@@ -172,11 +174,16 @@ static int tess_sphere(const sc_surface *f, int level, mesh *m)
         for (int j = 0; j < nlon; j++) {
             double c[4][3];   /* (i, j) (i, j+1) (i+1, j+1) (i+1, j) */
             for (int q = 0; q < 4; q++) {
-                double th = PI * (i + (q >= 2)) / level;
-                double ph = 2 * PI * (j + (q == 1 || q == 2)) / nlon;
-                c[q][0] = f->at[0] + f->radius * sin(th) * cos(ph);
-                c[q][1] = f->at[1] + f->radius * sin(th) * sin(ph);
-                c[q][2] = f->at[2] + f->radius * cos(th);
+                /* vertices by index: the seam's longitude nlon is longitude 0 and the
+                 * poles are one point each, exactly (sin(pi) and sin(2 pi) are not 0
+                 * in double: they left a hole at the pole and a crack on the seam) */
+                int a = i + (q >= 2), b = (j + (q == 1 || q == 2)) % nlon;
+                double th = PI * a / level, ph = 2 * PI * b / nlon;
+                double st = a == 0 || a == level ? 0 : sin(th);
+                double ct = a == 0 ? 1 : a == level ? -1 : cos(th);
+                c[q][0] = f->at[0] + f->radius * st * cos(ph);
+                c[q][1] = f->at[1] + f->radius * st * sin(ph);
+                c[q][2] = f->at[2] + f->radius * ct;
             }
             if (i > 0 && put_outward(m, c[0], c[1], c[2], f->at)) return -1;
             if (i < level - 1 && put_outward(m, c[0], c[2], c[3], f->at)) return -1;
@@ -213,5 +220,189 @@ int sc_tessellate(const sc_surface *s, int level, double **tri, long *ntri, char
     }
     *tri = m.t;
     *ntri = m.n;
+    return 0;
+}
+
+/* ---- coincident surfaces ----------------------------------------------------------- */
+
+/* The same underlying surface at the same place (apertures aside)?  *flip: a plane
+ * whose normal is reversed (its n1 and n2 swap sides). */
+static int same_surface(const sc_surface *a, const sc_surface *b, int *flip)
+{
+    int axial_a = a->shape >= SC_CAP && a->shape <= SC_ASPHERE;
+    int axial_b = b->shape >= SC_CAP && b->shape <= SC_ASPHERE;
+    *flip = 0;
+    if (a->shape == SC_MESH || b->shape == SC_MESH) return 0;
+    if (a->shape != b->shape && !(axial_a && axial_b)) return 0;
+    for (int i = 0; i < 3; i++) if (a->at[i] != b->at[i]) return 0;
+    if (a->shape == SC_SPHERE) return a->radius == b->radius;
+    int same = 1, opp = 1;
+    for (int i = 0; i < 3; i++) {
+        same &= a->axis[i] == b->axis[i];
+        opp &= a->axis[i] == -b->axis[i];
+    }
+    if (a->shape == SC_PLANE) { *flip = !same && opp; return same || opp; }
+    if (!same || a->radius != b->radius || a->conic != b->conic) return 0;
+    int n = a->ncoef > b->ncoef ? a->ncoef : b->ncoef;
+    for (int i = 0; i < n; i++)
+        if ((i < a->ncoef ? a->coef[i] : 0) != (i < b->ncoef ? b->coef[i] : 0)) return 0;
+    return 1;
+}
+
+/* Their apertures: 1 the same, 0 disjoint (a disc inside an annulus's hole: a lens
+ * face and its mount), -1 overlapping in part. */
+static int same_aperture(const sc_surface *a, const sc_surface *b)
+{
+    if (a->shape == SC_SPHERE) return 1;
+    int ra = a->shape == SC_PLANE && !(a->aperture > 0), rb = b->shape == SC_PLANE && !(b->aperture > 0);
+    if (ra || rb) {
+        if (ra && rb && a->rect[0] == b->rect[0] && a->rect[1] == b->rect[1]) {
+            for (int i = 0; i < 3; i++)
+                if (fabs(a->up[i]) != fabs(b->up[i])) return -1;
+            return 1;
+        }
+        return -1;
+    }
+    if (a->aperture == b->aperture && a->hole == b->hole) return 1;
+    return a->aperture <= b->hole || b->aperture <= a->hole ? 0 : -1;
+}
+
+/* Where the line p0 + s e (in plane f) runs inside f's disc or rectangle: [*s0, *s1],
+ * or 0 if it misses it. */
+static int plane_chord(const sc_surface *f, const double *p0, const double *e, double *s0,
+                       double *s1)
+{
+    double q[3] = {p0[0] - f->at[0], p0[1] - f->at[1], p0[2] - f->at[2]};
+    if (f->aperture > 0) {
+        double b = g_dot(e, q), c = g_dot(q, q) - f->aperture * f->aperture;
+        double disc = b * b - c;
+        if (!(disc > 0)) return 0;
+        *s0 = -b - sqrt(disc);
+        *s1 = -b + sqrt(disc);
+        return 1;
+    }
+    double u[3], lo = -INFINITY, hi = INFINITY;
+    g_cross(f->up, f->axis, u);
+    const double *ax[2] = {u, f->up};
+    for (int k = 0; k < 2; k++) {
+        double x = g_dot(q, ax[k]), dx = g_dot(e, ax[k]), h = f->rect[k] / 2;
+        if (dx == 0) { if (fabs(x) > h) return 0; continue; }
+        double a = (-h - x) / dx, b = (h - x) / dx;
+        if (a > b) { double t = a; a = b; b = t; }
+        if (a > lo) lo = a;
+        if (b < hi) hi = b;
+    }
+    if (!(lo < hi)) return 0;
+    *s0 = lo;
+    *s1 = hi;
+    return 1;
+}
+
+/* Two refracting planes that cross each other inside both apertures (the media
+ * between them would depend on which side of the other each ray is)? */
+static int planes_cross(const sc_surface *a, const sc_surface *b)
+{
+    double e[3], p0[3], m[3], n[3], sa0, sa1, sb0, sb1;
+    g_cross(a->axis, b->axis, e);
+    double ee = g_dot(e, e);
+    if (!(ee > 1e-24)) return 0;                       /* parallel */
+    double da = g_dot(a->axis, a->at), db = g_dot(b->axis, b->at);
+    g_cross(b->axis, e, m);
+    g_cross(e, a->axis, n);
+    for (int i = 0; i < 3; i++) p0[i] = (da * m[i] + db * n[i]) / ee;
+    g_unit(e);
+    if (!plane_chord(a, p0, e, &sa0, &sa1) || !plane_chord(b, p0, e, &sb0, &sb1)) return 0;
+    double lo = fmax(sa0, sb0), hi = fmin(sa1, sb1), size = (sa1 - sa0) + (sb1 - sb0);
+    return hi - lo > 1e-9 * size;
+}
+
+/* Two refracting surfaces of revolution on one axis (caps, conics, aspheres, and discs
+ * square to it) that cross inside both apertures: the gap between them changes sign. */
+static int axial_cross(const sc_surface *a, const sc_surface *b)
+{
+    int pa = a->shape == SC_PLANE, pb = b->shape == SC_PLANE;
+    if (a->shape == SC_SPHERE || b->shape == SC_SPHERE || a->shape == SC_MESH ||
+        b->shape == SC_MESH || (pa && !(a->aperture > 0)) || (pb && !(b->aperture > 0)))
+        return 0;
+    double sb = 1, off[3], x[3];
+    for (int i = 0; i < 3; i++) {
+        if (a->axis[i] != b->axis[i]) sb = -1;
+        off[i] = b->at[i] - a->at[i];
+    }
+    if (sb < 0) {                          /* only a plane may face the other way */
+        if (!pb) return 0;
+        for (int i = 0; i < 3; i++) if (a->axis[i] != -b->axis[i]) return 0;
+    }
+    g_cross(off, a->axis, x);              /* the vertices on one axis? */
+    if (!(sqrt(g_dot(x, x)) <= 1e-12 * (sqrt(g_dot(off, off)) + a->aperture))) return 0;
+    double dz = g_dot(off, a->axis), smax = fmin(a->aperture, b->aperture);
+    double smin = fmax(pa ? a->hole : 0, pb ? b->hole : 0);
+    double tol = 1e-12 * (fabs(dz) + smax), lo = 0, hi = 0;
+    if (!(smax > smin)) return 0;
+    for (int i = 0; i <= 256; i++) {
+        double s = smin + (smax - smin) * i / 256;
+        double g = (pb ? 0 : sag(b, s)) + dz - (pa ? 0 : sag(a, s));
+        lo = fmin(lo, g);
+        hi = fmax(hi, g);
+    }
+    return lo < -tol && hi > tol;
+}
+
+/* Surfaces at the same place (the same shape, position, axis and aperture) are traced
+ * as one interface, each in turn in the order they are listed (a ray going along the
+ * axis, or into a sphere, meets the first one first); refracting ones must then chain
+ * their media, n1 -> n -> n2.  Refused, with both lines: a chain that breaks, the
+ * same surface listed twice with apertures that overlap only in part, coincident
+ * tessellated surfaces, refracting planes that cross inside both apertures, and
+ * refracting surfaces of revolution on one axis that cross inside both. */
+int sc_check_coincident(const sc_scene *sc, char *err)
+{
+    static const char *names[] = {"plane", "sphere", "cap", "conic", "asphere", "mesh"};
+    for (int i = 0; i < sc->nsurf; i++)
+        for (int j = i + 1; j < sc->nsurf; j++) {
+            const sc_surface *a = &sc->surf[i], *b = &sc->surf[j];
+            int flip, ap;
+            if (a->shape == SC_PLANE && b->shape == SC_PLANE && a->kind == SC_REFRACT &&
+                b->kind == SC_REFRACT && planes_cross(a, b)) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this refracting plane crosses the one of "
+                         "line %ld inside both their apertures: which medium lies between "
+                         "them is ambiguous (end one where it meets the other)", b->src,
+                         b->line, a->line);
+                return -1;
+            }
+            if (a->kind == SC_REFRACT && b->kind == SC_REFRACT && axial_cross(a, b)) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this refracting %s crosses the %s of line "
+                         "%ld inside both their apertures: which medium lies between them "
+                         "is ambiguous (end one where it meets the other)", b->src, b->line,
+                         names[b->shape], names[a->shape], a->line);
+                return -1;
+            }
+            if (!same_surface(a, b, &flip) || (ap = same_aperture(a, b)) == 0) continue;
+            if (ap < 0) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this %s lies on the %s of line %ld with "
+                         "an aperture that overlaps it only in part: give coincident surfaces "
+                         "the same aperture, or apertures that do not overlap",
+                         b->src, b->line, names[b->shape], names[a->shape], a->line);
+                return -1;
+            }
+            if (a->tessellate || b->tessellate) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this %s coincides with the %s of line "
+                         "%ld: coincident surfaces are taken in order only as analytic "
+                         "surfaces (drop tessellate)", b->src, b->line, names[b->shape],
+                         names[a->shape], a->line);
+                return -1;
+            }
+            if (a->kind != SC_REFRACT || b->kind != SC_REFRACT) continue;
+            /* the medium between them: a's n2 (or, a reversed plane, its n1) */
+            double bn1 = flip ? b->n2 : b->n1;
+            if (a->n2 != bn1) {
+                snprintf(err, SC_ERRMAX, "%s:%ld: this %s coincides with the %s of line "
+                         "%ld and their media do not chain: %g -> %g there, then %g -> %g "
+                         "here (coincident surfaces are one interface, taken in the "
+                         "order listed: n1 -> n -> n2)", b->src, b->line, names[b->shape],
+                         names[a->shape], a->line, a->n1, a->n2, bn1, flip ? b->n1 : b->n2);
+                return -1;
+            }
+        }
     return 0;
 }

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include "scene.h"
 
 #define PI 3.14159265358979323846
@@ -99,6 +100,10 @@ static int tok_num(reader *r, const tok *t, const char *what, double *v)
     if (errno == ERANGE && fabs(*v) > 1) return fail(r, "%s: '%s' is out of range", what, buf);
     if (!isfinite(*v) || fabs(*v) > 1e30)
         return fail(r, "%s: '%s' is out of range (|x| <= 1e30)", what, buf);
+    /* one range for every number: 0, or 1e-30 <= |x| <= 1e30 (squares and products
+     * of lengths then neither underflow nor overflow; see README, Conventions) */
+    if ((*v != 0 && fabs(*v) < 1e-30) || (*v == 0 && errno == ERANGE))
+        return fail(r, "%s: '%s' is out of range (0, or 1e-30 <= |x| <= 1e30)", what, buf);
     return 0;
 }
 
@@ -837,6 +842,12 @@ static int read_setting(reader *r, sc_scene *sc)
         return fail(r, "output: '%.*s' is not segments, hits or summary",
                     (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
     }
+    if (tok_is(d, "mismatch")) {
+        if (r->nt != 2 || !(tok_is(&r->t[1], "warn") || tok_is(&r->t[1], "error")))
+            return fail(r, "mismatch: expected warn or error");
+        sc->mismatch_error = tok_is(&r->t[1], "error");
+        return 0;
+    }
     if (tok_is(d, "fresnel") || tok_is(d, "reflections")) {
         int *flag = tok_is(d, "fresnel") ? &sc->fresnel : &sc->reflections;
         if (r->nt != 2 || !(tok_is(&r->t[1], "on") || tok_is(&r->t[1], "off")))
@@ -871,7 +882,7 @@ static int read_directive(reader *r, sc_scene *sc)
                                          [SC_CAP] = "cap", [SC_CONIC] = "conic",
                                          [SC_ASPHERE] = "asphere", [SC_MESH] = "mesh"};
     static const char *const settings[] = {"depth", "cutoff", "threads", "escape", "fresnel",
-                                           "reflections", "output", NULL};
+                                           "reflections", "output", "mismatch", NULL};
     const tok *d = &r->t[0];
     for (int i = 0; i < 6; i++)
         if (tok_is(d, shapes[i])) return read_surface(r, sc, shapes[i], i);
@@ -879,8 +890,130 @@ static int read_directive(reader *r, sc_scene *sc)
     for (int i = 0; settings[i]; i++)
         if (tok_is(d, settings[i])) return read_setting(r, sc);
     return fail(r, "unknown directive '%.*s' (plane, sphere, cap, conic, asphere, mesh, "
-                "source, depth, cutoff, threads, escape, fresnel, reflections, output)",
+                "source, depth, cutoff, threads, escape, fresnel, reflections, output, mismatch)",
                 (int)(d->n < 24 ? d->n : 24), d->s);
+}
+
+/* ---- axial surfaces along one axis: crossing sags, media that disagree ---------
+ * Caps, conics and aspheres whose axes lie on one line are taken in order along it
+ * (ties in file order).  Two consecutive ones must not cross within the smaller
+ * aperture (negative edge thickness: refused), and when both refract, the index one
+ * gives the space between them should be the one the other expects: a disagreement
+ * is counted, and the first is kept for the message after the trace (scene.h). */
+
+#define AXMAX 4096          /* beyond this many axial surfaces the pairs are not checked */
+
+static double axial_sag(const sc_surface *f, double s)
+{
+    double c = f->radius != 0 ? 1 / f->radius : 0, s2 = s * s, q;
+    q = 1 - (1 + f->conic) * c * c * s2;
+    double z = c * s2 / (1 + sqrt(q > 0 ? q : 0)), p = s2;
+    for (int i = 0; i < f->ncoef; i++) {
+        z += f->coef[i] * p;
+        p *= s2;
+    }
+    return z;
+}
+
+typedef struct axm {
+    const sc_surface *f;
+    double u, sign;         /* vertex position along the line; axis . direction */
+} axm;
+
+static int axm_cmp(const void *x, const void *y)
+{
+    const axm *a = x, *b = y;
+    if (a->u != b->u) return a->u < b->u ? -1 : 1;
+    return a->f < b->f ? -1 : a->f > b->f;      /* file order */
+}
+
+/* Position along the line of member m at height s. */
+static double axm_pos(const axm *m, double s) { return m->u + m->sign * axial_sag(m->f, s); }
+
+/* The pair a, b (a first along the line): 0, or -1 with err if their sags cross. */
+static int axm_cross(const axm *a, const axm *b, char *err)
+{
+    enum { N = 64 };
+    double smax = fmin(a->f->aperture, b->f->aperture), prev = 0, t = 0;
+    double scale = fabs(a->u) + fabs(b->u) + smax;
+    if (!(smax > 0)) return 0;
+    for (int i = 1; i <= N; i++) {
+        double s = smax * i / N;
+        t = axm_pos(b, s) - axm_pos(a, s);
+        if (t < -1e-12 * scale) {
+            double lo = prev, hi = s;       /* t(lo) >= -tol > t(hi) */
+            for (int k = 0; k < 100 && lo < hi; k++) {
+                double mid = 0.5 * (lo + hi);
+                if (!(mid > lo && mid < hi)) break;
+                if (axm_pos(b, mid) - axm_pos(a, mid) < 0) hi = mid; else lo = mid;
+            }
+            double rim = axm_pos(b, smax) - axm_pos(a, smax);
+            snprintf(err, SC_ERRMAX, "%s:%ld: and %s:%ld: the surfaces cross at height "
+                     "%.6g from their axis (edge thickness %.6g at %.6g): negative edge "
+                     "thickness", a->f->src, a->f->line, b->f->src, b->f->line,
+                     b->u == a->u ? 0.0 : lo, rim < t ? rim : t, rim < t ? smax : s);
+            return -1;
+        }
+        prev = s;
+    }
+    return 0;
+}
+
+/* The media of the pair a, b: the index a leaves on b's side, b on a's. */
+static void axm_media(sc_scene *sc, const axm *a, const axm *b)
+{
+    if (a->f->kind != SC_REFRACT || b->f->kind != SC_REFRACT) return;
+    double na = a->sign > 0 ? a->f->n2 : a->f->n1, nb = b->sign > 0 ? b->f->n1 : b->f->n2;
+    if (!(fabs(na - nb) > 1e-9 * na)) return;
+    if (!sc->nmismatch++)
+        snprintf(sc->mismatch_where, sizeof sc->mismatch_where, "%s:%ld: gives %.10g "
+                 "after it, %s:%ld: expects %.10g before it", a->f->src, a->f->line, na,
+                 b->f->src, b->f->line, nb);
+}
+
+static int axial_pairs(sc_scene *sc, char *err)
+{
+    int n = 0, rc = 0;
+    for (int i = 0; i < sc->nsurf; i++)
+        n += sc->surf[i].shape >= SC_CAP && sc->surf[i].shape <= SC_ASPHERE;
+    if (n < 2 || n > AXMAX) return 0;
+    axm *m = malloc((size_t)n * sizeof *m);
+    char *used = calloc((size_t)n, 1);
+    const sc_surface **ax = malloc((size_t)n * sizeof *ax);
+    if (!m || !used || !ax) { free(m); free(used); free(ax); return 0; }
+    n = 0;
+    for (int i = 0; i < sc->nsurf; i++)
+        if (sc->surf[i].shape >= SC_CAP && sc->surf[i].shape <= SC_ASPHERE)
+            ax[n++] = &sc->surf[i];
+    for (int i = 0; i < n && !rc; i++) {
+        const sc_surface *a = ax[i];
+        if (used[i]) continue;
+        int k = 0;
+        for (int j = i; j < n; j++) {               /* the surfaces on a's axis line */
+            const sc_surface *b = ax[j];
+            if (used[j]) continue;
+            double dot = dot3(a->axis, b->axis), w[3], x[3];
+            if (!(fabs(dot) > 1 - 1e-12)) continue;
+            sub3(b->at, a->at, w);
+            cross3(w, a->axis, x);
+            double off = sqrt(dot3(x, x)), scale = sqrt(dot3(w, w)) + a->aperture;
+            if (!(off <= 1e-12 * scale)) continue;
+            used[j] = 1;
+            m[k].f = b;
+            m[k].u = dot3(w, a->axis);
+            m[k].sign = dot > 0 ? 1 : -1;
+            k++;
+        }
+        qsort(m, (size_t)k, sizeof *m, axm_cmp);
+        for (int j = 1; j < k && !rc; j++) {
+            rc = axm_cross(&m[j - 1], &m[j], err);
+            if (!rc) axm_media(sc, &m[j - 1], &m[j]);
+        }
+    }
+    free(m);
+    free(used);
+    free(ax);
+    return rc;
 }
 
 static void scene_defaults(sc_scene *sc)
@@ -908,6 +1041,8 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
     if (st < 0) goto bad;
     if (!sc->nsurf) { fail(&r, "the scene has no surface"); goto bad; }
     if (!sc->nsource) { fail(&r, "the scene has no source of rays"); goto bad; }
+    if (axial_pairs(sc, err)) goto bad;
+    if (sc_check_coincident(sc, err)) goto bad;     /* with both lines */
     return 0;
 bad:
     sc_free(sc);
@@ -1024,6 +1159,62 @@ static int load_mesh(const sc_scene *sc, sc_surface *s, char *err)
     return rc ? from_scene(s, err) : 0;
 }
 
+/* ---- no output over an input ---------------------------------------------------- */
+
+/* The same existing file (device and inode: links and other spellings count)? */
+static int same_file(const char *a, const char *b)
+{
+    struct stat x, y;
+    return a && b && stat(a, &x) == 0 && stat(b, &y) == 0 && x.st_dev == y.st_dev &&
+           x.st_ino == y.st_ino;
+}
+
+/* out (or out.part, which the trace writes first) is input?  0, or -1 with err. */
+static int clash(const sc_scene *sc, const char *what, const char *out, const char *in,
+                 const char *in_what, char *err)
+{
+    char *part = malloc(strlen(out) + 6);
+    int bad;
+    if (!part) return snprintf(err, SC_ERRMAX, "out of memory"), -1;
+    sprintf(part, "%s.part", out);
+    bad = strcmp(out, in) == 0 || strcmp(part, in) == 0 || same_file(out, in) ||
+          same_file(part, in);
+    free(part);
+    if (bad)
+        snprintf(err, SC_ERRMAX, "%s: output %s %s would overwrite %s %s: an output is "
+                 "never written over an input", sc->name, what, out, in_what, in);
+    return bad ? -1 : 0;
+}
+
+/* Every output (and its .part) against the scene file, its mesh and media files and
+ * the other outputs, before anything is opened for writing. */
+static int outputs_over_inputs(const sc_scene *sc, const char *path, char *err)
+{
+    const char *what[3] = {"segments", "hits", "summary"};
+    const char *out[3] = {sc->out_segments, sc->out_hits, sc->out_summary};
+    for (int i = 0; i < 3; i++) {
+        if (!out[i]) continue;
+        if (clash(sc, what[i], out[i], path, "the scene file", err)) return -1;
+        for (int j = 0; j < i; j++)
+            if (out[j] && (clash(sc, what[i], out[i], out[j], "output", err) ||
+                           clash(sc, what[j], out[j], out[i], "output", err)))
+                return -1;
+        for (int k = 0; k < sc->nsurf; k++) {
+            const char *f[2] = {sc->surf[k].mesh_file, sc->surf[k].media_file};
+            for (int m = 0; m < 2; m++) {
+                if (!f[m]) continue;
+                char *in = join(sc->dir, f[m]);
+                if (!in) return snprintf(err, SC_ERRMAX, "out of memory"), -1;
+                int rc = clash(sc, what[i], out[i], in, m ? "the media file" :
+                               "the mesh file", err);
+                free(in);
+                if (rc) return -1;
+            }
+        }
+    }
+    return 0;
+}
+
 int sc_load(const char *path, sc_scene *sc, char *err)
 {
     size_t len;
@@ -1045,6 +1236,7 @@ int sc_load(const char *path, sc_scene *sc, char *err)
             goto bad;
         }
     }
+    if (outputs_over_inputs(sc, path, err)) goto bad;
     return 0;
 oom:
     snprintf(err, SC_ERRMAX, "%s: out of memory", path);

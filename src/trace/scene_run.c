@@ -190,11 +190,31 @@ typedef struct out {
     double t0, last;
     int shown;
     char *err;
+    int (*stop)(void *ctx);     /* the caller's stop callback, or NULL */
+    void *stop_ctx;
+    unsigned records;           /* records written since the last poll */
+    int stopped;
 } out;
+
+/* Poll the stop callback; 1 (and o->stopped) if the trace must stop. */
+static int stop_now(out *o)
+{
+    if (!o->stopped && o->stop && o->stop(o->stop_ctx)) o->stopped = 1;
+    return o->stopped;
+}
+
+/* Writing a batch's records can take a while too (a few M segments): poll every 4096. */
+static int poll_records(out *o)
+{
+    if (++o->records < 4096) return 0;
+    o->records = 0;
+    return stop_now(o);
+}
 
 static int w_segment(void *ctx, const trace_segment *s)
 {
     out *o = ctx;
+    if (poll_records(o)) return 1;
     return fprintf(o->seg, "%.10g %.10g %.10g\n%.10g %.10g %.10g\n", s->p0[0], s->p0[1],
                    s->p0[2], s->p1[0], s->p1[1], s->p1[2]) < 0;
 }
@@ -205,6 +225,7 @@ static const char hit_header[] =
 static int w_hit(void *ctx, const trace_hit *h)
 {
     out *o = ctx;
+    if (poll_records(o)) return 1;
     return fprintf(o->hit, "%llu,%d,%d,%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
                    "%.17g,%.17g,%.17g,%.17g\n", (unsigned long long)h->ray, h->depth,
                    h->surface, h->prim, h->pos[0], h->pos[1], h->pos[2], h->dir[0],
@@ -217,6 +238,7 @@ static int w_progress(void *ctx, uint64_t done, uint64_t total)
 {
     out *o = ctx;
     double t = now_ms();
+    if (stop_now(o)) return 1;
     if (!o->tty || t - o->t0 < 1000 || (t - o->last < 200 && done < total)) return 0;
     o->last = t;
     o->shown = 1;
@@ -296,6 +318,17 @@ bad:
     return -1;
 }
 
+/* Rays per batch: the stop callback is polled between batches (and while records are
+ * written), so a batch must take a few ms at most even in a slow scene.  A ray costs
+ * up to `depth` interactions of about 0.1-1 us; 2^15 interactions per batch keeps a
+ * poll within ~30 ms while the batches stay large enough (64 rays or more) that
+ * handing them out costs under 1 % (results do not depend on the batch size). */
+static long stop_batch(int depth)
+{
+    long b = 32768 / (depth > 0 ? depth : 1);
+    return b < 64 ? 64 : b > 4096 ? 4096 : b;
+}
+
 static int run(const sc_scene *sc, sc_result *res, char *err)
 {
     const trace_api *tr = engine();
@@ -316,7 +349,10 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     opt.reflections = sc->reflections;
     opt.threads = sc->threads;
     opt.escape_length = sc->escape;
+    opt.batch = stop_batch(sc->depth);
     o.err = err;
+    o.stop = sc->stop;
+    o.stop_ctx = sc->stop_ctx;
     o.tty = isatty(2);
     o.t0 = now_ms();
     sink.ctx = &o;
@@ -330,14 +366,24 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
         fputs(hit_header, o.hit);
         sink.hit = w_hit;
     }
-    rc = tr->run(ts, &opt, &sink, &res->sum);
+    rc = stop_now(&o) ? TRACE_ECANCEL : tr->run(ts, &opt, &sink, &res->sum);
     if (o.shown) fputc('\n', stderr);
     res->progress_shown = o.shown;
+    res->stopped = o.stopped;
     if (rc < 0) {
         snprintf(err, SC_ERRMAX, "%s: the trace stopped: %s%s", sc->name,
-                 rc == TRACE_ECANCEL ? "an output could not be written" : tr->error(ts),
+                 o.stopped ? "interrupted" : rc == TRACE_ECANCEL ?
+                 "an output could not be written" : tr->error(ts),
                  sc->out_segments || sc->out_hits ? "; the outputs written so far are "
                  "left as .part files (incomplete)" : "");
+    } else if (sc->mismatch_error && res->sum.medium_mismatch) {
+        res->mismatch_failed = 1;
+        snprintf(err, SC_ERRMAX, "%s: %llu rays met a surface whose index on their side "
+                 "differs from the medium they travel in%s%s (the scene says `mismatch "
+                 "error`)%s", sc->name, (unsigned long long)res->sum.medium_mismatch,
+                 sc->nmismatch ? ": first " : "", sc->mismatch_where,
+                 sc->out_segments || sc->out_hits ? "; the outputs are left as .part "
+                 "files" : "");
     }
 out:
     /* finish() leaves a message in err on any failure */
@@ -350,7 +396,21 @@ out:
     return err[0] ? -1 : 0;
 }
 
-static const scene_api api = {SC_API_ABI, sc_load, sc_free, run, sc_tess_table, NULL};
+/* The table refuses a singlet whose surfaces cross within the semi-diameter, as
+ * add_lens does (the dialogue asks again before it gets here). */
+static int tess_table(const sc_tess_spec *sp, sc_tess_row *rows, char *err)
+{
+    trace_lens_surface a = {sp->r1, 0, sp->n, sp->aperture};
+    trace_lens_surface b = {sp->r2, sp->thickness, 1, sp->aperture};
+    double h, rim, edge;
+    if (trace_lens_cross(&a, &b, &h, &rim, &edge))
+        return snprintf(err, SC_ERRMAX, "tessellation table: the surfaces cross at height "
+                        "%.6g: their edge thickness at the semi-diameter %.6g is %.6g", h,
+                        rim, edge), -1;
+    return sc_tess_table(sp, rows, err);
+}
+
+static const scene_api api = {SC_API_ABI, sc_load, sc_free, run, tess_table, NULL};
 
 __attribute__((visibility("default"))) const scene_api *lm_scene_api(int abi)
 {

@@ -14,7 +14,16 @@ typedef struct hits {
     double *pos;        /* 3 per ray */
     unsigned char *got;
     uint64_t n;
+    int (*stop)(void *ctx);     /* the caller's stop request, polled per batch */
+    void *stop_ctx;
 } hits;
+
+static int on_progress(void *ctx, uint64_t done, uint64_t total)
+{
+    hits *k = ctx;
+    (void)done, (void)total;
+    return k->stop && k->stop(k->stop_ctx);
+}
 
 static int on_hit(void *ctx, const trace_hit *h)
 {
@@ -65,7 +74,7 @@ static int one_model(const trace_api *tr, const sc_tess_spec *sp, int model, int
     trace_material m = {TRACE_REFRACT, 1, 1}, dm = {TRACE_DETECT, 1, 1};
     trace_source src;
     trace_options opt;
-    trace_sink sink = {k, NULL, on_hit, NULL};
+    trace_sink sink = {k, NULL, on_hit, on_progress};
     trace_summary sum;
     int rc = -1;
 
@@ -116,8 +125,18 @@ static int one_model(const trace_api *tr, const sc_tess_spec *sp, int model, int
     opt.fresnel = 0;            /* one path per ray: compare like with like */
     opt.reflections = 0;
     opt.threads = sp->threads;
+    opt.batch = 4096;           /* a stop is seen within a few ms even on fine meshes */
     memset(k->got, 0, k->n);
-    if (tr->run(ts, &opt, &sink, &sum) < 0) goto engine;
+    rc = tr->run(ts, &opt, &sink, &sum);
+    if (rc == TRACE_ECANCEL) {
+        snprintf(err, SC_ERRMAX, "tessellation table: stopped");
+        rc = -1;
+        goto out;
+    }
+    if (rc < 0) {
+        rc = -1;
+        goto engine;
+    }
     row->trace_ms = sum.trace_ms;
     row->rays = (long)sum.rays;
     row->rays_per_s = sum.trace_ms > 0 ? (double)sum.rays / (sum.trace_ms / 1e3) : 0;
@@ -175,6 +194,8 @@ int sc_tess_table(const sc_tess_spec *sp, sc_tess_row *rows, char *err)
         !(sp->beam_radius <= sp->aperture))
         return snprintf(err, SC_ERRMAX, "tessellation table: the beam must be a grid of 1 to "
                         "10000 and fit the aperture"), -1;
+    ref.stop = k.stop = sp->stop;
+    ref.stop_ctx = k.stop_ctx = sp->stop_ctx;
     if (alloc_hits(&ref, n) || alloc_hits(&k, n)) {
         snprintf(err, SC_ERRMAX, "out of memory");
         goto out;

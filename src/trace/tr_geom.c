@@ -122,6 +122,11 @@ static void pad_box(tr_shape *g)
 static int init_aperture(tr_shape *g, const trace_surface *s, char *err, size_t cap)
 {
     g->aperture = s->aperture;
+    if (!tr_len_ok(s->width) || !tr_len_ok(s->height) || !tr_len_ok(s->r_outer) ||
+        !tr_len_ok(s->r_inner)) {
+        tr_set_err(err, cap, "aperture sizes must be 0 or %g to %g", TR_LEN_MIN, TR_LEN_MAX);
+        return -1;
+    }
     if (s->aperture == TRACE_AP_RECT) {
         if (!(s->width > 0 && s->height > 0 && isfinite(s->width) && isfinite(s->height))) {
             tr_set_err(err, cap, "rectangle needs a positive width and height");
@@ -188,6 +193,7 @@ static int init_axial(tr_shape *g, const trace_surface *s, char *err, size_t cap
     zlo = fmin(z0, z1) - extra;
     zhi = fmax(z0, z1) + extra;
     g->scale = fmax(smax, zhi - zlo);
+    g->reach = hypot(smax, fmax(fabs(zlo), fabs(zhi))) * (1 + 1e-9);
     local_box(g, smax, smax, zlo, zhi);
     return 0;
 }
@@ -202,6 +208,16 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
     }
     v_set(g->at, s->at);
     g->radius = s->radius;
+    if (!isinf(s->radius) && !tr_len_ok(s->radius)) {
+        tr_set_err(err, cap, "radius %g is out of range (0, or %g to %g)", s->radius,
+                   TR_LEN_MIN, TR_LEN_MAX);
+        return -1;
+    }
+    for (int i = 0; i < 3; i++)
+        if (fabs(s->at[i]) > TR_LEN_MAX) {
+            tr_set_err(err, cap, "surface position beyond |x| <= %g", TR_LEN_MAX);
+            return -1;
+        }
     switch (s->shape) {
     case TRACE_SPHERE:
         if (!(s->radius > 0 && isfinite(s->radius))) {
@@ -210,6 +226,7 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
         }
         g->w[2] = 1; frame(g, s->up);
         g->scale = s->radius;
+        g->reach = s->radius;
         for (int i = 0; i < 3; i++) {
             g->lo[i] = s->at[i] - s->radius;
             g->hi[i] = s->at[i] + s->radius;
@@ -238,6 +255,7 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
                 return -1;
             }
             g->scale = fmax(x, y);
+            g->reach = hypot(x, y) * (1 + 1e-9);
             local_box(g, x, y, 0, 0);
         }
         break;
@@ -260,7 +278,7 @@ int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap)
 /* ---- intersection ---- */
 
 static int plane_hit(const tr_shape *g, const double o[3], const double d[3],
-                     int leaving, double *t)
+                     int leaving, double *t, double p[3])
 {
     double lo[3], ld[3];
     if (leaving) return 0;
@@ -269,16 +287,21 @@ static int plane_hit(const tr_shape *g, const double o[3], const double d[3],
     if (ld[2] == 0) return 0;
     double tt = -lo[2] / ld[2];
     if (!(tt > 0)) return 0;
-    if (!tr_in_aperture(g, lo[0] + tt * ld[0], lo[1] + tt * ld[1])) return 0;
+    p[0] = lo[0] + tt * ld[0];
+    p[1] = lo[1] + tt * ld[1];
+    p[2] = 0;
+    if (!tr_in_aperture(g, p[0], p[1])) return 0;
     *t = tt;
-    return 1;
+    return tr_advance(g, lo, ld) > 0 ? 2 : 1;
 }
 
 /* p: the hit relative to the centre */
 static int sphere_hit(const tr_shape *g, const double o[3], const double d[3],
                       int leaving, double *t, double p[3])
 {
-    double q[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
+    double q[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]}, t0 = 0;
+    if (!leaving && (t0 = tr_advance(g, q, d)) > 0)     /* a far start: see tr_int.h */
+        for (int i = 0; i < 3; i++) q[i] += t0 * d[i];
     double A = v_dot(d, d), B = v_dot(q, d), R = g->radius;
     double l[3] = {q[0] - B / A * d[0], q[1] - B / A * d[1], q[2] - B / A * d[2]};
     double h2 = R * R - v_dot(l, l);
@@ -293,8 +316,8 @@ static int sphere_hit(const tr_shape *g, const double o[3], const double d[3],
     else if (r[1] > 0) tt = r[1];
     if (!(tt > 0)) return 0;
     for (int i = 0; i < 3; i++) p[i] = q[i] + tt * d[i];
-    *t = tt;
-    return 1;
+    *t = t0 + tt;
+    return t0 > 0 ? 2 : 1;
 }
 
 static void axial_normal_local(const tr_shape *g, const double p[3], double nl[3])
@@ -343,10 +366,12 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
                      int leaving, double *t, double p[3])
 {
     double lo[3], ld[3], r[2];
-    double c = g->c, k1 = 1.0 + g->k, tmin = 0;
+    double c = g->c, k1 = 1.0 + g->k, tmin = 0, t0 = 0;
     int nr = 0;
     to_local(g, o, lo);
     dir_local(g, d, ld);
+    if (!leaving && (t0 = tr_advance(g, lo, ld)) > 0)   /* a far start: see tr_int.h */
+        for (int j = 0; j < 3; j++) lo[j] += t0 * ld[j];
     double A = c * (ld[0] * ld[0] + ld[1] * ld[1] + k1 * ld[2] * ld[2]);
     double B = c * (lo[0] * ld[0] + lo[1] * ld[1] + k1 * lo[2] * ld[2]) - ld[2];
     double C = c * (lo[0] * lo[0] + lo[1] * lo[1] + k1 * lo[2] * lo[2]) - 2 * lo[2];
@@ -374,8 +399,8 @@ static int axial_hit(const tr_shape *g, const double o[3], const double d[3],
         if (!(tt > tmin)) continue;
         for (int j = 0; j < 3; j++) p[j] = lo[j] + tt * ld[j];
         if (!tr_axial_ok(g, p)) continue;
-        *t = tt;
-        return 1;
+        *t = t0 + tt;
+        return t0 > 0 ? 2 : 1;
     }
     return 0;
 }
@@ -385,11 +410,11 @@ int tr_shape_hit_t(const tr_shape *g, const double o[3], const double d[3], int 
 {
     switch (g->fast) {
     case TR_FAST_CONIC: return tr_conic_hit(g, o, d, leaving, t, p);
-    case TR_FAST_PLANE: return tr_plane_hit(g, o, d, leaving, t);
+    case TR_FAST_PLANE: return tr_plane_hit(g, o, d, leaving, t, p);
     default: break;
     }
     switch (g->shape) {
-    case TRACE_PLANE: return plane_hit(g, o, d, leaving, t);
+    case TRACE_PLANE: return plane_hit(g, o, d, leaving, t, p);
     case TRACE_SPHERE: return sphere_hit(g, o, d, leaving, t, p);
     default: return axial_hit(g, o, d, leaving, t, p);
     }
@@ -412,13 +437,23 @@ void tr_shape_hit_normal(const tr_shape *g, const double p[3], double n[3])
     }
 }
 
+void tr_shape_world(const tr_shape *g, const double p[3], double q[3])
+{
+    if (g->shape == TRACE_SPHERE) {               /* p is relative to the centre */
+        for (int i = 0; i < 3; i++) q[i] = g->at[i] + p[i];
+        return;
+    }
+    to_world_dir(g, p, q);
+    for (int i = 0; i < 3; i++) q[i] += g->at[i];
+}
+
 int tr_shape_hit(const tr_shape *g, const double o[3], const double d[3], int leaving,
                  double *t, double n[3])
 {
     double p[3];
-    if (!tr_shape_hit_t(g, o, d, leaving, t, p)) return 0;
-    tr_shape_hit_normal(g, p, n);
-    return 1;
+    int ok = tr_shape_hit_t(g, o, d, leaving, t, p);
+    if (ok) tr_shape_hit_normal(g, p, n);
+    return ok;
 }
 
 /* Single precision throughout (what a float-only tracer computes). */

@@ -1,7 +1,8 @@
 /* tr_int.h -- private to the trace engine's own files (tr_*.c); callers use trace.h.
  * Analytic surfaces in double (tr_geom.c), optics (tr_optics.c), sources
- * (tr_source.c), the scene and the trace loop on Embree (tr_engine.c), sequential
- * lenses (tr_lens.c). */
+ * (tr_source.c), the scene on Embree (tr_scene.c) and its next-hit query (tr_hit.c), the
+ * trace loop (tr_trace.c, tr_lanes.c, tr_pool.c: tr_eng.h), the table (tr_engine.c),
+ * sequential lenses (tr_lens.c). */
 #ifndef TR_INT_H
 #define TR_INT_H
 #include <math.h>
@@ -27,13 +28,30 @@ static inline void v_cross(const double a[3], const double b[3], double c[3])
     c[0] = x; c[1] = y; c[2] = z;
 }
 static inline double v_norm(const double a[3]) { return sqrt(v_dot(a, a)); }
+/* A finite vector whose squared length under- or overflows is scaled by its largest
+ * component first (dir 0 0 1e-170 is a direction); only zero and non-finite fail. */
 static inline int v_unit(double a[3])
 {
     double l = v_norm(a);
-    if (!(l > 0) || !isfinite(l)) return -1;
+    if (!(l > 0) || !isfinite(l)) {
+        double m = fmax(fabs(a[0]), fmax(fabs(a[1]), fabs(a[2])));
+        if (!(m > 0) || !isfinite(m)) return -1;
+        a[0] /= m; a[1] /= m; a[2] /= m;
+        l = v_norm(a);
+    }
     double r = 1.0 / l;
     a[0] *= r; a[1] *= r; a[2] *= r;
     return 0;
+}
+
+/* The one range of lengths and sizes (the scene reader's too): 0 where a size may be
+ * absent, else 1e-30 <= |x| <= 1e30, so that their squares and products neither
+ * underflow nor overflow. */
+#define TR_LEN_MIN 1e-30
+#define TR_LEN_MAX 1e30
+static inline int tr_len_ok(double x)
+{
+    return x == 0 || (fabs(x) >= TR_LEN_MIN && fabs(x) <= TR_LEN_MAX);
 }
 static inline void v_set(double d[3], const double s[3]) { d[0] = s[0]; d[1] = s[1]; d[2] = s[2]; }
 
@@ -49,6 +67,7 @@ typedef struct tr_shape {
     double r_outer2, r_inner2; /* squared; r_outer2 = 0: unbounded (sphere limit) */
     double hw, hh;             /* rectangle half width (along u), half height (v) */
     double scale;              /* size, for tolerances */
+    double reach;              /* no point of the surface lies farther from at */
     double lo[3], hi[3];       /* world bounds */
     int aligned;               /* u, v, w are the world's x, y, z */
     double k1, ck1;            /* 1 + k and c (1 + k), as the formulas compute them */
@@ -56,6 +75,21 @@ typedef struct tr_shape {
 } tr_shape;
 
 enum { TR_FAST_NONE, TR_FAST_CONIC, TR_FAST_PLANE };
+
+/* A ray starting farther than TR_FAR reaches before its closest approach to a
+ * surface's vertex is solved from an origin advanced, in double, to one reach before
+ * that point (tr_advance: the advance, or 0 for a ray near enough).  The quadratic's
+ * terms then cancel only as far as the surface's own size makes them, wherever the ray
+ * started: the hit keeps the precision of a ray started next to the surface (about the
+ * rounding of the start point itself), not one that falls with the square of the
+ * distance.  Points of the ray before the advanced origin are farther than the reach
+ * from the vertex, so no root is lost. */
+#define TR_FAR 4.0
+static inline double tr_advance(const tr_shape *g, const double lo[3], const double d[3])
+{
+    double t0 = -(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach;
+    return t0 > TR_FAR * g->reach ? t0 : 0;
+}
 
 /* Inside the aperture at local (x, y)? */
 static inline int tr_in_aperture(const tr_shape *g, double x, double y)
@@ -97,8 +131,10 @@ static inline int tr_conic_hit(const tr_shape *g, const double o[3], const doubl
                                int leaving, double *t, double p[3])
 {
     double lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
-    double c = g->c, k1 = g->k1, r[2];
+    double c = g->c, k1 = g->k1, r[2], t0 = 0;
     int nr = 0;
+    if (!leaving && (t0 = tr_advance(g, lo, d)) > 0)
+        for (int j = 0; j < 3; j++) lo[j] += t0 * d[j];
     double A = c * (d[0] * d[0] + d[1] * d[1] + k1 * d[2] * d[2]);
     double B = c * (lo[0] * d[0] + lo[1] * d[1] + k1 * lo[2] * d[2]) - d[2];
     if (leaving) {
@@ -115,8 +151,8 @@ static inline int tr_conic_hit(const tr_shape *g, const double o[3], const doubl
         if (!(tt > 0)) continue;
         for (int j = 0; j < 3; j++) p[j] = lo[j] + tt * d[j];
         if (!tr_axial_ok(g, p)) continue;
-        *t = tt;
-        return 1;
+        *t = t0 + tt;
+        return t0 > 0 ? 2 : 1;
     }
     return 0;
 }
@@ -131,19 +167,27 @@ static inline void tr_conic_normal_local(const tr_shape *g, const double p[3], d
     nl[0] *= l; nl[1] *= l; nl[2] *= l;
 }
 
-/* TR_FAST_PLANE: a plane whose frame is the world's. */
+/* TR_FAST_PLANE: a plane whose frame is the world's; p = the hit in local
+ * coordinates (z = 0). */
 static inline int tr_plane_hit(const tr_shape *g, const double o[3], const double d[3],
-                               int leaving, double *t)
+                               int leaving, double *t, double p[3])
 {
     if (leaving || d[2] == 0) return 0;
     double lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     double tt = -lo[2] / d[2];
     if (!(tt > 0)) return 0;
-    if (!tr_in_aperture(g, lo[0] + tt * d[0], lo[1] + tt * d[1])) return 0;
+    p[0] = lo[0] + tt * d[0];
+    p[1] = lo[1] + tt * d[1];
+    p[2] = 0;
+    if (!tr_in_aperture(g, p[0], p[1])) return 0;
     *t = tt;
-    return 1;
+    return tr_advance(g, lo, d) > 0 ? 2 : 1;
 }
 
+/* The hit functions below return 1 for a hit, and 2 for a hit of a ray that started
+ * far away (tr_advance): the caller then takes the hit point from the surface's own
+ * frame (tr_shape_world of the local point p), which holds it to the rounding of the
+ * surface's size, instead of o + t d, which rounds to that of the start point. */
 /* Validates and prepares; 0, or -1 with a message in err. */
 int tr_shape_init(tr_shape *g, const trace_surface *s, char *err, size_t cap);
 /* Nearest intersection with t > 0 of the ray o + t d (d unit).  `leaving`: the
@@ -156,6 +200,8 @@ int tr_shape_hit(const tr_shape *g, const double o[3], const double d[3], int le
 int tr_shape_hit_t(const tr_shape *g, const double o[3], const double d[3], int leaving,
                    double *t, double p[3]);
 void tr_shape_hit_normal(const tr_shape *g, const double p[3], double n[3]);
+/* The world point of the local hit point p that tr_shape_hit_t returned with 2. */
+void tr_shape_world(const tr_shape *g, const double p[3], double q[3]);
 /* The same computed in single precision (to compare with a float-only tracer). */
 int tr_shape_hit_float(const tr_shape *g, const double o[3], const double d[3],
                        int leaving, double *t, double n[3]);
@@ -230,7 +276,7 @@ int tr_add_lens(trace_scene *sc, const trace_lens *lens);
 int tr_lens_fan(const trace_lens *lens, double z_obj, double y_obj, double z_paraxial,
                 int nrays, const double *h, trace_fan_ray *out, char *err, size_t cap);
 
-/* Lens hints (tr_engine.c): after refraction at surface id a forward ray can only
+/* Lens hints (tr_scene.c): after refraction at surface id a forward ray can only
  * meet cand[0..n-1] (-1 entries skipped); valid until another surface is added. */
 void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n);
 int tr_scene_nsurf(const trace_scene *sc);

@@ -46,6 +46,13 @@ static int check_lens(const trace_lens *l, char *err, size_t cap)
                        i + 1, s->semi_diameter, fabs(s->radius));
             return -1;
         }
+        double h, rim, edge;
+        if (i && trace_lens_cross(&l->surf[i - 1], s, &h, &rim, &edge)) {
+            tr_set_err(err, cap, "surfaces %d and %d cross at height %.6g: their edge "
+                       "thickness at the semi-diameter %.6g is %.6g (surface %d lies left "
+                       "of surface %d there)", i, i + 1, h, rim, edge, i + 1, i);
+            return -1;
+        }
     }
     return 0;
 }
@@ -156,8 +163,17 @@ int tr_add_lens(trace_scene *sc, const trace_lens *l)
 typedef struct fan_ctx {
     trace_fan_ray *out;
     int *seen;
-    int n;
+    double *y1;         /* per ray: height where it meets surface 1 (NaN: it does not) */
+    int n, first;       /* rays; surface 1's id */
 } fan_ctx;
+
+static int fan_seg(void *ctx, const trace_segment *g)
+{
+    fan_ctx *f = ctx;
+    if (g->ray < (uint64_t)f->n && g->depth == 0)
+        f->y1[g->ray] = g->surface == f->first ? g->p1[1] : NAN;
+    return 0;
+}
 
 static int fan_hit(void *ctx, const trace_hit *h)
 {
@@ -177,86 +193,151 @@ static int fan_hit(void *ctx, const trace_hit *h)
     return 0;
 }
 
+/* Where the rays of a fan start and where they go: ray i is aimed at the point of
+ * surface 1 at height aim[i].  The object medium is homogeneous, so the straight line
+ * from the object to that point meets surface 1 there (the engine's hit is that point
+ * to rounding): the launch slope comes in closed form, no iteration.  A collimated
+ * ray runs parallel to the axis at height aim[i] and starts just left of surface 1
+ * and its mount (z_start), not far away: hits are solved about the ray's origin, so a
+ * far start costs precision (issue 9). */
+static void fan_rays(const trace_lens *l, double z_obj, double y_obj, double z_start,
+                     int n, const double *aim, trace_ray *rays)
+{
+    const trace_lens_surface *s1 = &l->surf[0];
+    for (int i = 0; i < n; i++) {
+        memset(&rays[i], 0, sizeof rays[i]);
+        if (isinf(z_obj)) {
+            rays[i].o[1] = aim[i];
+            rays[i].o[2] = z_start;
+            rays[i].d[2] = 1;
+        } else {
+            rays[i].o[1] = y_obj;
+            rays[i].o[2] = z_obj;
+            rays[i].d[1] = aim[i] - y_obj;
+            rays[i].d[2] = s1->z + sphere_sag(s1->radius, fabs(aim[i])) - z_obj;
+        }
+        rays[i].power = 1;
+    }
+}
+
+/* One trace of the fan through lens l (with its detector).  TRACE_OK or an error. */
+static int fan_once(const trace_api *tr, const trace_lens *l, const trace_ray *rays, int n,
+                    fan_ctx *fc, char *err, size_t cap)
+{
+    trace_scene *sc = tr->scene_new();
+    trace_source src;
+    trace_options o;
+    int rc;
+    if (!sc) {
+        tr_set_err(err, cap, "out of memory");
+        return TRACE_ENOMEM;
+    }
+    if ((rc = tr->add_lens(sc, l)) < 0) goto fail;
+    fc->first = rc;
+    memset(&src, 0, sizeof src);
+    src.type = TRACE_SRC_RAYS;
+    src.count = n;
+    src.ray = rays;
+    src.n_medium = l->n_object;
+    if ((rc = tr->add_source(sc, &src, NULL)) < 0) goto fail;
+    tr->options_default(&o);
+    o.fresnel = 0;
+    o.reflections = 0;
+    o.cutoff = 0;
+    o.threads = 1;
+    o.max_depth = 2 * l->nsurf + 4;
+    for (int i = 0; i < n; i++) {
+        fc->seen[i] = 0;
+        fc->y1[i] = NAN;
+    }
+    trace_sink sink = {fc, fan_seg, fan_hit, NULL};
+    if ((rc = tr->run(sc, &o, &sink, NULL)) < 0) goto fail;
+    tr->scene_free(sc);
+    return TRACE_OK;
+fail:
+    tr_set_err(err, cap, "%s", tr->error(sc));
+    tr->scene_free(sc);
+    return rc;
+}
+
 int tr_lens_fan(const trace_lens *lens, double z_obj, double y_obj, double z_par,
                 int nrays, const double *h, trace_fan_ray *out, char *err, size_t cap)
 {
     const trace_api *tr = trace_get_api(TRACE_ABI);
-    trace_scene *sc = NULL;
     trace_ray *rays = NULL;
+    double *aim = NULL, *y1 = NULL;
     int *seen = NULL, rc;
     if (check_lens(lens, err, cap)) return TRACE_EINVAL;
     if (nrays < 1 || !h || !out || !isfinite(z_par) || isnan(z_obj) || !isfinite(y_obj)) {
         tr_set_err(err, cap, "a fan needs rays, heights, outputs and a paraxial image z");
         return TRACE_EINVAL;
     }
-    double z1 = lens->surf[0].z, L = lens_scale(lens);
+    const trace_lens_surface *s1 = &lens->surf[0];
+    double z1 = s1->z;
     if (isfinite(z_obj) && z_obj >= z1) {
         tr_set_err(err, cap, "the object must lie left of the first surface");
         return TRACE_EINVAL;
     }
+    for (int i = 0; i < nrays; i++)
+        if (!isfinite(h[i])) {
+            tr_set_err(err, cap, "ray %d: height is not a number", i + 1);
+            return TRACE_EINVAL;
+        }
     trace_lens l = *lens;
     l.z_detector = z_par;
-    sc = tr->scene_new();
+    /* surface 1 and its mount reach left to z1 + its sag at the rim (< z1 if concave) */
+    double r1 = isfinite(s1->radius) ? fabs(s1->radius) : 0;
+    double rim = s1->semi_diameter > 0 ? s1->semi_diameter : r1;
+    double z_start = z1 + fmin(0.0, sphere_sag(s1->radius, rim)) - 0.01 * fmax(rim, 1e-3);
     rays = calloc((size_t)nrays, sizeof *rays);
     seen = calloc((size_t)nrays, sizeof *seen);
-    if (!sc || !rays || !seen) {
+    aim = calloc((size_t)nrays, sizeof *aim);
+    y1 = calloc((size_t)nrays, sizeof *y1);
+    if (!rays || !seen || !aim || !y1) {
         tr_set_err(err, cap, "out of memory");
         rc = TRACE_ENOMEM;
         goto done;
     }
-    if ((rc = tr->add_lens(sc, &l)) < 0) goto scene_err;
-    double z_start = z1 - 2 * L - 1;
-    for (int i = 0; i < nrays; i++) {
-        if (!isfinite(h[i])) {
-            tr_set_err(err, cap, "ray %d: height is not a number", i + 1);
-            rc = TRACE_EINVAL;
-            goto done;
+    fan_ctx fc = {out, seen, y1, nrays, -1};
+    memcpy(aim, h, (size_t)nrays * sizeof *aim);
+    /* A ray aimed at the very rim may land a rounding error outside it, or leave it
+     * onto its mount (which begins there): aim such rays a few units in the last place
+     * further in, until they get through (at most 8 times; what still does not is
+     * vignetted). */
+    for (int round = 0;; round++) {
+        for (int i = 0; i < nrays; i++) {
+            memset(&out[i], 0, sizeof out[i]);
+            out[i].h = h[i];
+            out[i].status = 1;
+            out[i].z_cross = out[i].lsa = out[i].y_image = out[i].opl = NAN;
         }
-        if (isinf(z_obj)) {
-            rays[i].o[1] = h[i];
-            rays[i].o[2] = z_start;
-            rays[i].d[2] = 1;
-        } else {
-            rays[i].o[1] = y_obj;
-            rays[i].o[2] = z_obj;
-            rays[i].d[1] = h[i] - y_obj;
-            rays[i].d[2] = z1 - z_obj;
-        }
-        rays[i].power = 1;
-        memset(&out[i], 0, sizeof out[i]);
-        out[i].h = h[i];
-        out[i].status = 1;
-        out[i].z_cross = out[i].lsa = out[i].y_image = out[i].opl = NAN;
+        fan_rays(&l, z_obj, y_obj, z_start, nrays, aim, rays);
+        if ((rc = fan_once(tr, &l, rays, nrays, &fc, err, cap)) < 0) goto done;
+        int again = 0;
+        for (int i = 0; i < nrays && round < 8; i++)
+            if (!seen[i] && rim > 0 && fabs(h[i]) >= rim * (1 - 1e-9) &&
+                fabs(h[i]) <= rim) {
+                aim[i] = h[i] * (1 - ldexp(1.0, 2 * round - 52));
+                again = 1;
+            }
+        if (!again) break;
     }
-    trace_source src;
-    memset(&src, 0, sizeof src);
-    src.type = TRACE_SRC_RAYS;
-    src.count = nrays;
-    src.ray = rays;
-    src.n_medium = lens->n_object;
-    if ((rc = tr->add_source(sc, &src, NULL)) < 0) goto scene_err;
-    trace_options o;
-    tr->options_default(&o);
-    o.fresnel = 0;
-    o.reflections = 0;
-    o.cutoff = 0;
-    o.threads = 1;
-    o.max_depth = 2 * l.nsurf + 4;
-    fan_ctx fc = {out, seen, nrays};
-    trace_sink sink = {&fc, NULL, fan_hit, NULL};
-    if ((rc = tr->run(sc, &o, &sink, NULL)) < 0) goto scene_err;
     for (int i = 0; i < nrays; i++) {
+        if (isnan(y1[i])) {             /* it missed surface 1: vignetted */
+            out[i].status = 1;
+            out[i].z_cross = out[i].lsa = out[i].y_image = out[i].opl = NAN;
+            continue;
+        }
+        out[i].h = y1[i];
         if (!seen[i]) continue;
         out[i].lsa = out[i].z_cross - z_par;
         if (isinf(z_obj)) out[i].opl -= lens->n_object * (z1 - z_start);
     }
     rc = TRACE_OK;
-    goto done;
-scene_err:
-    tr_set_err(err, cap, "%s", tr->error(sc));
 done:
-    tr->scene_free(sc);
     free(rays);
     free(seen);
+    free(aim);
+    free(y1);
     return rc;
 }

@@ -17,7 +17,7 @@ void tr_pk_set_clear(tr_pk_set *s)
 }
 
 void tr_pk_set_add(tr_pk_set *s, int id, const tr_shape *g, const trace_material *m,
-                   int leaving)
+                   int leaving, const tr_shape *from)
 {
     int i = s->nc;
     if (i < 0 || i >= 4 || i >= TR_PK) return;
@@ -28,18 +28,31 @@ void tr_pk_set_add(tr_pk_set *s, int id, const tr_shape *g, const trace_material
     s->id[i] = id;
     s->g[i] = g;
     s->leaving[i] = leaving;
+    /* a ray starting on `from` lies within |at - from's at| + from's reach of g's
+     * vertex: too near for tr_advance (with a margin for its rounding) if that is
+     * under (TR_FAR + 1) reaches; then the step need not ask */
+    s->farok[i] = 1;
+    if (from) {
+        double dv[3] = {from->at[0] - g->at[0], from->at[1] - g->at[1],
+                        from->at[2] - g->at[2]};
+        s->farok[i] = !(v_norm(dv) + from->reach <= 0.99 * (TR_FAR + 1) * g->reach);
+    }
+    s->anyfar |= s->farok[i];
     s->c[i] = g->c;
     s->ck1[i] = g->ck1;
     s->cone[i] = g->fast == TR_FAST_CONIC;
     s->kind[i] = m->kind;
     s->nf[i] = m->n_front;
     s->nb[i] = m->n_back;
-    for (int j = 0; j < 3; j++) s->wn[j][i] = -g->w[j];
+    for (int j = 0; j < 3; j++) {
+        s->wn[j][i] = -g->w[j];
+        s->at[j][i] = g->at[j];
+    }
     s->nc++;
 }
 
 /* Eight doubles make one AVX-512 register: what follows is compiled for AVX-512 (the
- * engine calls it only where the processor has it, see tr_engine.c).  The fused
+ * engine calls it only where the processor has it, see tr_lanes.c).  The fused
  * multiply-add it brings stays unused: -ffp-contract=off forbids it. */
 #pragma GCC target("avx2,avx512f,avx512vl,avx512dq")
 
@@ -123,11 +136,19 @@ static inline vm axial_ok(const tr_shape *g, const vd p[3])
 
 /* tr_conic_hit with tr_quad_roots: the roots in ascending order, the first one in
  * front on the vertex branch and the aperture wins. */
-static vm conic_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3], vd *t,
-                    vd p[3])
+static vm conic_hit(const tr_shape *g, int leaving, int farok, const vd o[3],
+                    const vd d[3], vd *t, vd p[3], vm *farout)
 {
     vd lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     double c = g->c, k1 = g->k1;
+    vd t0 = splat(0);
+    vm far = mask_none();
+    if (!leaving && farok) {             /* tr_advance: a far start */
+        t0 = -(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach;
+        far = t0 > TR_FAR * g->reach;
+        if (any(far))
+            for (int j = 0; j < 3; j++) lo[j] = sel(far, lo[j] + t0 * d[j], lo[j]);
+    }
     vd A = c * (d[0] * d[0] + d[1] * d[1] + k1 * d[2] * d[2]);
     vd B = c * (lo[0] * d[0] + lo[1] * d[1] + k1 * lo[2] * d[2]) - d[2];
     vd ra, rb;
@@ -151,30 +172,41 @@ static vm conic_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3]
     vd pa[3], pb[3];
     for (int j = 0; j < 3; j++) pa[j] = lo[j] + ra * d[j];
     vm oka = va & (ra > 0) & axial_ok(g, pa);
-    *t = ra;
+    int anyfar = !leaving && farok && any(far);
+    *farout = far;
+    *t = anyfar ? sel(far, t0 + ra, ra) : ra;
     for (int j = 0; j < 3; j++) p[j] = pa[j];
     vm need = vb & ~oka;
     if (!any(need)) return oka;            /* the usual case: no lane looks further */
     for (int j = 0; j < 3; j++) pb[j] = lo[j] + rb * d[j];
     vm okb = need & (rb > 0) & axial_ok(g, pb);
+    if (anyfar) { ra = sel(far, t0 + ra, ra); rb = sel(far, t0 + rb, rb); }
     *t = sel(oka, ra, rb);
     for (int j = 0; j < 3; j++) p[j] = sel(oka, pa[j], pb[j]);
     return oka | okb;
 }
 
 /* tr_plane_hit */
-static vm plane_hit(const tr_shape *g, int leaving, const vd o[3], const vd d[3], vd *t)
+static vm plane_hit(const tr_shape *g, int leaving, int farok, const vd o[3],
+                    const vd d[3], vd *t, vd p[3], vm *far)
 {
     if (leaving) return mask_none();
     vd lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     vd tt = -lo[2] / d[2];
     *t = tt;
-    return (d[2] != 0) & (tt > 0) & in_aperture(g, lo[0] + tt * d[0], lo[1] + tt * d[1]);
+    p[0] = lo[0] + tt * d[0];
+    p[1] = lo[1] + tt * d[1];
+    p[2] = splat(0);
+    *far = mask_none();
+    if (farok)
+        *far = (-(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach) > TR_FAR * g->reach;
+    return (d[2] != 0) & (tt > 0) & in_aperture(g, p[0], p[1]);
 }
 
 /* The chosen candidate of each lane and what the step needs of it. */
 typedef struct pick {
-    vd t, p[3];            /* distance and the conic's local hit point */
+    vd t, p[3];            /* distance and the local hit point */
+    vm far;                /* a far start: the hit point is at + p (tr_advance) */
     vm k;                  /* candidate index, -1: none */
     vm conic;              /* lanes whose candidate is a conic */
     vd kind;               /* its material (trace_material_kind) */
@@ -186,16 +218,19 @@ typedef struct pick {
 static void nearest(const tr_pk_set *s, const vd o[3], const vd d[3], pick *k)
 {
     vd best = splat(INFINITY), t, p[3];
+    vm far;
     k->k = msplat(-1);
+    k->far = mask_none();
     for (int j = 0; j < 3; j++) k->p[j] = splat(0);
     for (int i = 0; i < s->nc; i++) {
         int cone = s->g[i]->fast == TR_FAST_CONIC;
-        vm ok = cone ? conic_hit(s->g[i], s->leaving[i], o, d, &t, p)
-                     : plane_hit(s->g[i], s->leaving[i], o, d, &t);
+        vm ok = cone ? conic_hit(s->g[i], s->leaving[i], s->farok[i], o, d, &t, p, &far)
+                     : plane_hit(s->g[i], s->leaving[i], s->farok[i], o, d, &t, p, &far);
         vm up = ok & (t < best);
         best = sel(up, t, best);
         k->k = seli(up, msplat(i), k->k);
-        if (cone)
+        if (s->farok[i]) k->far = seli(up, far, k->far);
+        if (cone || (s->farok[i] && any(up & far)))   /* a plane's point: far starts */
             for (int j = 0; j < 3; j++) k->p[j] = sel(up, p[j], k->p[j]);
     }
     k->t = best;
@@ -293,6 +328,11 @@ unsigned tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *
     for (int i = 0; i < 3; i++) {
         q[i] = in->o[i] + k.t * in->d[i];
         x->nrm[i] = n[i];
+    }
+    if (st->anyfar && any(k.far)) {        /* on_hit: a far start's point (tr_advance) */
+        vm ix = k.k & 3;
+        for (int i = 0; i < 3; i++)
+            q[i] = sel(k.far, __builtin_shuffle(load(st->at[i]), ix) + k.p[i], q[i]);
     }
     vm fin = finite(q[0]) & finite(q[1]) & finite(q[2]) & finite(n[0]);
     out->len = in->len + k.t;

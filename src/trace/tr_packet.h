@@ -1,7 +1,7 @@
 /* tr_packet.h -- private to the trace engine: eight rays side by side through the
  * surfaces a sequential lens names (tr_packet.c), in vector arithmetic that rounds
  * exactly as the one-ray code does (tr_geom.c's fast shapes, tr_optics.c's Fresnel,
- * tr_engine.c's interaction): the same operations in the same order, where a branch
+ * tr_trace.c's interaction): the same operations in the same order, where a branch
  * becomes a select.  The engine keeps the books (counts, records, stacks); a ray the
  * packet cannot take one step further is handed back to the one-ray code unchanged. */
 #ifndef TR_PACKET_H
@@ -46,14 +46,19 @@ typedef struct tr_pk_set {
     int id[4];                   /* their surface ids */
     const tr_shape *g[4];
     int leaving[4];              /* the rays start on it */
+    int farok[4];                /* a ray may start far from it (tr_advance): 0 when
+                                    the rays start on a surface too near for that */
+    int anyfar;                  /* some farok[] is 1 */
     double c[TR_PK], ck1[TR_PK], cone[TR_PK], kind[TR_PK], nf[TR_PK], nb[TR_PK],
-           wn[3][TR_PK];         /* curvature terms, material kind and indices, -w */
+           wn[3][TR_PK],         /* curvature terms, material kind and indices, -w */
+           at[3][TR_PK];         /* vertices */
 } tr_pk_set;
 
-/* Empty s, then add the candidates in order (surface id, shape g, material m). */
+/* Empty s, then add the candidates in order (surface id, shape g, material m); from:
+ * the surface the rays start on (NULL: anywhere, from the sources). */
 void tr_pk_set_clear(tr_pk_set *s);
 void tr_pk_set_add(tr_pk_set *s, int id, const tr_shape *g, const trace_material *m,
-                   int leaving);
+                   int leaving, const tr_shape *from);
 
 /* What happened to each lane in a step. */
 enum {

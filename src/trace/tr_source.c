@@ -98,6 +98,12 @@ int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
                    s->n_medium);
         return -1;
     }
+    if (!(ts->s.power >= TR_LEN_MIN && ts->s.power <= TR_LEN_MAX) ||
+        !tr_len_ok(s->radius) || !tr_len_ok(s->waist) || !tr_len_ok(s->wavelength)) {
+        tr_set_err(err, cap, "source power, radius, waist and wavelength must be 0 (where "
+                   "absent) or %g to %g", TR_LEN_MIN, TR_LEN_MAX);
+        return -1;
+    }
     if (s->type != TRACE_SRC_RAYS && !finite3(s->at)) {
         tr_set_err(err, cap, "source position is not finite");
         return -1;
@@ -195,6 +201,14 @@ int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
         break;
     default:
         tr_set_err(err, cap, "unknown source type %d", s->type);
+        return -1;
+    }
+    if (ts->nrays < 1) {                /* e.g. a grid whose cells all miss its disc */
+        tr_set_err(err, cap, "the source emits no ray");
+        return -1;
+    }
+    if (s->type == TRACE_SRC_GAUSSIAN && !(ts->wsum > 0 && isfinite(ts->wsum))) {
+        tr_set_err(err, cap, "the Gaussian beam's ray weights are not finite");
         return -1;
     }
     if (s->pol != TRACE_UNPOLARISED && s->pol != TRACE_LINEAR) {

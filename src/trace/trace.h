@@ -247,7 +247,9 @@ typedef struct trace_lens {
 
 /* One meridional ray of a fan (object on the axis or in the y-z plane). */
 typedef struct trace_fan_ray {
-    double h;                  /* height at the first surface's vertex plane */
+    double h;                  /* in: the height aimed at on the first surface (the
+                                  ray meets surface 1 there); out: the height where it
+                                  met it (to rounding the same), or h if it missed */
     double z_cross;            /* where it crosses the axis after the last surface */
     double lsa;                /* z_cross - z_paraxial (longitudinal aberration) */
     double y_image;            /* height at z_paraxial (transverse aberration) */
@@ -301,7 +303,7 @@ typedef struct trace_api {
 
     /* Sequential lenses. */
     int (*add_lens)(trace_scene *sc, const trace_lens *lens);   /* id of surface 1 */
-    /* Trace nrays meridional rays of heights h[i] at the first vertex plane from the
+    /* Trace nrays meridional rays that meet the first surface at heights h[i] from the
      * object point (0, y_obj, z_obj) (z_obj = -INFINITY: a collimated beam parallel
      * to the axis) through the lens, geometry only, and compare with the paraxial
      * image z_paraxial supplied by the caller.  TRACE_OK or error (message in err). */
@@ -313,5 +315,48 @@ typedef struct trace_api {
 typedef const trace_api *(*trace_get_api_fn)(int abi);
 /* Exported by lensmat-trace.so: the table, or NULL if abi != TRACE_ABI. */
 const trace_api *trace_get_api(int abi);
+
+/* ---- a lens's geometry, checked without the module -------------------------------
+ * Inline so that the dialogue can refuse an answer at its question without loading
+ * the engine; tr_lens.c refuses the same lenses in add_lens and lens_fan.
+ * trace_lens_sag: the sag of a sphere of this radius (0 or inf: a plane) at height
+ * s <= |radius|.
+ * trace_lens_cross: do consecutive surfaces a, b (a left of b) cross within their
+ * semi-diameters?  The edge thickness t(s) = (b.z + sag_b(s)) - (a.z + sag_a(s)) of
+ * two spheres is monotone in s (t' = s (g(c_b) - g(c_a)) with g(c) = c / sqrt(1 - c^2
+ * s^2) increasing in the curvature c), so from t(0) = b.z - a.z >= 0 they cross iff t
+ * is negative at the rim: the smaller of the semi-diameters given (0 is none; when
+ * neither is given nothing is checked).  Returns 1 if they cross, with *h the height
+ * where t = 0 (0: they touch on the axis), *rim the rim height and *edge = t(rim) < 0;
+ * else 0. */
+static inline double trace_lens_sag(double radius, double s)
+{
+    if (!(radius != 0) || radius > 1e300 || radius < -1e300) return 0;
+    double c = 1 / radius, q = 1 - c * c * s * s;
+    return c * s * s / (1 + __builtin_sqrt(q > 0 ? q : 0));
+}
+static inline int trace_lens_cross(const trace_lens_surface *a, const trace_lens_surface *b,
+                                   double *h, double *rim, double *edge)
+{
+    double sa = a->semi_diameter, sb = b->semi_diameter;
+    double s = sa > 0 && sb > 0 ? (sa < sb ? sa : sb) : sa > 0 ? sa : sb;
+    if (!(s > 0)) return 0;
+    double za = a->z + trace_lens_sag(a->radius, s), zb = b->z + trace_lens_sag(b->radius, s);
+    double t = zb - za, scale = __builtin_fabs(za) + __builtin_fabs(zb) + s;
+    if (!(t < -1e-14 * scale)) return 0;
+    double lo = 0, hi = s;            /* t(lo) >= 0 > t(hi): bisection to the last bit */
+    if (b->z > a->z)
+        for (int i = 0; i < 200; i++) {
+            double mid = 0.5 * (lo + hi);
+            if (!(mid > lo && mid < hi)) break;
+            double tm = (b->z + trace_lens_sag(b->radius, mid)) -
+                        (a->z + trace_lens_sag(a->radius, mid));
+            if (tm >= 0) lo = mid; else hi = mid;
+        }
+    *h = lo;
+    *rim = s;
+    *edge = t;
+    return 1;
+}
 
 #endif

@@ -1,0 +1,29 @@
+#!/bin/sh
+# bench_imaging.sh -- the imaging engine's frame and centroid figures (issue 10):
+# centroid accuracy against the Cramer-Rao bound on 1000 synthetic 640x480 16-bit frames
+# and the time per frame of each method (tests/imaging/bench_centroid.c; the method
+# table goes to build/bench/centroid_methods.tsv for the plot), the synthesis time, and
+# the cost of loading the module for the first frame and the camera module for the first
+# video frame (tests/imaging/bench_load.c, median of 7 fresh processes).
+# BENCH_QUICK=1: 200 frames, 3 processes.
+B=build/obj/imaging_tests
+for b in bench_centroid bench_load; do
+    [ -x "$B/$b" ] || { echo "bench_imaging: $B/$b not built (make bench builds it)" >&2; exit 1; }
+done
+n=1000; runs=7
+[ -n "$BENCH_QUICK" ] && { n=200; runs=3; }
+echo "# machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; one thread"
+mkdir -p build/bench
+"$B/bench_centroid" "$n" build/bench/centroid_methods.tsv || exit 1
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+"$B/bench_load" build/lib --make-avi "$tmp/v.avi" || exit 1
+i=0
+while [ $i -lt $runs ]; do
+    "$B/bench_load" build/lib tests/imaging/fuzz-corpus/g16.png "$tmp/v.avi" >> "$tmp/load" || exit 1
+    i=$((i + 1))
+done
+med() { sort -n | awk '{v[NR] = $1} END {print v[int((NR + 1) / 2)]}'; }
+echo "BENCH imaging_load_ms $(cut -d' ' -f1 "$tmp/load" | med) ms"
+echo "BENCH imaging_first_read_ms $(cut -d' ' -f2 "$tmp/load" | med) ms"
+echo "BENCH camera_load_ms $(cut -d' ' -f3 "$tmp/load" | med) ms"

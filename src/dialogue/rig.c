@@ -1,0 +1,391 @@
+/* rig.c -- the cornea-rig dialogue (lensmat --rig): choose a rig file and a chip
+ * (the simulator, with its event log, or a GPIO chip through libgpiod), then home,
+ * move the joints, move to a target point on the cornea, expose, or scan N points;
+ * in the simulator every point is checked in closed loop (the simulated motors'
+ * pose through the exact forward model must land within the quantisation bound of
+ * the detector point).  The engine (build/lib/lensmat-rig.so) is loaded when the
+ * dialogue starts; its emergency_off is a stop hook, so a signal switches the laser
+ * off, then the drivers, before lensmat exits; every other way out closes the
+ * machine the same way.  Texts: prompts/rig.txt. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include "ask.h"
+#include "dialogues.h"
+#include "engine.h"
+#include "../rig/rig.h"
+#include "../trace/trace.h"
+#include "prompts_rig.h"
+
+#define P(k) rig_prompts[RIG_##k]
+#define WORD 4096
+#define DEG (3.14159265358979323846 / 180)
+
+typedef struct rdlg {
+    lm_io *io;
+    const rig_api *api;
+    rg_rig rig;
+    int have_rig, sim;
+    rg_machine *m;
+    char log[WORD], state[WORD + 8];
+    double worst_um, worst_bound_um;
+    int outside;
+    const trace_api *tr;        /* the independent check, loaded with the first point */
+    int tr_tried;
+} rdlg;
+
+static const rig_api *volatile hook_api;
+
+/* Stop hook (async-signal-safe: the engine's emergency path only). */
+static void laser_off_hook(void *ctx)
+{
+    (void)ctx;
+    if (hook_api && hook_api->emergency_off) hook_api->emergency_off();
+}
+
+static int stop_cb(void *ctx) { (void)ctx; return lm_stop_requested(); }
+
+static const char *const jname[RG_NJOINTS] = {"m1a", "m1b", "u", "v", "m2a", "m2b"};
+static int linear(int j) { return j == RG_J_U || j == RG_J_V; }
+
+/* "m1a 1 deg, m1b ..." of a pose (rad, mm). */
+static const char *pose_text(const rg_pose *p, char *buf, size_t cap)
+{
+    size_t n = 0;
+    buf[0] = 0;
+    for (int j = 0; j < RG_NJOINTS && n < cap; j++) {
+        double v = linear(j) ? p->j[j] : p->j[j] / DEG;
+        if (fabs(v) < 5e-13) v = 0;     /* no "-0" */
+        n += (size_t)snprintf(buf + n, cap - n, P(POSITION), j ? ", " : "", jname[j], v,
+                              linear(j) ? "mm" : "deg");
+    }
+    return buf;
+}
+
+/* ---- answers ------------------------------------------------------------------- */
+
+static int check_rig(void *ctx, const char *word, char *msg, size_t cap)
+{
+    rdlg *d = ctx;
+    d->have_rig = 0;
+    if (d->api->rig_load(word, &d->rig, msg, cap)) return -1;
+    d->have_rig = 1;
+    return 0;
+}
+
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return !stat(a, &sa) && !stat(b, &sb) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+static int check_log(void *ctx, const char *word, char *msg, size_t cap)
+{
+    rdlg *d = ctx;
+    static const char *const ext[] = {"", ".part", ".state", ".state.part"};
+    char name[WORD + 16];
+    if (!strcmp(word, "-")) return 0;
+    /* the log, the file it grows in and the shared state: none may be an input */
+    for (int i = 0; i < 4; i++) {
+        snprintf(name, sizeof name, "%s%s", word, ext[i]);
+        if (lm_check_output(d->io, name, msg, cap)) return -1;
+        if (same_file(name, d->rig.path)) { snprintf(msg, cap, P(LOG_IS_RIG), name); return -1; }
+    }
+    return 0;
+}
+
+static int ask_num(rdlg *d, const char *q, const char *what, unsigned flags, double min,
+                   double *v)
+{
+    lm_numspec spec = {what, flags, min};
+    return lm_ask_number(d->io, q, q, &spec, v);
+}
+
+/* An engine refusal: said (and recorded); in a replay it ends the session. */
+static int refused(rdlg *d, int rc, const char *err)
+{
+    lm_say(d->io, LM_BOTH, P(FAILED), err);
+    if (rc == RG_ESTOP || lm_stop_requested()) return LM_FAIL;
+    if (!d->io->interactive) {
+        fprintf(stderr, "lensmat: %s:%ld: %s\n", d->io->src, d->io->line, err);
+        return LM_FAIL;
+    }
+    return LM_GO;
+}
+
+/* ---- actions ------------------------------------------------------------------- */
+
+static int do_home(rdlg *d)
+{
+    char err[RG_ERRMAX], buf[512];
+    rg_pose p;
+    int rc = d->api->home(d->m, stop_cb, NULL, err, sizeof err);
+    if (rc) return refused(d, rc, err);
+    d->api->position(d->m, NULL, &p);
+    lm_say(d->io, LM_BOTH, P(HOMED), pose_text(&p, buf, sizeof buf));
+    return LM_GO;
+}
+
+static int do_joints(rdlg *d)
+{
+    char err[RG_ERRMAX], buf[512], q[256];
+    rg_pose p;
+    int rc;
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        double v;
+        snprintf(q, sizeof q, P(JOINT), jname[j], linear(j) ? "mm" : "degrees");
+        if ((rc = ask_num(d, q, P(JOINT_WHAT), 0, 0, &v))) return rc;
+        p.j[j] = linear(j) ? v : v * DEG;
+    }
+    if ((rc = d->api->move(d->m, &p, stop_cb, NULL, err, sizeof err))) return refused(d, rc, err);
+    d->api->position(d->m, NULL, &p);
+    lm_say(d->io, LM_BOTH, P(MOVED), pose_text(&p, buf, sizeof buf));
+    return LM_GO;
+}
+
+static int do_expose_ms(rdlg *d, double ms)
+{
+    char err[RG_ERRMAX];
+    int rc = d->api->expose(d->m, ms, stop_cb, NULL, err, sizeof err);
+    if (rc) return refused(d, rc, err);
+    lm_say(d->io, LM_BOTH, P(EXPOSED), ms);
+    return LM_GO;
+}
+
+static int ask_ms(rdlg *d, double *ms)
+{
+    return ask_num(d, P(EXPOSE_MS), P(EXPOSE_MS_WHAT), LM_POSITIVE, 0, ms);
+}
+
+/* Closed loop (simulator): the simulated motors' pose, through the exact forward
+ * model and through the trace engine (mirrors and cornea as surfaces, independent of
+ * the geometry code); the spot's miss at the detector point must be within the bound
+ * half a step on every joint can cause (first order, through the Jacobian).  miss
+ * (the larger of the two), traced (NAN without the tracer) and bound in um; 0 if the
+ * chip has no motor feedback. */
+static int closed_loop(rdlg *d, const double target[3], double *miss, double *traced,
+                       double *bound)
+{
+    const rig_api *a = d->api;
+    const rg_geometry *g = &d->rig.geom;
+    long s[RG_NJOINTS];
+    rg_pose p;
+    rg_beam b;
+    double J[4 * RG_NJOINTS], cond, e[2] = {0, 0};
+    char err[RG_ERRMAX];
+    if (!a->motors(d->m, s)) return 0;
+    for (int j = 0; j < RG_NJOINTS; j++)
+        p.j[j] = s[j] / d->rig.axis[j].steps_per * (linear(j) ? 1 : DEG);
+    *traced = NAN;
+    if (a->forward(g, &p, &b, err, sizeof err) ||
+        a->jacobian(g, &p, J, &cond, err, sizeof err)) { *miss = INFINITY; *bound = 0; return 1; }
+    for (int r = 0; r < 2; r++)
+        for (int j = 0; j < RG_NJOINTS; j++)
+            e[r] += fabs(J[(2 + r) * RG_NJOINTS + j]) * 0.5 / g->joint[j].steps_per;
+    *miss = 1e3 * sqrt((b.det[0] - g->detector[0]) * (b.det[0] - g->detector[0]) +
+                       (b.det[1] - g->detector[1]) * (b.det[1] - g->detector[1]) +
+                       (b.det[2] - g->detector[2]) * (b.det[2] - g->detector[2]));
+    *bound = 1e3 * sqrt(e[0] * e[0] + e[1] * e[1]) * (1 + 1e-6) + 1e-6;
+    if (!d->tr_tried) {
+        trace_get_api_fn get = (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
+        d->tr_tried = 1;
+        d->tr = get ? get(TRACE_ABI) : NULL;
+        if (!d->tr) lm_say(d->io, LM_BOTH, "%s", P(NO_TRACER));
+    }
+    if (d->tr && a->verify) {
+        rg_verify v;
+        if (a->verify(d->tr, g, &p, target, &v, err, sizeof err) || !v.hit) *traced = INFINITY;
+        else *traced = v.err_detector * 1e3;
+        if (*traced > *miss) *miss = *traced;
+    }
+    return 1;
+}
+
+/* Solve, quantise, move, (expose), check: one target. */
+static int visit(rdlg *d, const rg_target *t, double ms)
+{
+    const rig_api *a = d->api;
+    rg_solution s;
+    rg_quantised q;
+    long steps[RG_NJOINTS];
+    char err[RG_ERRMAX], buf[512], dg[512];
+    double miss, traced, bound;
+    int rc = a->solve(&d->rig.geom, t, NULL, &s, err, sizeof err);
+    if (rc) return refused(d, rc, err);
+    if ((rc = a->quantise(&d->rig.geom, t, &s, &q, err, sizeof err))) return refused(d, rc, err);
+    lm_say(d->io, LM_BOTH, P(SOLVED), s.target[0], s.target[1], s.target[2],
+           pose_text(&q.pose, buf, sizeof buf));
+    if (s.diag & (RG_D_ILLCOND | RG_D_NEAR_PARALLEL))
+        lm_say(d->io, LM_BOTH, P(WARN), a->diag_text(s.diag, dg, sizeof dg), s.cond);
+    lm_say(d->io, LM_BOTH, P(LANDING), q.err_cornea * 1e3, q.err_detector * 1e3);
+    for (int j = 0; j < RG_NJOINTS; j++) steps[j] = (long)q.steps[j];
+    if ((rc = a->move_steps(d->m, steps, stop_cb, NULL, err, sizeof err)))
+        return refused(d, rc, err);
+    if (ms > 0 && (rc = do_expose_ms(d, ms))) return rc;
+    if (closed_loop(d, s.target, &miss, &traced, &bound)) {
+        int ok = miss <= bound;
+        if (isnan(traced))
+            lm_say(d->io, LM_BOTH, P(CLOSED_LOOP_MODEL), miss, bound,
+                   ok ? P(CLOSED_OK) : P(CLOSED_BAD));
+        else
+            lm_say(d->io, LM_BOTH, P(CLOSED_LOOP), miss, traced, bound,
+                   ok ? P(CLOSED_OK) : P(CLOSED_BAD));
+        if (miss > d->worst_um) d->worst_um = miss;
+        if (bound > d->worst_bound_um) d->worst_bound_um = bound;
+        d->outside += !ok;
+    } else {
+        lm_say(d->io, LM_BOTH, "%s", P(NO_FEEDBACK));
+    }
+    return LM_GO;
+}
+
+static int have_geometry(rdlg *d)
+{
+    const rig_api *a = d->api;
+    if (a->solve && a->quantise && a->forward && a->jacobian && a->diag_text) return 1;
+    lm_say(d->io, LM_BOTH, "%s\n", P(NO_GEOMETRY));
+    return 0;
+}
+
+static int do_point(rdlg *d)
+{
+    static const char *const kinds[] = {"angles", "height", NULL};
+    rg_target t;
+    double x, phi;
+    int rc, k;
+    if (!have_geometry(d)) return refused(d, RG_EINVAL, P(NO_GEOMETRY));
+    if ((rc = lm_ask_choice(d->io, P(TARGET_KIND), P(TARGET_KIND), P(TARGET_KIND_WHAT), kinds,
+                            &k)))
+        return rc;
+    if (k == 0) rc = ask_num(d, P(THETA), P(THETA_WHAT), LM_NONNEG, 0, &x);
+    else rc = ask_num(d, P(HEIGHT), P(HEIGHT_WHAT), LM_NONNEG, 0, &x);
+    if (rc || (rc = ask_num(d, P(PHI), P(PHI_WHAT), 0, 0, &phi))) return rc;
+    t.kind = k == 0 ? RG_T_ANGLES : RG_T_HEIGHT;
+    t.a = k == 0 ? x * DEG : x;
+    t.b = phi * DEG;
+    return visit(d, &t, 0);
+}
+
+static int do_scan(rdlg *d)
+{
+    double n, hmax, ms;
+    int rc;
+    if (!have_geometry(d)) return refused(d, RG_EINVAL, P(NO_GEOMETRY));
+    if ((rc = ask_num(d, P(SCAN_N), P(SCAN_N_WHAT), LM_POSITIVE, 0, &n))) return rc;
+    if (n != floor(n) || n > 1e6) {
+        char m[128];
+        snprintf(m, sizeof m, "%g points: give a whole number from 1 to 1000000", n);
+        return refused(d, RG_EINVAL, m);
+    }
+    if ((rc = ask_num(d, P(SCAN_H), P(SCAN_H_WHAT), LM_NONNEG, 0, &hmax)) ||
+        (rc = ask_ms(d, &ms)))
+        return rc;
+    d->worst_um = d->worst_bound_um = 0;
+    d->outside = 0;
+    /* a sunflower (Vogel) spiral: even cover of the disc, no two points on a ring */
+    for (long k = 0; k < (long)n; k++) {
+        rg_target t;
+        t.kind = RG_T_HEIGHT;
+        t.a = hmax * sqrt((k + 0.5) / n);
+        t.b = fmod(k * 137.50776405, 360) * DEG;
+        lm_say(d->io, LM_BOTH, P(SCAN_POINT), (int)k + 1, (int)n, t.a, t.b / DEG);
+        if ((rc = visit(d, &t, ms))) return rc;
+    }
+    lm_say(d->io, LM_BOTH, P(SCAN_DONE), (int)n, d->worst_um, d->worst_bound_um, d->outside);
+    if (d->outside && !d->io->interactive) return LM_FAIL;
+    return LM_GO;
+}
+
+/* ---- the session ---------------------------------------------------------------- */
+
+static int need_engine(rdlg *d)
+{
+    rig_get_api_fn get = (rig_get_api_fn)lm_engine_symbol("rig", RIG_API_SYMBOL);
+    if (get) d->api = get(RIG_ABI);
+    if (!d->api || !d->api->open) {
+        if (get) fprintf(stderr, "lensmat: the rig module's interface does not match\n");
+        return -1;
+    }
+    return 0;
+}
+
+static int open_machine(rdlg *d)
+{
+    static const char *const backends[] = {"sim", "gpiod", NULL};
+    rg_open_opts o = {RG_BACKEND_SIM, NULL, NULL, NULL, 0};
+    char err[RG_ERRMAX];
+    int rc, b;
+    if ((rc = lm_ask_choice(d->io, P(BACKEND), P(BACKEND), P(BACKEND_WHAT), backends, &b)))
+        return rc;
+    d->sim = b == 0;
+    if (d->sim) {
+        if ((rc = lm_ask_word(d->io, P(SIM_LOG), P(SIM_LOG), P(SIM_LOG_WHAT), check_log, d,
+                              d->log, sizeof d->log)))
+            return rc;
+        if (strcmp(d->log, "-")) {
+            o.sim_log = d->log;
+            snprintf(d->state, sizeof d->state, "%s.state", d->log);
+            o.sim_state = d->state;
+        }
+    } else {
+        o.backend = RG_BACKEND_GPIOD;
+        o.realtime = 1;
+    }
+    hook_api = d->api;
+    lm_on_stop(laser_off_hook, NULL);
+    if ((rc = d->api->open(&d->rig, &o, &d->m, err, sizeof err))) {
+        lm_say(d->io, LM_REC, P(OPEN_FAILED), err);
+        fprintf(stderr, "lensmat: %s\n", err);
+        return LM_FAIL;
+    }
+    lm_say(d->io, LM_BOTH, P(OPENED), d->sim ? P(OPENED_SIM) : d->rig.chip);
+    lm_say(d->io, LM_OUT, P(SCHED_OUT), d->api->sched_note(d->m));
+    return LM_GO;
+}
+
+int lm_rig(lm_io *io)
+{
+    static const char *const actions[] = {"home", "joints", "point", "expose", "scan", "quit",
+                                          NULL};
+    rdlg *d = calloc(1, sizeof *d);
+    char name[WORD];
+    int rc, a;
+    if (!d) { fprintf(stderr, "lensmat: out of memory\n"); return LM_FAIL; }
+    d->io = io;
+    lm_say(io, LM_BOTH, "%s", P(INTRO));
+    if (need_engine(d)) { free(d); return LM_FAIL; }
+    rc = lm_ask_word(io, P(RIG_FILE), P(RIG_FILE), P(RIG_FILE_WHAT), check_rig, d, name,
+                     sizeof name);
+    if (!rc) {
+        const rg_rig *r = &d->rig;
+        lm_say(io, LM_BOTH, P(RIG_LOADED), r->path, r->chip, r->laser.offset,
+               r->interlock.offset, r->max_on_ms, r->tick_us);
+        rc = open_machine(d);
+    }
+    while (!rc) {
+        double ms;
+        if ((rc = lm_ask_choice(io, P(ACTION), P(ACTION), P(ACTION_WHAT), actions, &a))) break;
+        if (a == 5) break;
+        rc = a == 0 ? do_home(d) : a == 1 ? do_joints(d) : a == 2 ? do_point(d)
+           : a == 3 ? ((rc = ask_ms(d, &ms)) ? rc : do_expose_ms(d, ms)) : do_scan(d);
+    }
+    /* every way out: laser off, then drivers disabled */
+    if (d->m) {
+        d->api->close(d->m);
+        d->m = NULL;
+        lm_say(io, LM_BOTH, "%s", P(CLOSED));
+        if (d->state[0]) unlink(d->state);
+        if (d->sim && strcmp(d->log, "-")) lm_say(io, LM_OUT, P(WRITTEN_OUT), d->log);
+    }
+    lm_on_stop_remove(laser_off_hook, NULL);
+    free(d);
+    if (rc == LM_FAIL || rc == LM_QUIT) return rc;
+    lm_check_leftover(io);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    return LM_GO;
+}
+
+const char *lm_rig_example(void) { return P(EXAMPLE); }

@@ -1,0 +1,394 @@
+/* rg_file.c -- the rig file reader: plain "key value" lines (README "Rig files"),
+ * '#' comments, one "axis NAME" block per joint.  Every error names FILE:LINE:
+ * unknown keys, a key given twice, bad numbers, a GPIO line used twice, values out of
+ * range.  The geometry keys go to the geometry part (rg_geom_file_key). */
+#define _DEFAULT_SOURCE
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include "rig/rg_hw.h"
+
+#define MAXFILE (1 << 20)
+#define MAXWORDS 24
+
+static const char *const axis_names[RG_NJOINTS] = {"m1a", "m1b", "u", "v", "m2a", "m2b"};
+
+typedef struct reader {
+    const char *name;
+    long line;
+    rg_rig *rig;
+    int cur;                    /* current axis, -1 before the first */
+    char *err;
+    size_t cap;
+    /* where each key was given (duplicates): globals, then per axis */
+    long gseen[16];
+    long aseen[RG_NJOINTS][16];
+    const rig_api *geo;         /* the geometry half (its keys), or NULL */
+} reader;
+
+static int fail(reader *r, const char *fmt, ...)
+{
+    va_list ap;
+    int n = snprintf(r->err, r->cap, "%s:%ld: ", r->name, r->line);
+    if (n < 0 || (size_t)n >= r->cap) n = 0;
+    va_start(ap, fmt);
+    vsnprintf(r->err + n, r->cap - n, fmt, ap);
+    va_end(ap);
+    return RG_EINVAL;
+}
+
+static int number(reader *r, const char *key, const char *w, double *v)
+{
+    char *end;
+    if (!w) return fail(r, "'%s' needs a number", key);
+    errno = 0;
+    *v = strtod(w, &end);
+    if (end == w || *end || errno == ERANGE || !isfinite(*v))
+        return fail(r, "'%s' is not a number (for '%s')", w, key);
+    return 0;
+}
+
+static int positive(reader *r, const char *key, const char *w, double max, double *v)
+{
+    int rc = number(r, key, w, v);
+    if (rc) return rc;
+    if (!(*v > 0) || *v > max) return fail(r, "'%s' must be greater than 0 and at most %g",
+                                           key, max);
+    return 0;
+}
+
+static int yesno(reader *r, const char *key, const char *w, const char *yes,
+                 const char *no, int *v)
+{
+    if (w && !strcmp(w, yes)) { *v = 1; return 0; }
+    if (w && !strcmp(w, no)) { *v = 0; return 0; }
+    return fail(r, "'%s' takes '%s' or '%s'", key, yes, no);
+}
+
+/* "OFFSET [active_low]" */
+static int line_spec(reader *r, const char *key, char **w, int nw, rg_line *l)
+{
+    char *end;
+    long v;
+    if (nw < 2) return fail(r, "'%s' needs a line offset", key);
+    errno = 0;
+    v = strtol(w[1], &end, 10);
+    if (end == w[1] || *end || errno || v < 0 || v > 1023)
+        return fail(r, "'%s' is not a line offset (0 to 1023) for '%s'", w[1], key);
+    if (nw > 3 || (nw == 3 && strcmp(w[2], "active_low")))
+        return fail(r, "after the offset of '%s' only 'active_low' may follow", key);
+    l->offset = (int)v;
+    l->active_low = nw == 3;
+    l->at = (int)r->line;
+    return 0;
+}
+
+enum { G_CHIP, G_LASER, G_INTERLOCK, G_HEART, G_MAXON, G_TICK, G_HTIMEOUT, G_HOMETO,
+       G_SETTLE, G_SIMRT, G_SIMIL, G_SIMILMS, NG };
+static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
+    "max_on_ms", "tick_us", "heartbeat_timeout_ms", "home_timeout_s", "settle_ms",
+    "sim_realtime", "sim_interlock", "sim_interlock_open_ms"};
+enum { A_STEP, A_DIR, A_ENABLE, A_HOME, A_STEPS, A_MIN, A_MAX, A_SPEED, A_ACCEL,
+       A_HOMEAT, A_HOMEDIR, A_HOMESPEED, A_DIRINV, A_SIMHOME, NA };
+static const char *const akeys[NA] = {"step", "dir", "enable", "home", "steps_per", "min",
+    "max", "speed", "accel", "home_at", "home_dir", "home_speed", "dir_invert", "sim_home"};
+
+static int find(const char *const *keys, int n, const char *k)
+{
+    for (int i = 0; i < n; i++) if (!strcmp(keys[i], k)) return i;
+    return -1;
+}
+
+static int global_key(reader *r, int k, char **w, int nw)
+{
+    rg_rig *g = r->rig;
+    const char *a = nw > 1 ? w[1] : NULL;
+    if (nw > (k == G_LASER || k == G_INTERLOCK || k == G_HEART ? 3 : 2))
+        return fail(r, "'%s' takes one value", w[0]);
+    switch (k) {
+    case G_CHIP:
+        if (!a) return fail(r, "'chip' needs a name");
+        if (strlen(a) >= sizeof g->chip) return fail(r, "the chip name is too long");
+        strcpy(g->chip, a);
+        return 0;
+    case G_LASER: return line_spec(r, w[0], w, nw, &g->laser);
+    case G_INTERLOCK: return line_spec(r, w[0], w, nw, &g->interlock);
+    case G_HEART: return line_spec(r, w[0], w, nw, &g->heartbeat);
+    case G_MAXON: return positive(r, w[0], a, 60000, &g->max_on_ms);
+    case G_TICK: {
+        int rc = number(r, w[0], a, &g->tick_us);
+        if (!rc && !(g->tick_us >= 20 && g->tick_us <= 100000))
+            return fail(r, "'tick_us' must be from 20 to 100000");
+        return rc;
+    }
+    case G_HTIMEOUT: return positive(r, w[0], a, 10000, &g->heartbeat_timeout_ms);
+    case G_HOMETO: return positive(r, w[0], a, 3600, &g->home_timeout_s);
+    case G_SETTLE: {
+        int rc = number(r, w[0], a, &g->settle_ms);
+        if (!rc && !(g->settle_ms >= 0 && g->settle_ms <= 60000))
+            return fail(r, "'settle_ms' must be from 0 to 60000");
+        return rc;
+    }
+    case G_SIMRT: return yesno(r, w[0], a, "yes", "no", &g->sim_realtime);
+    case G_SIMIL: return yesno(r, w[0], a, "open", "closed", &g->sim_interlock_open);
+    case G_SIMILMS: {
+        int rc = number(r, w[0], a, &g->sim_interlock_open_ms);
+        if (!rc && !(g->sim_interlock_open_ms >= 0))
+            return fail(r, "'sim_interlock_open_ms' must be 0 or more");
+        return rc;
+    }
+    }
+    return 0;
+}
+
+static int axis_key(reader *r, int k, char **w, int nw)
+{
+    rg_axis *x = &r->rig->axis[r->cur];
+    const char *a = nw > 1 ? w[1] : NULL;
+    if (nw > (k <= A_HOME ? 3 : 2)) return fail(r, "'%s' takes one value", w[0]);
+    switch (k) {
+    case A_STEP: return line_spec(r, w[0], w, nw, &x->step);
+    case A_DIR: return line_spec(r, w[0], w, nw, &x->dir);
+    case A_ENABLE: return line_spec(r, w[0], w, nw, &x->enable);
+    case A_HOME: return line_spec(r, w[0], w, nw, &x->home);
+    case A_STEPS: return positive(r, w[0], a, 1e7, &x->steps_per);
+    case A_MIN: return number(r, w[0], a, &x->min);
+    case A_MAX: return number(r, w[0], a, &x->max);
+    case A_SPEED: return positive(r, w[0], a, 1e6, &x->speed);
+    case A_ACCEL: return positive(r, w[0], a, 1e9, &x->accel);
+    case A_HOMEAT: return number(r, w[0], a, &x->home_at);
+    case A_HOMEDIR:
+        if (a && !strcmp(a, "+")) { x->home_dir = 1; return 0; }
+        if (a && !strcmp(a, "-")) { x->home_dir = -1; return 0; }
+        return fail(r, "'home_dir' takes '+' or '-'");
+    case A_HOMESPEED: return positive(r, w[0], a, 1e6, &x->home_speed);
+    case A_DIRINV: return yesno(r, w[0], a, "yes", "no", &x->dir_invert);
+    case A_SIMHOME: {
+        int ok = 1, rc = yesno(r, w[0], a, "ok", "broken", &ok);
+        x->sim_home_broken = !ok;
+        return rc;
+    }
+    }
+    return 0;
+}
+
+static int one_line(reader *r, char *s)
+{
+    char *w[MAXWORDS + 1], *p = s;
+    int nw = 0, k;
+    char *hash = strchr(s, '#');
+    if (hash) *hash = 0;
+    while (*p && isspace((unsigned char)*p)) p++;
+    if (!*p) return 0;
+    while (*p) {
+        while (*p && isspace((unsigned char)*p)) *p++ = 0;
+        if (!*p) break;
+        if (nw == MAXWORDS) return fail(r, "too many words on this line");
+        w[nw++] = p;
+        while (*p && !isspace((unsigned char)*p)) p++;
+    }
+    if (!strcmp(w[0], "axis")) {
+        int j = nw == 2 ? find(axis_names, RG_NJOINTS, w[1]) : -1;
+        if (j < 0) return fail(r, "'axis' takes one of m1a m1b u v m2a m2b");
+        if (r->rig->axis[j].at)
+            return fail(r, "axis %s is given twice (first at line %d)", w[1],
+                        r->rig->axis[j].at);
+        r->rig->axis[j].at = (int)r->line;
+        r->cur = j;
+        return 0;
+    }
+    if ((k = find(gkeys, NG, w[0])) >= 0) {
+        if (r->gseen[k]) return fail(r, "'%s' is given twice (first at line %ld)", w[0],
+                                     r->gseen[k]);
+        r->gseen[k] = r->line;
+        return global_key(r, k, w, nw);
+    }
+    if ((k = find(akeys, NA, w[0])) >= 0) {
+        if (r->cur < 0)
+            return fail(r, "'%s' belongs to an axis: put it after an 'axis NAME' line", w[0]);
+        if (r->aseen[r->cur][k])
+            return fail(r, "'%s' is given twice for axis %s (first at line %ld)", w[0],
+                        axis_names[r->cur], r->aseen[r->cur][k]);
+        r->aseen[r->cur][k] = r->line;
+        return axis_key(r, k, w, nw);
+    }
+    if (r->geo && r->geo->geometry_key) {
+        char gerr[RG_ERRMAX];
+        int g;
+        if (!strcmp(w[0], "joint"))
+            return fail(r, "'joint' is for geometry-only files: here each axis block gives "
+                        "its steps and travel");
+        g = r->geo->geometry_key(&r->rig->geom, nw, (const char *const *)w, gerr,
+                                 sizeof gerr);
+        if (g == 0) { r->rig->geom_keys++; return 0; }
+        if (g != 1) return fail(r, "%s", gerr);
+    }
+    return fail(r, "unknown key '%s'", w[0]);
+}
+
+typedef struct named_line { const rg_line *l; char what[32]; } named_line;
+
+/* Whole-file checks: required keys, ranges, every GPIO line used once. */
+static int finish(reader *r)
+{
+    rg_rig *g = r->rig;
+    named_line all[RG_NJOINTS * 4 + 3];
+    int n = 0;
+    static const char *const lname[4] = {"STEP", "DIR", "ENABLE", "home"};
+    r->line = 0;
+#define WHOLE(...) (snprintf(r->err, r->cap, __VA_ARGS__), RG_EINVAL)
+    if (!g->chip[0]) return WHOLE("%s: no 'chip' line", r->name);
+    if (g->laser.offset < 0) return WHOLE("%s: no 'laser' line", r->name);
+    if (g->interlock.offset < 0) return WHOLE("%s: no 'interlock' line", r->name);
+    if (!(g->max_on_ms > 0)) return WHOLE("%s: no 'max_on_ms' line", r->name);
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        rg_axis *x = &g->axis[j];
+        const char *an = axis_names[j];
+        double rate;
+        if (!x->at) return WHOLE("%s: no 'axis %s' block", r->name, an);
+        r->line = x->at;
+        if (x->step.offset < 0) return fail(r, "axis %s has no 'step' line", an);
+        if (x->dir.offset < 0) return fail(r, "axis %s has no 'dir' line", an);
+        if (!(x->steps_per > 0)) return fail(r, "axis %s has no 'steps_per' line", an);
+        if (!r->aseen[j][A_MIN] || !r->aseen[j][A_MAX])
+            return fail(r, "axis %s needs 'min' and 'max'", an);
+        if (!(x->min < x->max)) return fail(r, "axis %s: 'min' must be less than 'max'", an);
+        if (!(x->speed > 0) || !(x->accel > 0))
+            return fail(r, "axis %s needs 'speed' and 'accel'", an);
+        if (fabs(x->min) * x->steps_per > 1e12 || fabs(x->max) * x->steps_per > 1e12)
+            return fail(r, "axis %s: the travel is more than 1e12 steps", an);
+        rate = x->speed * x->steps_per;
+        if (rate > 1e6 / g->tick_us)
+            return fail(r, "axis %s: speed %g is %g steps/s, more than one step per control "
+                        "step (tick_us %g: %g steps/s)", an, x->speed, rate, g->tick_us,
+                        1e6 / g->tick_us);
+        if (x->home.offset >= 0) {
+            if (!x->home_dir) return fail(r, "axis %s: its home switch needs 'home_dir'", an);
+            if (!r->aseen[j][A_HOMEAT])
+                return fail(r, "axis %s: its home switch needs 'home_at'", an);
+            if (!(x->home_at >= x->min && x->home_at <= x->max))
+                return fail(r, "axis %s: 'home_at' %g is outside its travel [%g, %g]", an,
+                            x->home_at, x->min, x->max);
+            if (!(x->home_speed > 0)) x->home_speed = x->speed / 4;
+            if (x->home_speed > x->speed)
+                return fail(r, "axis %s: 'home_speed' is more than 'speed'", an);
+        } else if (!r->aseen[j][A_HOMEAT]) {
+            return fail(r, "axis %s has neither a 'home' switch nor 'home_at' (where it "
+                        "stands at power-on)", an);
+        }
+        for (int k = 0; k < 4; k++) {
+            const rg_line *l = k == 0 ? &x->step : k == 1 ? &x->dir : k == 2 ? &x->enable
+                             : &x->home;
+            if (l->offset < 0) continue;
+            all[n].l = l;
+            snprintf(all[n].what, sizeof all[n].what, "the %s line of axis %s", lname[k], an);
+            n++;
+        }
+    }
+    all[n].l = &g->laser; strcpy(all[n++].what, "the laser line");
+    all[n].l = &g->interlock; strcpy(all[n++].what, "the interlock line");
+    if (g->heartbeat.offset >= 0) { all[n].l = &g->heartbeat; strcpy(all[n++].what, "the heartbeat line"); }
+    for (int a = 0; a < n; a++)
+        for (int b = 0; b < n; b++)
+            if (a != b && all[a].l->offset == all[b].l->offset &&
+                (all[a].l->at < all[b].l->at || (all[a].l->at == all[b].l->at && a < b))) {
+                r->line = all[b].l->at;
+                return fail(r, "line %d is already %s (line %d)", all[b].l->offset,
+                            all[a].what, all[a].l->at);
+            }
+    if (g->heartbeat.offset >= 0 && !(g->heartbeat_timeout_ms > 0))
+        g->heartbeat_timeout_ms = 5;
+    /* the geometry's joints are the axes (per rad for angles) */
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        const rg_axis *x = &g->axis[j];
+        double u = x->linear ? 1 : M_PI / 180;
+        g->geom.joint[j].steps_per = x->steps_per / u;
+        g->geom.joint[j].lo = x->min * u;
+        g->geom.joint[j].hi = x->max * u;
+    }
+    if (r->geo && r->geo->geometry_check) {
+        char gerr[RG_ERRMAX];
+        if (r->geo->geometry_check(&g->geom, gerr, sizeof gerr))
+            return WHOLE("%s: the geometry: %s", r->name, gerr);
+    }
+#undef WHOLE
+    return 0;
+}
+
+static void defaults(rg_rig *g, const rig_api *geo)
+{
+    memset(g, 0, sizeof *g);
+    if (geo && geo->geometry_default) geo->geometry_default(&g->geom);
+    g->laser.offset = g->interlock.offset = g->heartbeat.offset = -1;
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        rg_axis *x = &g->axis[j];
+        x->step.offset = x->dir.offset = x->enable.offset = x->home.offset = -1;
+        x->linear = j == RG_J_U || j == RG_J_V;
+    }
+    g->tick_us = 250;
+    g->home_timeout_s = 30;
+    g->sim_interlock_open_ms = -1;
+}
+
+int rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,
+                 size_t cap)
+{
+    reader r;
+    char buf[4096];
+    size_t i = 0;
+    memset(&r, 0, sizeof r);
+    r.name = name; r.rig = rig; r.cur = -1; r.err = err; r.cap = cap;
+    r.geo = rg_geom_api();
+    defaults(rig, r.geo);
+    snprintf(rig->path, sizeof rig->path, "%s", name);
+    while (i < len) {
+        size_t e = i, n;
+        int rc;
+        r.line++;
+        while (e < len && text[e] != '\n') e++;
+        n = e - i;
+        if (memchr(text + i, 0, n)) return fail(&r, "a NUL byte: this is not a text file");
+        if (n >= sizeof buf) return fail(&r, "the line is longer than %zu characters",
+                                         sizeof buf - 1);
+        memcpy(buf, text + i, n);
+        buf[n] = 0;
+        if ((rc = one_line(&r, buf))) return rc;
+        i = e + 1;
+    }
+    return finish(&r);
+}
+
+int rg_rig_load(const char *path, rg_rig *rig, char *err, size_t cap)
+{
+    FILE *f = fopen(path, "r");
+    char *text;
+    size_t n;
+    int rc;
+    struct stat st;
+    if (!f) { snprintf(err, cap, "%s: %s", path, strerror(errno)); return RG_EINVAL; }
+    if (fstat(fileno(f), &st) || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        snprintf(err, cap, "%s: not a regular file", path);
+        return RG_EINVAL;
+    }
+    text = malloc(MAXFILE + 1);
+    if (!text) { fclose(f); snprintf(err, cap, "%s: out of memory", path); return RG_ENOMEM; }
+    n = fread(text, 1, MAXFILE + 1, f);
+    if (ferror(f)) {
+        snprintf(err, cap, "%s: %s", path, strerror(errno));
+        rc = RG_EINVAL;
+    } else if (n > MAXFILE) {
+        snprintf(err, cap, "%s: larger than %d bytes: not a rig file", path, MAXFILE);
+        rc = RG_EINVAL;
+    } else {
+        rc = rg_rig_parse(text, n, path, rig, err, cap);
+    }
+    free(text);
+    fclose(f);
+    return rc;
+}

@@ -1,0 +1,91 @@
+/* rg_hw.h -- inside the machine part of the rig engine (not public): the chip
+ * interface both backends implement (rg_sim.c, rg_gpiod.c, rg_null in rg_sim.c), the
+ * machine state shared by motion (rg_motion.c) and safety (rg_safety.c), and the
+ * geometry half reached through its table. */
+#ifndef RG_HW_H
+#define RG_HW_H
+#include <stdint.h>
+#include "rig/rg_int.h"
+
+/* Output groups: each is one bulk request, so one call changes all its lines (all
+ * STEP lines together).  Bit j of a mask or value is axis j (RG_J_*); LASER and
+ * HEART have bit 0 only.  Values are logical: 1 = active (active-low applied by the
+ * backend). */
+enum { RG_G_STEP, RG_G_DIR, RG_G_ENABLE, RG_G_LASER, RG_G_HEART, RG_NGROUPS };
+/* Inputs: bit j = home switch of axis j is active (tripped); RG_IN_INTERLOCK = closed. */
+#define RG_IN_INTERLOCK (1u << RG_NJOINTS)
+
+typedef struct rg_chip rg_chip;
+typedef struct rg_chip_ops {
+    /* Set the lines of group g whose bits are in mask to the bits of val. */
+    int  (*set)(rg_chip *c, int g, unsigned mask, unsigned val);
+    /* Current input levels, and the inputs that changed (an edge event) since the
+     * last call: a short opening of the interlock is seen even if closed again. */
+    int  (*inputs)(rg_chip *c, unsigned *level, unsigned *edges);
+    int64_t (*now)(rg_chip *c);                 /* ns */
+    void (*sleep_until)(rg_chip *c, int64_t t); /* absolute deadline, ns */
+    /* Async-signal-safe: laser inactive, then every ENABLE inactive. */
+    void (*emergency)(rg_chip *c);
+    /* Release everything (after the caller switched laser and drivers off). */
+    void (*close)(rg_chip *c);
+    /* Moves and exposures tell the simulator what they do (log lines); may be NULL. */
+    void (*note)(rg_chip *c, const char *what);
+    /* The motors' positions where the chip knows them (simulator): 1, else 0. */
+    int  (*motors)(rg_chip *c, long steps[RG_NJOINTS]);
+} rg_chip_ops;
+struct rg_chip { const rg_chip_ops *ops; };
+
+int rg_sim_open(const rg_rig *rig, const rg_open_opts *o, rg_chip **c, char *err,
+                size_t cap);
+int rg_null_open(const rg_rig *rig, rg_chip **c, char *err, size_t cap);
+int rg_gpiod_open(const rg_rig *rig, const char *chip, rg_chip **c, char *err,
+                  size_t cap);
+
+#define RG_TIMING_MAX 65536     /* lateness samples kept (a ring) */
+struct rg_machine {
+    const rg_rig *rig_ptr;
+    rg_rig rig;
+    rg_chip *chip;
+    long pos[RG_NJOINTS];       /* commanded position, steps */
+    int homed;
+    unsigned dir_val;           /* last DIR values written */
+    int laser_on;
+    char sched[160];            /* what real-time scheduling got */
+    /* step-edge lateness (real clock backends) */
+    long late_n;
+    float *late;                /* RG_TIMING_MAX samples, us */
+    int measure;                /* 1: record lateness */
+    struct rg_machine *next;    /* the list emergency_off walks */
+};
+
+/* rg_motion.c */
+int  rg_pose_steps(const rg_rig *rig, const rg_pose *p, long steps[RG_NJOINTS], char *err,
+                   size_t cap);
+int  rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop, void *ctx,
+                   char *err, size_t cap);
+int  rg_move(rg_machine *m, const rg_pose *p, rg_stop_fn stop, void *ctx, char *err,
+             size_t cap);
+int  rg_home(rg_machine *m, rg_stop_fn stop, void *ctx, char *err, size_t cap);
+void rg_position(const rg_machine *m, long steps[RG_NJOINTS], rg_pose *p);
+int64_t rg_tick_ns(const rg_rig *rig);
+int  rg_plan_move(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
+                  double *seconds, char *err, size_t cap);
+void rg_wait(rg_machine *m, int64_t deadline);  /* sleep_until + lateness record */
+/* rg_safety.c */
+int  rg_open(const rg_rig *rig, const rg_open_opts *o, rg_machine **m, char *err,
+             size_t cap);
+int  rg_close(rg_machine *m);
+int  rg_expose(rg_machine *m, double ms, rg_stop_fn stop, void *ctx, char *err,
+               size_t cap);
+void rg_emergency_off(void);
+void rg_laser_off(rg_machine *m);
+void rg_get_timing(const rg_machine *m, rg_timing *t);
+const char *rg_sched_note(const rg_machine *m);
+/* rg_file.c */
+int  rg_rig_load(const char *path, rg_rig *rig, char *err, size_t cap);
+int  rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,
+                  size_t cap);
+/* The geometry half's table (rig_get_api): its rig-file keys, default and check. */
+const rig_api *rg_geom_api(void);
+
+#endif

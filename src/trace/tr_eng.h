@@ -1,0 +1,235 @@
+/* tr_eng.h -- private to the engine's core files: the scene as the trace loop sees it
+ * (tr_scene.c builds it on Embree, tr_hit.c answers "which surface next"), a ray's
+ * working state and books (tr_trace.c, the recursive trace loop), the lanes of the
+ * packet path (tr_lanes.c) and the worker the thread pool hands batches to
+ * (tr_pool.c).  The exported table is in tr_engine.c. */
+#ifndef TR_ENG_H
+#define TR_ENG_H
+#include <embree3/rtcore.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "tr_int.h"
+#include "tr_packet.h"
+
+#pragma GCC visibility push(hidden)
+
+typedef struct tr_surf {
+    int id, is_mesh;
+    trace_material mat;
+    tr_shape shape;            /* analytic surface, or a mesh's underlying one */
+    int has_under, refine;
+    double *vtx;               /* mesh: nv*3 */
+    uint32_t *idx;             /* mesh: ntri*3 */
+    double *media;             /* mesh: ntri*2 or NULL */
+    long nv, ntri;
+    double eps;                /* mesh: plane distances below this are "here" */
+    int closed;                /* mesh: closed and consistently wound, its normals
+                                  outward (1) or inward (-1); 0: not known closed */
+    int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
+    const tr_shape *seqg[4];   /* ... and their shapes */
+    tr_pk_set pk;              /* ... laid out for the packet */
+    double pad;                /* analytic: its Embree box grows by this (tr_build) */
+    const double *eoff;        /* ... and moves by minus the scene's eoff */
+    int group, gprev, gnext;   /* analytic surfaces at the same place (the same shape,
+                                  position, axis and aperture): the group's first
+                                  member, the members before and after it in the
+                                  order they were added; -1: none (tr_build) */
+} tr_surf;
+
+/* Embree sees coordinates in single precision: surfaces reaching beyond TR_EMBREE_MAX
+ * (or unbounded) stay out of its BVH and are tested in double on every query, and
+ * Embree's rays start where they enter the box of what it holds (see nearest()). */
+#define TR_EMBREE_MAX 1e15
+
+struct trace_scene {
+    char err[512];
+    tr_surf **surf;
+    int nsurf, capsurf;
+    tr_source *src;
+    int nsrc, capsrc;
+    uint64_t nrays;
+    RTCDevice dev;
+    RTCScene scn;
+    int built;
+    double build_ms;
+    int *far, nfar;            /* surfaces outside Embree's range, tested in double */
+    int nembree;               /* surfaces Embree holds */
+    int ngroup;                /* surfaces in a group of coincident ones */
+    int nclosed;               /* closed meshes */
+    double elo[3], ehi[3];     /* ... their box, grown by epad */
+    double nlo[3], nhi[3];     /* ... grown by its diagonal: a ray starting in there
+                                  hands Embree its own origin */
+    double epad;               /* how far a float ray may stray from the double one */
+    double eoff[3];            /* Embree's coordinates are the world's minus this (the
+                                  centre of its box): a scene far from the origin keeps
+                                  single precision's digits for its own size */
+    int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
+    int entry[4], nentry;      /* lens: what a forward ray from left of it meets first */
+    const tr_shape *entryg[4];
+    tr_pk_set entry_pk;
+    double entry_z;            /* ... if it starts at z < entry_z */
+};
+
+typedef struct tr_hitrec {
+    int surf;
+    long prim;
+    double t, n[3];                  /* n: unit normal pointing into the front side */
+    int far;                         /* 1: the hit point is q (a far start), else o + t d */
+    double q[3];
+} tr_hitrec;
+
+static inline double tr_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+typedef struct tr_tally {
+    double emitted, detected, absorbed, escaped, cutoff;
+    uint32_t segments, interactions, tir, hits, cut_depth, cut_power, cut_reflection,
+             mismatch, failures;
+    int max_depth;
+    int fail_cause, fail_surf;   /* the ray's first numerical failure (TR_FAIL_*) */
+} tr_tally;
+
+/* Why a ray failed numerically (every failure makes the run an error, see tr_pool.c). */
+enum { TR_FAIL_NONE, TR_FAIL_POINT, TR_FAIL_DIR, TR_FAIL_POWER };
+
+/* The first failure of a batch, of a run: which ray, why, where. */
+typedef struct tr_failure {
+    uint64_t ray;
+    int cause, surf;
+} tr_failure;
+
+/* The powers of one ray's tally: summed ray by ray, in ray order, so that the sums
+ * keep their bits whatever the thread count (the counts are summed in any order). */
+typedef struct tr_power {
+    double emitted, detected, absorbed, escaped, cutoff;
+} tr_power;
+
+typedef struct tr_wray {
+    double o[3], d[3];
+    double n, len, opl;
+    tr_pol pol;
+    int depth, last_surf;
+    long last_prim;
+    uint32_t hist;
+} tr_wray;
+
+typedef struct tr_buf {
+    void *p;
+    size_t n, cap, size;
+} tr_buf;
+
+/* Room for one more record at the end of b (NULL: out of memory). */
+static inline void *buf_slot(tr_buf *b)
+{
+    if (b->n == b->cap) {
+        size_t cap = b->cap ? 2 * b->cap : 1024;
+        void *p = realloc(b->p, cap * b->size);
+        if (!p) return NULL;
+        b->p = p;
+        b->cap = cap;
+    }
+    return (char *)b->p + b->n++ * b->size;
+}
+
+/* Append all of a's records to b and empty a. */
+static inline int buf_move(tr_buf *b, tr_buf *a)
+{
+    if (a->n == 0) return 0;
+    if (b->n + a->n > b->cap) {
+        size_t cap = b->cap ? b->cap : 1024;
+        while (cap < b->n + a->n) cap *= 2;
+        void *p = realloc(b->p, cap * b->size);
+        if (!p) return -1;
+        b->p = p;
+        b->cap = cap;
+    }
+    memcpy((char *)b->p + b->n * b->size, a->p, a->n * a->size);
+    b->n += a->n;
+    a->n = 0;
+    return 0;
+}
+
+/* Where a ray's records go: the worker's buffers, or a lane's until its turn. */
+typedef struct tr_out {
+    tr_buf seg, hit;
+} tr_out;
+
+/* Rays traced side by side on the lens shortcut (tr_packet.c): TR_PK rays' arithmetic
+ * in vector registers, one step at a time. */
+#define TR_LANES TR_PK
+
+typedef struct tr_lane {
+    tr_wray r;                   /* its doubles live in the packet while it runs */
+    tr_tally *ty;
+    uint64_t ray;
+    double p0;
+    int sp, live;
+    int state;                   /* LANE_RUN, LANE_DONE, LANE_SLOW */
+    tr_wray *stack;
+    tr_out out;
+} tr_lane;
+enum { LANE_RUN, LANE_DONE, LANE_SLOW };
+
+typedef struct tr_worker {
+    const trace_scene *sc;
+    const trace_options *o;
+    uint64_t first, count;       /* the batch in hand: global ray numbers */
+    tr_tally tally[TR_LANES];    /* the rays in hand (trace_lanes: one per lane) */
+    tr_power *power;             /* the batch's powers, one per ray (its slot's) */
+    trace_summary *counts;       /* the batch's counts (its slot's) */
+    int want_seg, want_hit;
+    tr_failure fail;             /* the batch's first failure (cause 0: none) */
+    tr_out out;
+    tr_wray *stack;
+    tr_lane lane[TR_LANES];
+    int nomem;
+} tr_worker;
+
+/* ---- the scene (tr_scene.c) ---- */
+trace_scene *tr_scene_new(void);
+void tr_scene_free(trace_scene *sc);
+const char *tr_scene_error(const trace_scene *sc);
+int tr_add_surface(trace_scene *sc, const trace_surface *s, const trace_material *m);
+int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m);
+int tr_add_source(trace_scene *sc, const trace_source *s, uint64_t *first);
+int tr_build(trace_scene *sc, double *ms);
+/* ---- the next hit (tr_hit.c) ---- */
+/* Embree's callbacks (tr_build attaches them). */
+void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a);
+void tr_user_occluded(const struct RTCOccludedFunctionNArguments *a);
+void tr_mesh_filter(const struct RTCFilterFunctionNArguments *a);
+/* The next surface a ray meets: the lens shortcut (the same hits, bit for bit), else
+ * Embree; 0 if none. */
+int tr_find_hit(const trace_scene *sc, const trace_options *o, const double org[3],
+                const double d[3], int last, long last_prim, uint32_t hist,
+                tr_hitrec *h);
+
+/* ---- the trace loop (tr_trace.c) ---- */
+void tr_emit_segment(tr_worker *w, tr_out *out, const tr_wray *r, uint64_t ray,
+                     const double p1[3], int end, int surf);
+void tr_emit_hit(tr_worker *w, tr_out *out, const tr_wray *r, uint64_t ray,
+                 const tr_hitrec *h, const double p[3]);
+int tr_strong(const tr_worker *w, tr_tally *ty, double p, double p0);
+void tr_keep(tr_worker *w, tr_tally *ty, int *sp, const tr_wray *c, double p0);
+void tr_ray_start(tr_wray *r, const tr_ray0 *r0, tr_tally *ty, double *p0);
+void tr_trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int sp,
+                   tr_wray *rp, int live, uint64_t ray, double p0);
+void tr_trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty);
+void tr_fold(tr_worker *w, uint64_t i, const tr_tally *t);
+void tr_scene_ray(const trace_scene *sc, int *k, uint64_t g, tr_ray0 *r);
+
+/* ---- the packet orchestration (tr_lanes.c) ---- */
+void tr_trace_batch(tr_worker *w);
+
+/* ---- the run (tr_pool.c) ---- */
+void tr_options_default(trace_options *o);
+int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
+           trace_summary *sum);
+
+#pragma GCC visibility pop
+#endif

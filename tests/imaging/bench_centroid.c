@@ -1,0 +1,123 @@
+/* bench_centroid.c -- issue 10's centroid and synthesis figures: 1000 synthetic 640x480
+ * 16-bit frames (B = 100, sigma = 50, A = 1000, w = 3 px, uniform sub-pixel positions)
+ * located by each method; RMS error per coordinate against the Cramer-Rao bound, median
+ * time per frame (one thread), the same-run baseline of reading the frame once, and the
+ * synthesis time.  Arguments: [N frames] [TSV file for the method table]. */
+#include "it.h"
+
+enum { NMETH = 4 };
+static const char *meth_name[NMETH] = {"gauss_fit", "moments", "moments_bg", "gauss_fit_plane"};
+static const int meth_id[NMETH] = {IM_CM_GAUSS, IM_CM_MOMENTS, IM_CM_MOMENTS_BG, IM_CM_GAUSS};
+
+static volatile uint64_t sink;
+
+/* The baseline: every sample read once and summed, vectorised like the engine's pass. */
+__attribute__((target_clones("arch=skylake-avx512", "avx2", "default"), optimize("O3")))
+static uint64_t sum_frame(const uint16_t *restrict p, size_t n)
+{
+    uint64_t total = 0;
+    for (size_t i = 0; i < n; i += 4096) {
+        uint32_t s = 0;
+        size_t e = i + 4096 < n ? i + 4096 : n;
+        for (size_t k = i; k < e; k++) s += p[k];
+        total += s;
+    }
+    return total;
+}
+
+int main(int argc, char **argv)
+{
+    const im_frame_api *fa = it_api();
+    int n = argc > 1 ? atoi(argv[1]) : 1000;
+    const char *tsv = argc > 2 ? argv[2] : NULL;
+    im_sensor s = it_sensor();
+    im_centroider *c = fa->centroider_new();
+    double *tsyn = malloc(sizeof(double) * n), *tread = malloc(sizeof(double) * n);
+    double *tm[NMETH], se[NMETH] = {0}, sig2 = 0;
+    int found[NMETH] = {0}, nsig = 0;
+    long iters = 0;
+    uint64_t z = 12345;
+    char err[256];
+    for (int m = 0; m < NMETH; m++) tm[m] = malloc(sizeof(double) * n);
+    if (n < 1 || !c || !tsyn || !tread) return 1;
+    for (int k = 0; k < n; k++) {
+        double x = 20 + 600 * it_uniform(&z), y = 20 + 440 * it_uniform(&z), t0;
+        im_spot_src sp = it_spot(x, y);
+        im_frame *f;
+        t0 = it_now();
+        if (fa->synth(&s, &sp, 1, 1000 + (uint64_t)k, 1, &f, err, sizeof err)) {
+            fprintf(stderr, "bench_centroid: %s\n", err);
+            return 1;
+        }
+        tsyn[k] = it_now() - t0;
+        /* Baseline: read every sample of the frame once. */
+        sink += sum_frame(f->px, (size_t)f->width * f->height);
+        t0 = it_now();
+        sink += sum_frame(f->px, (size_t)f->width * f->height);
+        tread[k] = it_now() - t0;
+        for (int m = 0; m < NMETH; m++) {
+            im_centroid_opt o;
+            im_spot spot[4];
+            im_centroid_result r;
+            memset(&o, 0, sizeof o);
+            o.method = meth_id[m];
+            o.plane = m == 3;
+            t0 = it_now();
+            int rc = fa->centroid(c, f, &o, spot, 4, &r, err, sizeof err);
+            tm[m][k] = it_now() - t0;
+            if (rc || r.outcome != IM_FOUND_ONE) continue;
+            found[m]++;
+            se[m] += (spot[0].x - x) * (spot[0].x - x) + (spot[0].y - y) * (spot[0].y - y);
+            if (m == 0) iters += spot[0].iter;
+            if (m == 0) { sig2 += 0.5 * (spot[0].sx * spot[0].sx + spot[0].sy * spot[0].sy); nsig++; }
+        }
+        fa->frame_free(f);
+    }
+    /* Shot noise on (a camera at gain 1 e/count), the other synthesis path. */
+    im_sensor s2 = s;
+    s2.shot_noise = 1; s2.background = 1e5; s2.read_noise = 10;
+    double tshot[21];
+    for (int k = 0; k < 21; k++) {
+        im_spot_src sp = it_spot(320.3, 240.7);
+        im_frame *f;
+        double t0 = it_now();
+        fa->synth(&s2, &sp, 1, (uint64_t)k, 1, &f, err, sizeof err);
+        tshot[k] = it_now() - t0;
+        fa->frame_free(f);
+    }
+    double crb = it_crb();
+    double rms[NMETH], med[NMETH];
+    for (int m = 0; m < NMETH; m++) {
+        rms[m] = found[m] ? sqrt(se[m] / (2.0 * found[m])) : INFINITY;
+        med[m] = it_median(tm[m], n) * 1e6;
+    }
+    double read_us = it_median(tread, n) * 1e6;
+    printf("# %d frames 640x480 16-bit, B=100 sigma=50 A=1000 w=3 px; CRB %.4f px; "
+           "found %d/%d/%d/%d of %d; %.1f fit iterations\n", n, crb, found[0], found[1],
+           found[2], found[3], n, (double)iters / n);
+    printf("BENCH centroid_rms_px %.4f px\n", rms[0]);
+    printf("BENCH centroid_vs_crb %.3f ratio\n", rms[0] / crb);
+    printf("BENCH centroid_sigma_vs_rms %.3f ratio\n", sqrt(sig2 / (nsig ? nsig : 1)) / rms[0]);
+    printf("BENCH centroid_moments_rms_px %.4f px\n", rms[1]);
+    printf("BENCH centroid_moments_bg_rms_px %.4f px\n", rms[2]);
+    printf("BENCH centroid_plane_rms_px %.4f px\n", rms[3]);
+    printf("BENCH centroid_us %.1f us\n", med[0]);
+    printf("BENCH centroid_plane_us %.1f us\n", med[3]);
+    printf("BENCH centroid_moments_us %.1f us\n", med[1]);
+    printf("BENCH centroid_moments_bg_us %.1f us\n", med[2]);
+    printf("BENCH frame_read_once_us %.1f us\n", read_us);
+    printf("BENCH centroid_vs_read %.2f ratio\n", med[0] / read_us);
+    printf("BENCH frame_synth_ms %.3f ms\n", it_median(tsyn, n) * 1e3);
+    printf("BENCH frame_synth_shot_ms %.3f ms\n", it_median(tshot, 21) * 1e3);
+    if (tsv) {
+        FILE *o = fopen(tsv, "w");
+        if (o) {
+            fprintf(o, "method\trms_px\tus_per_frame\n");
+            for (int m = 0; m < NMETH; m++)
+                fprintf(o, "%s\t%.5f\t%.1f\n", meth_name[m], rms[m], med[m]);
+            fclose(o);
+        }
+    }
+    fa->centroider_free(c);
+    return 0;
+}

@@ -1,0 +1,255 @@
+/* vm_rig.c -- the libgpiod backend against the kernel's own GPIO character device:
+ * run inside the gpio-vm guest (tests/t_85_rig_gpio.sh) with the gpio-sim chip
+ * $GPIO_CHIP, whose lines the test reads and drives through $GPIO_SIM/sim_gpioN/
+ * (value: what we drive; pull: drives an input).  Checks: a line held by another
+ * consumer refused by name, unknown chip and line, homing against a home switch that
+ * another process trips, slow moves whose STEP pulses and DIR level are counted
+ * through sysfs, the heartbeat toggling and the laser going low when the interlock
+ * opens mid-exposure, and SIGTERM mid-scan: laser low, then drivers disabled.
+ * argv[1]: the rig file (tests/rig/vm.rig).  Prints PASS/FAIL lines; exit 0 or 1. */
+#define _GNU_SOURCE
+#include <fcntl.h>
+#include <gpiod.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include "rig/rig.h"
+#include "unit.h"
+
+static const rig_api *rg;
+static const char *sim_dir;
+
+static int64_t now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000;
+}
+
+static void msleep(int ms) { usleep((useconds_t)ms * 1000); }
+
+static int sysval(int line)
+{
+    char p[300], b[8] = "";
+    int fd;
+    snprintf(p, sizeof p, "%s/sim_gpio%d/value", sim_dir, line);
+    fd = open(p, O_RDONLY);
+    if (fd < 0) return -1;
+    if (read(fd, b, sizeof b - 1) < 1) b[0] = '?';
+    close(fd);
+    return b[0] == '1' ? 1 : b[0] == '0' ? 0 : -1;
+}
+
+static void pull(int line, int up)
+{
+    char p[300];
+    FILE *f;
+    snprintf(p, sizeof p, "%s/sim_gpio%d/pull", sim_dir, line);
+    if ((f = fopen(p, "w"))) { fputs(up ? "pull-up" : "pull-down", f); fclose(f); }
+}
+
+/* A child that watches one output for ms milliseconds, polling every 0.5 ms:
+ * rising edges counted, the level of `other` at the first and last rising edge.
+ * Reports through a pipe.  Returns the child's pid. */
+typedef struct seen { int rises, other_first, other_last; } seen;
+static pid_t watch_line(int line, int other, int ms, int fd[2])
+{
+    pid_t pid;
+    if (pipe(fd)) return -1;
+    pid = fork();
+    if (pid == 0) {
+        seen s = {0, -1, -1};
+        int last = sysval(line);
+        int64_t end = now_ms() + ms;
+        close(fd[0]);
+        while (now_ms() < end) {
+            int v = sysval(line);
+            if (v == 1 && last == 0) {
+                s.rises++;
+                s.other_last = sysval(other);
+                if (s.other_first < 0) s.other_first = s.other_last;
+            }
+            if (v >= 0) last = v;
+            usleep(500);
+        }
+        if (write(fd[1], &s, sizeof s) != sizeof s) _exit(1);
+        _exit(0);
+    }
+    close(fd[1]);
+    return pid;
+}
+
+static seen watch_result(pid_t pid, int fd[2])
+{
+    seen s = {-1, -1, -1};
+    if (read(fd[0], &s, sizeof s) != sizeof s) s.rises = -1;
+    close(fd[0]);
+    waitpid(pid, NULL, 0);
+    return s;
+}
+
+static void test_refusals(const rg_rig *rig0, const char *chip)
+{
+    rg_rig rig = *rig0;
+    rg_open_opts o = {RG_BACKEND_GPIOD, chip, NULL, NULL, 0};
+    rg_machine *m = NULL;
+    char err[RG_ERRMAX] = "";
+    struct gpiod_chip *c = gpiod_chip_open_lookup(chip);
+    struct gpiod_line *l = c ? gpiod_chip_get_line(c, 24) : NULL;
+    int rc;
+    CHECK(l && gpiod_line_request_output(l, "other", 0) == 0, "another consumer holds line 24");
+    rc = rg->open(&rig, &o, &m, err, sizeof err);
+    CHECK(rc == RG_EBUSY && !m && strstr(err, "line 24 (the laser, rig file line 6) is already "
+          "in use by \"other\""), "a line held by another consumer is refused (%s)", err);
+    if (l) gpiod_line_release(l);
+    if (c) gpiod_chip_close(c);
+    o.chip = "nochip";
+    CHECK(rg->open(&rig, &o, &m, err, sizeof err) == RG_EINVAL && strstr(err, "no GPIO chip "
+          "'nochip'"), "an unknown chip (%s)", err);
+    o.chip = chip;
+    rig.axis[RG_J_V].home.offset = 40;
+    CHECK(rg->open(&rig, &o, &m, err, sizeof err) == RG_EINVAL && strstr(err, "has 32 lines: "
+          "line 40 (home switch of axis v"), "an unknown line (%s)", err);
+}
+
+static void test_machine(const rg_rig *rig, const char *chip)
+{
+    rg_open_opts o = {RG_BACKEND_GPIOD, chip, NULL, NULL, 0};
+    rg_machine *m = NULL;
+    char err[RG_ERRMAX] = "";
+    long pos[RG_NJOINTS], t[RG_NJOINTS];
+    int fd[2], rc;
+    pid_t pid;
+    seen s;
+
+    CHECK(rg->open(rig, &o, &m, err, sizeof err) == 0, "open the gpio-sim chip (%s)", err);
+    if (!m) return;
+    CHECK(sysval(24) == 0 && sysval(12) == 1 && sysval(17) == 1,
+          "at open: laser low, the active-low ENABLE lines high (drivers disabled)");
+    /* homing: another process trips the home switches after 0.3 s */
+    pid = fork();
+    if (pid == 0) { msleep(300); for (int j = 18; j < 24; j++) pull(j, 1); _exit(0); }
+    {
+        int64_t t0 = now_ms();
+        rc = rg->home(m, NULL, NULL, err, sizeof err);
+        waitpid(pid, NULL, 0);
+        rg->position(m, pos, NULL);
+        CHECK(rc == 0 && rg->homed(m) && pos[0] == -3000 && pos[2] == -8000 &&
+              now_ms() - t0 >= 250, "homing stops when the switches trip (%s, %lld ms)", err,
+              (long long)(now_ms() - t0));
+        CHECK(sysval(12) == 0, "drivers enabled (ENABLE active-low: low)");
+    }
+    /* a slow move: +20 steps on m1a, counted through sysfs, DIR high */
+    memcpy(t, pos, sizeof t);
+    t[0] += 20;
+    pid = watch_line(0, 6, 2000, fd);
+    rc = rg->move_steps(m, t, NULL, NULL, err, sizeof err);
+    s = watch_result(pid, fd);
+    CHECK(rc == 0 && s.rises == 20 && s.other_first == 1 && s.other_last == 1,
+          "a move of +20 steps: %d STEP pulses seen, DIR %d..%d (%s)", s.rises, s.other_first,
+          s.other_last, err);
+    t[0] -= 13;
+    pid = watch_line(0, 6, 2000, fd);
+    rc = rg->move_steps(m, t, NULL, NULL, err, sizeof err);
+    s = watch_result(pid, fd);
+    CHECK(rc == 0 && s.rises == 13 && s.other_first == 0 && s.other_last == 0,
+          "a move of -13 steps: %d STEP pulses seen, DIR %d..%d", s.rises, s.other_first,
+          s.other_last);
+    /* exposure: the heartbeat toggles; the interlock opens at 0.4 s; laser low */
+    pid = fork();
+    if (pid == 0) {
+        int ok = 1, changes = 0, last = sysval(26);
+        int64_t end = now_ms() + 300;
+        msleep(20);
+        ok &= sysval(24) == 1;
+        while (now_ms() < end) {
+            int v = sysval(26);
+            if (v != last) changes++;
+            last = v;
+            usleep(1000);
+        }
+        ok &= changes >= 5;
+        ok &= sysval(24) == 1;
+        pull(25, 1);           /* active-low interlock: high = open */
+        msleep(100);
+        ok &= sysval(24) == 0;
+        _exit(ok ? 0 : 1);
+    }
+    rc = rg->expose(m, 1500, NULL, NULL, err, sizeof err);
+    {
+        int st;
+        waitpid(pid, &st, 0);
+        CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0, "during the exposure: laser high, the "
+              "heartbeat toggling, and laser low within 100 ms of the interlock opening");
+    }
+    CHECK(rc == RG_EINTERLOCK && sysval(24) == 0, "expose returns the interlock (%s)", err);
+    CHECK(rg->expose(m, 10, NULL, NULL, err, sizeof err) == RG_EINTERLOCK && sysval(24) == 0,
+          "no exposure while it stays open");
+    pull(25, 0);
+    rg->close(m);
+    CHECK(sysval(24) == 0, "closed: laser low");
+    for (int j = 18; j < 24; j++) pull(j, 0);
+}
+
+static void on_term(int sig)
+{
+    (void)sig;
+    rg->emergency_off();    /* what the dialogue's stop hook does */
+    for (;;) pause();       /* keep the lines: the parent reads them, then SIGKILLs */
+}
+
+/* SIGTERM while a scan runs: the laser goes low, then the drivers are disabled. */
+static void test_kill(const rg_rig *rig0, const char *chip)
+{
+    rg_rig rig = *rig0;
+    pid_t pid;
+    int before, laser, en0, en5, st;
+    for (int j = 0; j < RG_NJOINTS; j++) rig.axis[j].home.offset = -1;   /* homed at once */
+    pid = fork();
+    if (pid == 0) {
+        rg_open_opts o = {RG_BACKEND_GPIOD, chip, NULL, NULL, 0};
+        rg_machine *m;
+        char err[RG_ERRMAX];
+        long t[RG_NJOINTS];
+        signal(SIGTERM, on_term);
+        if (rg->open(&rig, &o, &m, err, sizeof err) || rg->home(m, NULL, NULL, err, sizeof err))
+            _exit(1);
+        rg->position(m, t, NULL);
+        for (int k = 0; k < 100; k++) {            /* the scan: step, expose */
+            t[k % RG_NJOINTS] += 1;
+            if (rg->move_steps(m, t, NULL, NULL, err, sizeof err) ||
+                rg->expose(m, 1500, NULL, NULL, err, sizeof err)) _exit(1);
+        }
+        _exit(0);
+    }
+    msleep(700);
+    before = sysval(24);
+    kill(pid, SIGTERM);
+    msleep(300);
+    laser = sysval(24); en0 = sysval(12); en5 = sysval(17);
+    kill(pid, SIGKILL);
+    waitpid(pid, &st, 0);
+    CHECK(before == 1, "the scan was mid-exposure when SIGTERM came (laser %d)", before);
+    CHECK(laser == 0 && en0 == 1 && en5 == 1, "after SIGTERM mid-scan: laser low (%d), drivers "
+          "disabled (ENABLE %d %d)", laser, en0, en5);
+}
+
+int main(int argc, char **argv)
+{
+    rg_rig rig;
+    char err[RG_ERRMAX];
+    const char *chip = getenv("GPIO_CHIP");
+    sim_dir = getenv("GPIO_SIM");
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    rg = rig_get_api(RIG_ABI);
+    if (!chip || !sim_dir || argc < 2) { printf("FAIL not in the gpio-vm guest\n"); return 1; }
+    if (rg->rig_load(argv[1], &rig, err, sizeof err)) { printf("FAIL %s\n", err); return 1; }
+    test_refusals(&rig, chip);
+    test_machine(&rig, chip);
+    test_kill(&rig, chip);
+    return unit_failed();
+}
