@@ -25,6 +25,7 @@ int lm_microscope(lm_io *io);  const char *lm_microscope_example(void);
 int lm_telescope(lm_io *io);   const char *lm_telescope_example(void);
 int lm_vision(lm_io *io);      const char *lm_vision_example(void);
 int lm_cornea(lm_io *io);      const char *lm_cornea_example(void);
+int lm_cornea_scan(lm_io *io); const char *lm_cornea_scan_example(void);
 int lm_fit(lm_io *io);         const char *lm_fit_example(void);
 int lm_prescription(lm_io *io);    const char *lm_prescription_example(void);
 int lm_to_prescription(lm_io *io); const char *lm_to_prescription_example(void);

@@ -1,0 +1,318 @@
+/* cn_fit.c -- the weighted nonlinear least-squares fit of cornea and eye pose to the
+ * detector spots (GSL multifit_nlinear, trust region with Levenberg-Marquardt steps,
+ * central-difference Jacobian), robust outlier rejection by normalised residuals,
+ * and the predicted accuracy of a scan before it is run. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include "cn_int.h"
+
+typedef struct fctx {
+    int model, nf, idx[CN_NPARAM], n;
+    const int *use;                 /* spots fitted */
+    const cn_spot *s;
+    const cn_plane *pl;
+    const double *apex0;
+    cn_params base;
+} fctx;
+
+static void unpack(const fctx *c, const gsl_vector *x, cn_params *p)
+{
+    *p = c->base;
+    for (int k = 0; k < c->nf; k++) p->p[c->idx[k]] = gsl_vector_get(x, k);
+}
+
+static int f_res(const gsl_vector *x, void *data, gsl_vector *f)
+{
+    const fctx *c = data;
+    cn_params p;
+    unpack(c, x, &p);
+    for (int i = 0; i < c->n; i++) {
+        const cn_spot *s = &c->s[c->use[i]];
+        double u, v;
+        if (cn_forward(c->model, &p, c->apex0, c->pl, &s->ray, &u, &v, NULL, NULL)) {
+            u = s->u + 10; v = s->v + 10;   /* a miss: a large residual turns the
+                                               trust region back */
+        }
+        gsl_vector_set(f, 2 * i, (u - s->u) / s->sigma);
+        gsl_vector_set(f, 2 * i + 1, (v - s->v) / s->sigma);
+    }
+    return GSL_SUCCESS;
+}
+
+static int f_jac(const gsl_vector *x, void *data, gsl_matrix *J)
+{
+    const fctx *c = data;
+    cn_params p;
+    double ru[CN_NPARAM], rv[CN_NPARAM];
+    unpack(c, x, &p);
+    for (int i = 0; i < c->n; i++) {
+        if (cn_jacobian(c->model, &p, c->apex0, c->pl, &c->s[c->use[i]], c->idx, c->nf,
+                        ru, rv))
+            memset(ru, 0, sizeof ru), memset(rv, 0, sizeof rv);
+        for (int k = 0; k < c->nf; k++) {
+            gsl_matrix_set(J, 2 * i, k, ru[k]);
+            gsl_matrix_set(J, 2 * i + 1, k, rv[k]);
+        }
+    }
+    return GSL_SUCCESS;
+}
+
+static int cmpd(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* One trust-region solve over the spots in use; returns iterations or CN_E*. */
+static int solve(fctx *c, cn_params *p, int max_iter, int (*stop)(void *), void *sctx)
+{
+    gsl_multifit_nlinear_fdf fdf;
+    gsl_multifit_nlinear_parameters prm = gsl_multifit_nlinear_default_parameters();
+    prm.trs = gsl_multifit_nlinear_trs_lm;
+    prm.scale = gsl_multifit_nlinear_scale_more;
+    fdf.f = f_res;
+    fdf.df = f_jac;
+    fdf.fvv = NULL;
+    fdf.n = 2 * (size_t)c->n;
+    fdf.p = c->nf;
+    fdf.params = c;
+    c->base = *p;
+    gsl_multifit_nlinear_workspace *w =
+        gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &prm, fdf.n, fdf.p);
+    gsl_vector *x = gsl_vector_alloc(c->nf);
+    if (!w || !x) { if (w) gsl_multifit_nlinear_free(w); gsl_vector_free(x); return CN_ENOMEM; }
+    for (int k = 0; k < c->nf; k++) gsl_vector_set(x, k, p->p[c->idx[k]]);
+    gsl_multifit_nlinear_init(x, &fdf, w);
+    int it, rc = 0;
+    for (it = 0; it < max_iter; it++) {
+        if (stop && stop(sctx)) { rc = CN_ESTOP; break; }
+        int st = gsl_multifit_nlinear_iterate(w);
+        if (st == GSL_ENOPROG) break;    /* no step lowers chi^2 further */
+        if (st) break;
+        int info;
+        if (gsl_multifit_nlinear_test(1e-12, 1e-12, 0, &info, w) == GSL_SUCCESS) {
+            it++;
+            break;
+        }
+    }
+    unpack(c, w->x, p);
+    gsl_multifit_nlinear_free(w);
+    gsl_vector_free(x);
+    return rc ? rc : it;
+}
+
+int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
+           const cn_fit_opts *o, cn_result *res, char *err, size_t errcap)
+{
+    cn_fit_opts d = {0};
+    if (!o) o = &d;
+    memset(res, 0, sizeof *res);
+    if (o->model < CN_SPHERE || o->model > CN_BICONIC || n < 0) {
+        snprintf(err, errcap, "bad fit options (model %d, %d spots)", o->model, n);
+        return CN_EINVAL;
+    }
+    cn_plane pl;
+    cn_plane_of(g, &pl);
+    const double *apex0 = g->cornea.trans;
+    cn_params p;
+    if (start) p = *start;
+    else {
+        cn_params_from_cornea(&g->cornea, apex0, 0, 0, &p);
+        if (o->model == CN_BICONIC && p.p[CN_C0] == 0 && p.p[CN_C45] == 0)
+            p.p[CN_C0] = -1e-4;   /* off the axis singularity of zero cylinder */
+    }
+    if (o->model == CN_SPHERE) p.p[CN_TX] = p.p[CN_TY] = 0;
+    fctx c = {.model = o->model, .s = spots, .pl = &pl, .apex0 = apex0};
+    cn_free_mask(o->model, o->fix_tilt, res->free);
+    for (int k = 0; k < CN_NPARAM; k++) if (res->free[k]) c.idx[c.nf++] = k;
+    int *use = malloc(sizeof *use * (n > 0 ? n : 1));
+    double *tmp = malloc(sizeof *tmp * (n > 0 ? n : 1));
+    if (!use || !tmp) { free(use); free(tmp); snprintf(err, errcap, "out of memory"); return CN_ENOMEM; }
+    for (int i = 0; i < n; i++) {
+        spots[i].nres = NAN;
+        if (spots[i].status == CN_S_OK &&
+            !(spots[i].sigma > 0 && isfinite(spots[i].u) && isfinite(spots[i].v)))
+            spots[i].status = CN_S_NONE;
+    }
+    double k_rej = o->reject_k > 0 ? o->reject_k : 5;
+    int rounds = o->reject_rounds == 0 ? 3 : o->reject_rounds < 0 ? 0 : o->reject_rounds;
+    int max_iter = o->max_iter > 0 ? o->max_iter : 1000;
+    int rc = 0, iters = 0;
+    for (int round = 0;; round++) {
+        c.n = 0;
+        for (int i = 0; i < n; i++) if (spots[i].status == CN_S_OK) use[c.n++] = i;
+        c.use = use;
+        if (2 * c.n < c.nf + 1) {
+            snprintf(err, errcap, "%d usable spots: too few for %d parameters", c.n, c.nf);
+            rc = CN_EFIT;
+            goto out;
+        }
+        rc = solve(&c, &p, max_iter, o->stop, o->stop_ctx);
+        if (rc < 0) { snprintf(err, errcap, rc == CN_ESTOP ? "stopped" : "fit failed"); goto out; }
+        iters += rc;
+        rc = 0;
+        /* normalised residuals; robust scale from their median (Rayleigh: 1.1774) */
+        int m = 0;
+        for (int i = 0; i < c.n; i++) {
+            cn_spot *s = &spots[use[i]];
+            double u, v;
+            if (cn_forward(o->model, &p, apex0, &pl, &s->ray, &u, &v, NULL, NULL)) {
+                s->status = CN_S_MISS;
+                continue;
+            }
+            s->nres = hypot(u - s->u, v - s->v) / s->sigma;
+            tmp[m++] = s->nres;
+        }
+        if (round >= rounds || m == 0) break;
+        qsort(tmp, m, sizeof *tmp, cmpd);
+        double scale = tmp[m / 2] / 1.1774;
+        double thr = k_rej * fmax(scale, 0.5);
+        int nrej = 0;
+        for (int i = 0; i < c.n; i++) {
+            cn_spot *s = &spots[use[i]];
+            if (s->status == CN_S_OK && s->nres > thr) { s->status = CN_S_OUTLIER; nrej++; }
+        }
+        if (!nrej) break;
+    }
+    /* the analysis at the solution */
+    c.n = 0;
+    for (int i = 0; i < n; i++) if (spots[i].status == CN_S_OK) use[c.n++] = i;
+    int M = 2 * c.n;
+    double *J = malloc(sizeof *J * (size_t)M * c.nf);
+    if (!J) { snprintf(err, errcap, "out of memory"); rc = CN_ENOMEM; goto out; }
+    double chi2 = 0, ss = 0;
+    for (int i = 0; i < c.n; i++) {
+        const cn_spot *s = &spots[use[i]];
+        double u, v;
+        cn_forward(o->model, &p, apex0, &pl, &s->ray, &u, &v, NULL, NULL);
+        ss += (u - s->u) * (u - s->u) + (v - s->v) * (v - s->v);
+        chi2 += s->nres * s->nres;
+        cn_jacobian(o->model, &p, apex0, &pl, s, c.idx, c.nf, &J[2 * i * c.nf],
+                    &J[(2 * i + 1) * c.nf]);
+    }
+    cn_svd a = {.nfree = c.nf};
+    memcpy(a.idx, c.idx, sizeof a.idx);
+    rc = cn_analyse(J, M, o->model, &p, o->rcond > 0 ? o->rcond : 1e-9, &a);
+    free(J);
+    if (rc) { snprintf(err, errcap, "too few spots to analyse the fit"); goto out; }
+    res->model = o->model;
+    res->nused = c.n;
+    res->nrejected = n - c.n;
+    res->iterations = iters;
+    res->rms = c.n ? sqrt(ss / c.n) : NAN;
+    res->chi2_dof = M > c.nf ? chi2 / (M - c.nf) : NAN;
+    res->par = p;
+    res->nfree = c.nf;
+    memcpy(res->idx, c.idx, sizeof res->idx);
+    memcpy(res->sv, a.sv, sizeof a.sv);
+    memcpy(res->vt, a.vt, sizeof a.vt);
+    memcpy(res->cov, a.cov, sizeof a.cov);
+    res->cond = a.cond;
+    res->undetermined = a.undetermined;
+    memcpy(res->why, a.why, sizeof res->why);
+    /* chi^2 test: a fit far above its noise is a local minimum, the wrong model or
+     * a sigma too small; what its weakest direction mixes is then not trustworthy */
+    int dof = M - c.nf;
+    res->chi2_z = dof > 0 ? (chi2 - dof) / sqrt(2.0 * dof) : 0;
+    if (res->chi2_z > 4) {
+        res->poor = 1;
+        const double *v = &res->vt[(c.nf - 1) * c.nf];
+        size_t l = strlen(res->why);
+        if (l + 200 > sizeof res->why) l = sizeof res->why - 200;   /* room for this */
+        l += snprintf(res->why + l, sizeof res->why - l,
+                      "POOR FIT: chi2/dof %.3g, %.1f sd above 1 (local minimum, wrong "
+                      "model or sigma too small); not trustworthy:", res->chi2_dof,
+                      res->chi2_z);
+        for (int q = 0; q < c.nf; q++)
+            if (fabs(v[q]) > 0.3 && l + 12 < sizeof res->why) {
+                res->undetermined |= 1u << c.idx[q];
+                res->cov[c.idx[q] * (CN_NPARAM + 1)] = INFINITY;
+                l += snprintf(res->why + l, sizeof res->why - l, " %s",
+                              cn_param_name(c.idx[q]));
+            }
+        if (l + 1 < sizeof res->why) strcat(res->why, "\n");
+    }
+    cn_clinical_of(o->model, &p, res->cov, res->undetermined, &res->k);
+out:
+    free(use);
+    free(tmp);
+    return rc;
+}
+
+int cn_predict_scan(const rg_geometry *g, const cn_spot *spots, int n, int model,
+                    int fix_tilt, const cn_params *p, double sigma, cn_predict *pr,
+                    char *err, size_t errcap)
+{
+    cn_plane pl;
+    int free_[CN_NPARAM];
+    memset(pr, 0, sizeof *pr);
+    cn_plane_of(g, &pl);
+    cn_free_mask(model, fix_tilt, free_);
+    cn_svd a = {0};
+    for (int k = 0; k < CN_NPARAM; k++) if (free_[k]) a.idx[a.nfree++] = k;
+    double *J = malloc(sizeof *J * 2 * (size_t)(n > 0 ? n : 1) * a.nfree);
+    if (!J) { snprintf(err, errcap, "out of memory"); return CN_ENOMEM; }
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        cn_spot s = spots[i];
+        if (s.status != CN_S_OK && s.status != CN_S_OUTLIER) continue;
+        if (sigma > 0) s.sigma = sigma;
+        if (!(s.sigma > 0)) continue;
+        if (cn_jacobian(model, p, g->cornea.trans, &pl, &s, a.idx, a.nfree,
+                        &J[m * a.nfree], &J[(m + 1) * a.nfree]) == CN_OK)
+            m += 2;
+    }
+    int rc = cn_analyse(J, m, model, p, 1e-9, &a);
+    free(J);
+    if (rc) { snprintf(err, errcap, "%d usable spots: too few to predict", m / 2); return rc; }
+    pr->nfree = a.nfree;
+    memcpy(pr->idx, a.idx, sizeof a.idx);
+    memcpy(pr->sv, a.sv, sizeof a.sv);
+    memcpy(pr->vt, a.vt, sizeof a.vt);
+    pr->cond = a.cond;
+    for (int k = 0; k < CN_NPARAM; k++) pr->sd[k] = sqrt(a.cov[k * CN_NPARAM + k]);
+    pr->undetermined = a.undetermined;
+    memcpy(pr->why, a.why, sizeof pr->why);
+    cn_clinical_of(model, p, a.cov, a.undetermined, &pr->k);
+    return CN_OK;
+}
+
+const char *cn_report(const cn_result *r, char *buf, size_t cap)
+{
+    static const char *const mn[] = {"sphere", "conic", "biconic"};
+    const cn_clinical *k = &r->k;
+    size_t l = 0;
+#define OUT(...) do { if (l < cap) l += snprintf(buf + l, cap - l, __VA_ARGS__); } while (0)
+    if (cap) buf[0] = 0;
+    OUT("model %s: %d spots fitted, %d left out, %d iterations, residual RMS %.3g um, "
+        "chi2/dof %.3g\n", mn[r->model], r->nused, r->nrejected, r->iterations,
+        r->rms * 1000, r->chi2_dof);
+    OUT("apex radius R %.5f +- %.5f mm   Q %.4f +- %.4f\n", k->R, k->sd_R, k->Q, k->sd_Q);
+    if (r->model == CN_BICONIC)
+        OUT("R flat %.5f +- %.5f mm (Q %.4f +- %.4f)   R steep %.5f +- %.5f mm "
+            "(Q %.4f +- %.4f)\n", k->R_flat, k->sd_R_flat, k->Q_flat, k->sd_Q_flat,
+            k->R_steep, k->sd_R_steep, k->Q_steep, k->sd_Q_steep);
+    if (r->model == CN_BICONIC) {
+        OUT("Sim K (n 1.3375): K1 %.3f +- %.3f D @ %.1f   K2 %.3f +- %.3f D @ %.1f   "
+            "axis +- %.2f deg\n", k->K1, k->sd_K1, k->K1_axis, k->K2, k->sd_K2,
+            k->K2_axis, k->sd_axis);
+        OUT("mean K %.3f +- %.3f D   cylinder %.3f +- %.3f D @ %.1f   corneal power "
+            "(n 1.376) %.3f +- %.3f D\n", k->Km, k->sd_Km, k->cyl, k->sd_cyl, k->K2_axis,
+            k->P, k->sd_P);
+    } else
+        OUT("K (n 1.3375) %.3f +- %.3f D (no cylinder in this model)   corneal power "
+            "(n 1.376) %.3f +- %.3f D\n", k->Km, k->sd_Km, k->P, k->sd_P);
+    OUT("eye: apex shift %.4f %.4f %.4f mm (+- %.4f %.4f %.4f), tilt %.3f %.3f deg "
+        "(+- %.3f %.3f)\n", k->dx, k->dy, k->dz, k->sd_dx, k->sd_dy, k->sd_dz, k->tx,
+        k->ty, k->sd_tx, k->sd_ty);
+    OUT("singular values (scaled columns):");
+    for (int i = 0; i < r->nfree; i++) OUT(" %.3g", r->sv[i]);
+    OUT("   condition %.3g\n", r->cond);
+    if (r->undetermined || r->poor) OUT("%s", r->why);
+#undef OUT
+    return buf;
+}

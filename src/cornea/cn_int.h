@@ -1,0 +1,52 @@
+/* cn_int.h -- internals shared by the cornea engine's files (never by other engines). */
+#ifndef CN_INT_H
+#define CN_INT_H
+#include "cornea.h"
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+typedef struct cn_surf {
+    double cf, cs, qf, qs;          /* flat/steep apex curvatures (1/mm) and Q */
+    double alpha, ca, sa;           /* flat meridian angle, its cos and sin */
+} cn_surf;
+
+const char *cn_param_name(int k);
+void cn_plane_of(const rg_geometry *g, cn_plane *pl);
+void cn_surface(int model, const cn_params *p, cn_surf *s);
+int cn_forward(int model, const cn_params *p, const double apex0[3], const cn_plane *pl,
+               const cn_ray *r, double *u, double *v, double spot[3], double normal[3]);
+void cn_params_from_cornea(const rg_cornea *c, const double apex0[3], double rx,
+                           double ry, cn_params *p);
+void cn_cornea_from_params(const rig_api *rg, int model, const cn_params *p,
+                           const double apex0[3], rg_cornea *c);
+int cn_ray_of_pose(const rig_api *rg, const rg_geometry *g, const rg_pose *pose,
+                   cn_ray *r, char *err, size_t errcap);
+int cn_simulate(const rig_api *rg, const rg_geometry *g, const rg_cornea *truth,
+                const cn_scan_opts *o, cn_spot *spots, int cap, char *err, size_t errcap);
+int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
+           const cn_fit_opts *o, cn_result *res, char *err, size_t errcap);
+int cn_predict_scan(const rg_geometry *g, const cn_spot *spots, int n, int model,
+                    int fix_tilt, const cn_params *p, double sigma, cn_predict *pr,
+                    char *err, size_t errcap);
+const char *cn_report(const cn_result *r, char *buf, size_t cap);
+
+/* cn_analyse.c: Jacobian, SVD, covariance, determinacy, clinical numbers */
+void cn_free_mask(int model, int fix_tilt, int free[CN_NPARAM]);
+extern const double cn_step[CN_NPARAM];
+int cn_jacobian(int model, const cn_params *p, const double apex0[3], const cn_plane *pl,
+                const cn_spot *s, const int *idx, int nfree, double *row_u,
+                double *row_v);
+typedef struct cn_svd {
+    int nfree, idx[CN_NPARAM];
+    double sv[CN_NPARAM], vt[CN_NPARAM * CN_NPARAM], cond;
+    double cov[CN_NPARAM * CN_NPARAM];
+    unsigned undetermined;
+    char why[512];
+} cn_svd;
+/* J: m x nfree weighted Jacobian (row-major). */
+int cn_analyse(const double *J, int m, int model, const cn_params *p, double rcond,
+               cn_svd *a);
+void cn_clinical_of(int model, const cn_params *p, const double *cov,
+                    unsigned undetermined, cn_clinical *k);
+#endif

@@ -1,0 +1,181 @@
+/* cornea.h -- public face of the cornea analysis engine (issue 12): fit a cornea model
+ * (sphere, conic, biconic/toric) and the eye's pose to laser-spot positions on the
+ * rig's detector, report what clinicians read (apex radius, Q, Sim K, cylinder, power)
+ * with uncertainties, say which parameters a scan does not determine (SVD of the
+ * weighted Jacobian), and predict the accuracy of a rig and scan before building it.
+ * Lives in build/lib/lensmat-cornea.so:
+ *     cornea_get_api_fn get = (cornea_get_api_fn)lm_engine_symbol("cornea",
+ *                                                                 CORNEA_API_SYMBOL);
+ *     const cornea_api *cn = get ? get(CORNEA_ABI) : NULL;
+ * The rig is reached only through the rig_api table the caller passes in (rig.h's
+ * public types and functions).  The engine never prints and never exits; functions
+ * return 0 (CN_OK) or a negative CN_E* code with a message in err.  mm and radians.
+ *
+ * The fit's forward model is analytic: the incoming beam of each commanded pose
+ * (where it leaves m2 and its direction, from rig_api.forward: it does not depend on
+ * the cornea) meets the cornea of the parameters, reflects, and crosses the fixed
+ * detector plane (through the detector point, normal along nominal apex -> detector,
+ * the apex being the rig file's eye_at).  Detector coordinates (u, v) are mm in that
+ * plane along cn_plane.e1, e2. */
+#ifndef CORNEA_H
+#define CORNEA_H
+#include <stddef.h>
+#include "rig/rig.h"
+
+#define CORNEA_ABI 1
+#define CORNEA_API_SYMBOL "cornea_get_api"
+
+enum { CN_OK = 0, CN_EINVAL = -1, CN_ENOMEM = -2, CN_EFIT = -3, CN_ESTOP = -4,
+       CN_EABI = -10 };
+
+/* Fit parameters.  The toric part is fitted as power-vector components of the apex
+ * curvature, c(phi) = 1/R + C0 cos 2phi + C45 sin 2phi (1/mm), well conditioned at
+ * zero cylinder; R_flat, R_steep and the axis are derived from them. */
+enum cn_param { CN_R, CN_C0, CN_C45, CN_QF, CN_QS, CN_DX, CN_DY, CN_DZ, CN_TX, CN_TY,
+                CN_NPARAM };
+enum cn_model { CN_SPHERE, CN_CONIC, CN_BICONIC };
+
+typedef struct cn_plane {          /* the detector plane */
+    double at[3], w[3];            /* detector point; unit normal */
+    double e1[3], e2[3];           /* in-plane unit axes of (u, v) */
+} cn_plane;
+
+typedef struct cn_ray { double o[3], d[3]; } cn_ray;   /* the beam leaving m2 */
+
+/* One exposure.  status: CN_S_OK, or why the frame gave no usable spot. */
+enum cn_spot_status { CN_S_OK, CN_S_NONE, CN_S_SEVERAL, CN_S_OUTLIER, CN_S_MISS };
+typedef struct cn_spot {
+    cn_ray ray;                    /* incoming beam of the commanded pose */
+    double u, v;                   /* measured centroid on the detector (mm) */
+    double sigma;                  /* its standard uncertainty per axis (mm) */
+    int status;                    /* enum cn_spot_status (input: OK, NONE, SEVERAL) */
+    double nres;                   /* output: normalised residual |r| / sigma */
+} cn_spot;
+
+/* Parameter vector: p[CN_*] in the units above (tilts: rad, about rig x then y). */
+typedef struct cn_params { double p[CN_NPARAM]; } cn_params;
+
+typedef struct cn_fit_opts {
+    int model;                     /* enum cn_model */
+    int fix_tilt;                  /* 1: tilt held at the start value (sphere: always) */
+    double reject_k;               /* outlier: |r|/sigma > k * robust scale (0: 5) */
+    int reject_rounds;             /* refits after rejection (0: 3; -1: none) */
+    double rcond;                  /* singular value / largest below it: not
+                                      determined (0: 1e-9) */
+    int max_iter;                  /* trust-region iterations (0: 100) */
+    int (*stop)(void *ctx); void *stop_ctx;   /* polled each iteration */
+} cn_fit_opts;
+
+/* What the clinician reads, each with its standard uncertainty (sd_*; INFINITY when
+ * the scan does not determine it). */
+typedef struct cn_clinical {
+    double R, sd_R;                /* apex radius, mean of the meridians (mm) */
+    double Q, sd_Q;                /* conic constant, flat meridian */
+    double R_flat, sd_R_flat, R_steep, sd_R_steep;
+    double Q_flat, sd_Q_flat, Q_steep, sd_Q_steep;
+    double K1, sd_K1, K1_axis;     /* flat K (D, n 1.3375) and its meridian (deg 0-180) */
+    double K2, sd_K2, K2_axis;     /* steep K */
+    double sd_axis;                /* of K1_axis (deg) */
+    double Km, sd_Km;              /* mean K (D) */
+    double cyl, sd_cyl;            /* corneal cylinder K2 - K1 (D, at K2_axis) */
+    double P, sd_P;                /* mean corneal power with n = 1.376 (D) */
+    double dx, dy, dz, sd_dx, sd_dy, sd_dz;   /* eye pose: apex shift (mm) */
+    double tx, ty, sd_tx, sd_ty;   /* tilt (deg) */
+} cn_clinical;
+
+#define CN_KERATO_N 1.3375
+#define CN_CORNEA_N 1.376
+
+typedef struct cn_result {
+    int model;
+    int nused, nrejected;          /* spots fitted; spots left out (status says why) */
+    int iterations;
+    double rms;                    /* residual RMS on the detector (mm) */
+    double chi2_dof;               /* chi^2 / degrees of freedom */
+    cn_params par;                 /* fitted values (fixed ones: the start) */
+    int free[CN_NPARAM];           /* 1: fitted */
+    double cov[CN_NPARAM * CN_NPARAM];   /* covariance (fixed rows/cols 0; INFINITY on
+                                            the diagonal of undetermined ones) */
+    /* SVD of the weighted Jacobian with columns scaled to unit norm: */
+    int nfree;
+    int idx[CN_NPARAM];            /* free parameter of each column */
+    double sv[CN_NPARAM];          /* singular values, largest first */
+    double vt[CN_NPARAM * CN_NPARAM];   /* right singular vectors, row k: direction of
+                                           sv[k] over the free columns (row length
+                                           nfree), in column-scaled units */
+    double cond;                   /* sv[0] / sv[nfree-1] */
+    unsigned undetermined;         /* bit CN_*: parameter not determined (a singular
+                                      direction below rcond, or sd over its limit) */
+    char why[512];                 /* one line per undetermined parameter / direction */
+    int poor;                      /* 1: chi^2 more than 4 sd above its dof (the
+                                      weakest direction's parameters then marked) */
+    double chi2_z;                 /* (chi^2 - dof) / sqrt(2 dof) */
+    cn_clinical k;
+} cn_result;
+
+typedef struct cn_predict {        /* accuracy of a rig and scan before building it */
+    int nfree, idx[CN_NPARAM];
+    double sv[CN_NPARAM], vt[CN_NPARAM * CN_NPARAM], cond;
+    double sd[CN_NPARAM];          /* predicted parameter uncertainty */
+    double J[2 * CN_NPARAM];       /* not used by callers: scratch */
+    unsigned undetermined;
+    char why[512];
+    cn_clinical k;                 /* predicted clinical uncertainties (sd_*) */
+} cn_predict;
+
+/* A simulated scan (synthetic data, tests and benchmarks). */
+typedef struct cn_scan_opts {
+    int npoints;                   /* number of targets (rings of a sunflower pattern) */
+    double theta_max;              /* zone: largest polar angle (rad) about the apex
+                                      centre of curvature */
+    int one_meridian;              /* 1: all points on the meridian phi = meridian */
+    double meridian;
+    double sigma;                  /* centroid noise (mm, Gaussian; 0: none) */
+    unsigned long long seed;
+    int quantise;                  /* 1: commanded poses on the step grid */
+} cn_scan_opts;
+
+typedef struct cornea_api {
+    int abi;
+    const char *(*version)(void);
+    const char *(*param_name)(int param);          /* "R" "C0" ... NULL past the end */
+    /* Detector plane of a rig geometry (normal along nominal apex -> detector). */
+    void (*plane)(const rg_geometry *g, cn_plane *pl);
+    /* Model (true) cornea parameters from an rg_cornea placed by eye_pose(rx, ry, 0)
+     * relative to nominal apex `apex0`; and back (biconic or conic). */
+    void (*params_from_cornea)(const rg_cornea *c, const double apex0[3], double rx,
+                               double ry, cn_params *p);
+    /* And back: the rg_cornea (zone 0) of parameters, for the rig and the tracer. */
+    void (*cornea_from_params)(const rig_api *rg, int model, const cn_params *p,
+                               const double apex0[3], rg_cornea *c);
+    /* The analytic forward model: the ray off the cornea of p onto the plane.
+     * 0 (u, v filled; spot/normal optional) or CN_EFIT (misses the cornea). */
+    int (*forward)(int model, const cn_params *p, const double apex0[3],
+                   const cn_plane *pl, const cn_ray *r, double *u, double *v,
+                   double spot[3], double normal[3]);
+    /* The incoming ray of a commanded pose, through rig_api.forward. */
+    int (*ray_of_pose)(const rig_api *rg, const rg_geometry *g, const rg_pose *pose,
+                       cn_ray *r, char *err, size_t errcap);
+    /* Simulate a scan: targets on the rig's nominal cornea (g->cornea), solved and
+     * (optionally) quantised by the rig, traced by rig_api.forward through the TRUE
+     * cornea `truth` (placed), detector hits on the plane of g plus noise.  spots[]
+     * holds cap entries; returns the number written (>= 0) or CN_E*. */
+    int (*simulate)(const rig_api *rg, const rg_geometry *g, const rg_cornea *truth,
+                    const cn_scan_opts *o, cn_spot *spots, int cap, char *err,
+                    size_t errcap);
+    /* Fit.  start: initial parameters (NULL: the nominal cornea of g, pose 0). */
+    int (*fit)(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
+               const cn_fit_opts *o, cn_result *res, char *err, size_t errcap);
+    /* Predicted accuracy of the scan's rays at parameters p for centroid sigma
+     * (each spot's own sigma when sigma <= 0). */
+    int (*predict)(const rg_geometry *g, const cn_spot *spots, int n, int model,
+                   int fix_tilt, const cn_params *p, double sigma, cn_predict *pr,
+                   char *err, size_t errcap);
+    /* Plain-text report of a result into buf; returns buf. */
+    const char *(*report)(const cn_result *r, char *buf, size_t cap);
+} cornea_api;
+
+typedef const cornea_api *(*cornea_get_api_fn)(int abi);
+const cornea_api *cornea_get_api(int abi);
+
+#endif

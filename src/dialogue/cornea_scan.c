@@ -1,0 +1,113 @@
+/* cornea_scan.c -- the --cornea-scan dialogue (issue 12): a simulated measurement.
+ * The example rig geometry scans a synthetic eye the user describes (radius, Q,
+ * cylinder and axis, decentration, tilt), spots with centroid noise, the cornea
+ * engine fits the chosen model and the report is printed: Sim K, radii, Q, pose,
+ * singular values, what is not determined.  Texts in prompts/cornea_scan.txt; the
+ * rig and cornea engines are loaded here only. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "calcio.h"
+#include "dialogues.h"
+#include "engine.h"
+#include "../rig/rig.h"
+#include "../cornea/cornea.h"
+#include "prompts_cornea_scan.h"
+
+#define CS(k) cornea_scan_prompts[CORNEA_SCAN_##k]
+#define DEG (3.14159265358979323846 / 180)
+
+/* One number in [lo, hi] (whole when integral), asked again on a terminal. */
+static int ranged(calc *c, const char *q, const char *what, const char *range, double lo,
+                  double hi, int integral, double *v)
+{
+    for (;;) {
+        lm_mark m;
+        int rc;
+        calc_mark(c, &m);
+        if ((rc = calc_num(c, q, what, 0, v))) return rc;
+        if (*v >= lo && *v <= hi && (!integral || *v == floor(*v))) return LM_GO;
+        if ((rc = calc_reject(c, &m, what, q, CS(AGAIN), CS(RANGE), range)))
+            return rc;
+    }
+}
+
+static int stop_cb(void *ctx) { (void)ctx; return lm_stop_requested() != 0; }
+
+int lm_cornea_scan(lm_io *io)
+{
+    static const char *const models[] = {"sphere", "conic", "biconic", NULL};
+    calc cc = {io, PX_MM, "mm"}, *c = &cc;
+    rig_get_api_fn rget;
+    cornea_get_api_fn cget;
+    *(void **)&rget = lm_engine_symbol("rig", RIG_API_SYMBOL);
+    *(void **)&cget = lm_engine_symbol("cornea", CORNEA_API_SYMBOL);
+    const rig_api *rg = rget ? rget(RIG_ABI) : NULL;
+    const cornea_api *cn = cget ? cget(CORNEA_ABI) : NULL;
+    if (!rg || !cn) return calc_fail(c, CS(NO_ENGINE));
+    int model, rc;
+    double np, zone, R, Q, cyl, axis, dx, dy, tx, ty, noise, pitch, seed;
+    if ((rc = calc_choice(c, CS(MODEL), CS(MODEL_WHAT), models, &model)) ||
+        (rc = ranged(c, CS(POINTS), CS(POINTS_WHAT), CS(POINTS_RANGE), 10, 10000, 1, &np)) ||
+        (rc = ranged(c, CS(ZONE), CS(ZONE_WHAT), CS(ZONE_RANGE), 0.5, 12, 0, &zone)) ||
+        (rc = ranged(c, CS(R), CS(R_WHAT), CS(R_RANGE), 5, 12, 0, &R)) ||
+        (rc = ranged(c, CS(Q), CS(Q_WHAT), CS(Q_RANGE), -1, 1, 0, &Q)) ||
+        (rc = ranged(c, CS(CYL), CS(CYL_WHAT), CS(CYL_RANGE), 0, 8, 0, &cyl)) ||
+        (rc = ranged(c, CS(AXIS), CS(AXIS_WHAT), CS(AXIS_RANGE), -360, 360, 0, &axis)) ||
+        (rc = ranged(c, CS(DX), CS(DX_WHAT), CS(DEC_RANGE), -1, 1, 0, &dx)) ||
+        (rc = ranged(c, CS(DY), CS(DY_WHAT), CS(DEC_RANGE), -1, 1, 0, &dy)) ||
+        (rc = ranged(c, CS(TX), CS(TX_WHAT), CS(TILT_RANGE), -10, 10, 0, &tx)) ||
+        (rc = ranged(c, CS(TY), CS(TY_WHAT), CS(TILT_RANGE), -10, 10, 0, &ty)) ||
+        (rc = ranged(c, CS(NOISE), CS(NOISE_WHAT), CS(NOISE_RANGE), 0, 10, 0, &noise)) ||
+        (rc = ranged(c, CS(PITCH), CS(PITCH_WHAT), CS(PITCH_RANGE), 0.1, 100, 0, &pitch)) ||
+        (rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)))
+        return rc;
+    rg_geometry g;
+    rg->geometry_default(&g);
+    rg_cornea eye = g.cornea;
+    double km = 337.5 / R;
+    eye.model = RG_BICONIC;
+    eye.R = 337.5 / (km - cyl / 2);
+    eye.R2 = 337.5 / (km + cyl / 2);
+    eye.Q = eye.Q2 = Q;
+    eye.axis = axis * DEG;
+    eye.zone = 0;
+    double at[3] = {g.cornea.trans[0] + dx, g.cornea.trans[1] + dy, g.cornea.trans[2]};
+    rg->eye_pose(&eye, tx * DEG, ty * DEG, 0, at);
+    int n = (int)np;
+    cn_spot *sp = malloc(sizeof *sp * n);
+    if (!sp) return calc_fail(c, CS(NO_ENGINE));
+    double sigma = noise * pitch * 1e-3;
+    cn_scan_opts so = {.npoints = n, .theta_max = zone * DEG, .sigma = sigma,
+                       .seed = (unsigned long long)seed, .quantise = 1};
+    char err[256];
+    static char buf[4096];
+    int got = cn->simulate(rg, &g, &eye, &so, sp, n, err, sizeof err);
+    int ok = 0;
+    for (int i = 0; i < got; i++) ok += sp[i].status == CN_S_OK;
+    calc_say(c, CS(SCANNED), n, ok, sigma * 1e3);
+    cn_fit_opts fo = {.model = model, .stop = stop_cb};
+    cn_result r;
+    if (got < 0 || cn->fit(&g, sp, got, NULL, &fo, &r, err, sizeof err)) {
+        free(sp);
+        if (lm_stop_requested()) return LM_FAIL;
+        calc_say(c, CS(FAILED), got < 0 ? "no scan" : err);
+        return LM_FAIL;
+    }
+    free(sp);
+    cn->report(&r, buf, sizeof buf);
+    for (char *l = buf, *e; *l; l = e + 1) {     /* line by line into the record */
+        e = strchr(l, '\n');
+        if (!e) { calc_say(c, CS(LINE), l); break; }
+        *e = 0;
+        calc_say(c, CS(LINE), l);
+    }
+    cn_params t;
+    cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
+    calc_say(c, CS(TRUTH), eye.R, eye.R2, km, cyl);
+    calc_say(c, CS(ERRORS), (r.k.R - t.p[CN_R]) * 1e3, r.k.Km - km,
+             model == CN_BICONIC ? remainder(r.k.K1_axis - fmod(axis + 360, 180), 180.0)
+                                 : 0.0);
+    return calc_done(c);
+}
+const char *lm_cornea_scan_example(void) { return CS(EXAMPLE); }
