@@ -62,3 +62,6 @@ frames_maps() {
         ! grep -q '^Frame' "$F/nf.rec"
 }
 check "rig frames: a scan with frames maps OpenCV, one without maps none (LD_DEBUG=files)" frames_maps
+# the same scan under ASan and UBSan (core and modules: the imaging engine's frames too)
+check "rig frames: ASan build, the same scan replays to the same record" sh -c \
+    "cd '$F/s' && LENSMAT_LIBDIR='$TOP/build/asan/lib' '$ASAN' --rig r3.rec < in2 > /dev/null && cmp r.rec r3.rec"
