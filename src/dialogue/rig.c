@@ -19,6 +19,7 @@
 #include "../rig/rig.h"
 #include "../trace/trace.h"
 #include "prompts_rig.h"
+#include "rigframe.h"
 
 #define P(k) rig_prompts[RIG_##k]
 #define WORD 4096
@@ -35,6 +36,10 @@ typedef struct rdlg {
     int outside;
     const trace_api *tr;        /* the independent check, loaded with the first point */
     int tr_tried;
+    lm_rigcam cam;              /* rig file "camera frames": the imaging engine's frames */
+    int cam_off;                /* frames wanted but the imaging engine is missing */
+    int nframes;
+    double fworst_um, fworst_lim_um, fsigma_um, foff_um;
 } rdlg;
 
 static const rig_api *volatile hook_api;
@@ -167,7 +172,7 @@ static int ask_ms(rdlg *d, double *ms)
  * (the larger of the two), traced (NAN without the tracer) and bound in um; 0 if the
  * chip has no motor feedback. */
 static int closed_loop(rdlg *d, const double target[3], double *miss, double *traced,
-                       double *bound)
+                       double *bound, rg_beam *bo, double hit[3])
 {
     const rig_api *a = d->api;
     const rg_geometry *g = &d->rig.geom;
@@ -180,6 +185,7 @@ static int closed_loop(rdlg *d, const double target[3], double *miss, double *tr
     for (int j = 0; j < RG_NJOINTS; j++)
         p.j[j] = s[j] / d->rig.axis[j].steps_per * (linear(j) ? 1 : DEG);
     *traced = NAN;
+    hit[0] = hit[1] = hit[2] = NAN;
     if (a->forward(g, &p, &b, err, sizeof err) ||
         a->jacobian(g, &p, J, &cond, err, sizeof err)) { *miss = INFINITY; *bound = 0; return 1; }
     for (int r = 0; r < 2; r++)
@@ -189,6 +195,8 @@ static int closed_loop(rdlg *d, const double target[3], double *miss, double *tr
                        (b.det[1] - g->detector[1]) * (b.det[1] - g->detector[1]) +
                        (b.det[2] - g->detector[2]) * (b.det[2] - g->detector[2]));
     *bound = 1e3 * sqrt(e[0] * e[0] + e[1] * e[1]) * (1 + 1e-6) + 1e-6;
+    *bo = b;
+    memcpy(hit, b.det, sizeof b.det);   /* the tracer's hit replaces it below */
     if (!d->tr_tried) {
         trace_get_api_fn get = (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
         d->tr_tried = 1;
@@ -198,9 +206,56 @@ static int closed_loop(rdlg *d, const double target[3], double *miss, double *tr
     if (d->tr && a->verify) {
         rg_verify v;
         if (a->verify(d->tr, g, &p, target, &v, err, sizeof err) || !v.hit) *traced = INFINITY;
-        else *traced = v.err_detector * 1e3;
+        else { *traced = v.err_detector * 1e3; memcpy(hit, v.det, sizeof v.det); }
         if (*traced > *miss) *miss = *traced;
     }
+    return 1;
+}
+
+/* The detected spot (rig file "camera frames"): the landing point made into a camera
+ * frame, its centroid located by the imaging engine; it must land within the bound
+ * plus three times the centroid's own uncertainty.  1: within. */
+static int frame_check(rdlg *d, const rg_beam *b, const double hit[3], double bound,
+                       double ms)
+{
+    const double *det = d->rig.geom.detector;
+    lm_rigcam_spot sp;
+    char err[RG_ERRMAX];
+    double miss, lim;
+    int ok;
+    if (lm_rigcam_detect(&d->cam, &d->rig, b, hit, ms > 0 ? ms / 1e3 : 1e-3, &sp, err,
+                         sizeof err)) {
+        lm_say(d->io, LM_BOTH, P(FRAME_FAILED), err);
+        return 0;
+    }
+    miss = 1e3 * sqrt((sp.det[0] - det[0]) * (sp.det[0] - det[0]) +
+                      (sp.det[1] - det[1]) * (sp.det[1] - det[1]) +
+                      (sp.det[2] - det[2]) * (sp.det[2] - det[2]));
+    lim = bound + 3e3 * sp.sigma;
+    ok = miss <= lim;
+    lm_say(d->io, LM_BOTH, P(FRAME), sp.x, sp.y, sp.w, sp.snr, miss, sp.sigma * 1e3,
+           sp.off * 1e3, bound, lim, ok ? P(CLOSED_OK) : P(CLOSED_BAD));
+    d->nframes++;
+    if (miss > d->fworst_um) { d->fworst_um = miss; d->fworst_lim_um = lim; }
+    if (sp.sigma * 1e3 > d->fsigma_um) d->fsigma_um = sp.sigma * 1e3;
+    if (sp.off * 1e3 > d->foff_um) d->foff_um = sp.off * 1e3;
+    return ok;
+}
+
+/* Frames wanted: load the imaging engine now (first point), say the camera. */
+static int want_frames(rdlg *d)
+{
+    char err[RG_ERRMAX];
+    const rg_rig *r = &d->rig;
+    if (!r->cam_frames || d->cam_off) return 0;
+    if (d->cam.tried) return 1;
+    if (lm_rigcam_load(&d->cam, err, sizeof err)) {
+        lm_say(d->io, LM_BOTH, P(CAMERA_NONE), err);
+        d->cam_off = 1;
+        return 0;
+    }
+    lm_say(d->io, LM_BOTH, P(CAMERA_ON), r->cam_pixels, r->cam_pixels, r->cam_pitch * 1e3,
+           r->cam_read_noise, r->beam_waist, r->cam_seed);
     return 1;
 }
 
@@ -212,7 +267,8 @@ static int visit(rdlg *d, const rg_target *t, double ms)
     rg_quantised q;
     long steps[RG_NJOINTS];
     char err[RG_ERRMAX], buf[512], dg[512];
-    double miss, traced, bound;
+    double miss, traced, bound, hit[3];
+    rg_beam b;
     int rc = a->solve(&d->rig.geom, t, NULL, &s, err, sizeof err);
     if (rc) return refused(d, rc, err);
     if ((rc = a->quantise(&d->rig.geom, t, &s, &q, err, sizeof err))) return refused(d, rc, err);
@@ -225,7 +281,7 @@ static int visit(rdlg *d, const rg_target *t, double ms)
     if ((rc = a->move_steps(d->m, steps, stop_cb, NULL, err, sizeof err)))
         return refused(d, rc, err);
     if (ms > 0 && (rc = do_expose_ms(d, ms))) return rc;
-    if (closed_loop(d, s.target, &miss, &traced, &bound)) {
+    if (closed_loop(d, s.target, &miss, &traced, &bound, &b, hit)) {
         int ok = miss <= bound;
         if (isnan(traced))
             lm_say(d->io, LM_BOTH, P(CLOSED_LOOP_MODEL), miss, bound,
@@ -235,6 +291,7 @@ static int visit(rdlg *d, const rg_target *t, double ms)
                    ok ? P(CLOSED_OK) : P(CLOSED_BAD));
         if (miss > d->worst_um) d->worst_um = miss;
         if (bound > d->worst_bound_um) d->worst_bound_um = bound;
+        if (want_frames(d) && isfinite(miss)) ok = frame_check(d, &b, hit, bound, ms) && ok;
         d->outside += !ok;
     } else {
         lm_say(d->io, LM_BOTH, "%s", P(NO_FEEDBACK));
@@ -285,6 +342,8 @@ static int do_scan(rdlg *d)
         return rc;
     d->worst_um = d->worst_bound_um = 0;
     d->outside = 0;
+    d->nframes = 0;
+    d->fworst_um = d->fworst_lim_um = d->fsigma_um = d->foff_um = 0;
     /* a sunflower (Vogel) spiral: even cover of the disc, no two points on a ring */
     for (long k = 0; k < (long)n; k++) {
         rg_target t;
@@ -295,6 +354,9 @@ static int do_scan(rdlg *d)
         if ((rc = visit(d, &t, ms))) return rc;
     }
     lm_say(d->io, LM_BOTH, P(SCAN_DONE), (int)n, d->worst_um, d->worst_bound_um, d->outside);
+    if (d->nframes)
+        lm_say(d->io, LM_BOTH, P(FRAMES_DONE), d->nframes, d->fworst_um, d->fworst_lim_um,
+               d->fsigma_um, d->foff_um);
     if (d->outside && !d->io->interactive) return LM_FAIL;
     return LM_GO;
 }
@@ -381,6 +443,7 @@ int lm_rig(lm_io *io)
         if (d->sim && strcmp(d->log, "-")) lm_say(io, LM_OUT, P(WRITTEN_OUT), d->log);
     }
     lm_on_stop_remove(laser_off_hook, NULL);
+    lm_rigcam_free(&d->cam);
     free(d);
     if (rc == LM_FAIL || rc == LM_QUIT) return rc;
     lm_check_leftover(io);

@@ -26,7 +26,7 @@ typedef struct reader {
     char *err;
     size_t cap;
     /* where each key was given (duplicates): globals, then per axis */
-    long gseen[16];
+    long gseen[32];
     long aseen[RG_NJOINTS][16];
     const rig_api *geo;         /* the geometry half (its keys), or NULL */
 } reader;
@@ -89,10 +89,12 @@ static int line_spec(reader *r, const char *key, char **w, int nw, rg_line *l)
 }
 
 enum { G_CHIP, G_LASER, G_INTERLOCK, G_HEART, G_MAXON, G_TICK, G_HTIMEOUT, G_HOMETO,
-       G_SETTLE, G_SIMRT, G_SIMIL, G_SIMILMS, NG };
+       G_SETTLE, G_SIMRT, G_SIMIL, G_SIMILMS, G_CAM, G_CPITCH, G_CPIX, G_CNOISE, G_CSEED,
+       G_WAIST, NG };
 static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "max_on_ms", "tick_us", "heartbeat_timeout_ms", "home_timeout_s", "settle_ms",
-    "sim_realtime", "sim_interlock", "sim_interlock_open_ms"};
+    "sim_realtime", "sim_interlock", "sim_interlock_open_ms", "camera", "camera_pitch",
+    "camera_pixels", "camera_read_noise", "camera_seed", "beam_waist"};
 enum { A_STEP, A_DIR, A_ENABLE, A_HOME, A_STEPS, A_MIN, A_MAX, A_SPEED, A_ACCEL,
        A_HOMEAT, A_HOMEDIR, A_HOMESPEED, A_DIRINV, A_SIMHOME, NA };
 static const char *const akeys[NA] = {"step", "dir", "enable", "home", "steps_per", "min",
@@ -142,6 +144,29 @@ static int global_key(reader *r, int k, char **w, int nw)
             return fail(r, "'sim_interlock_open_ms' must be 0 or more");
         return rc;
     }
+    case G_CAM: return yesno(r, w[0], a, "frames", "none", &g->cam_frames);
+    case G_CPITCH: return positive(r, w[0], a, 1, &g->cam_pitch);
+    case G_CPIX: {
+        double n;
+        int rc = number(r, w[0], a, &n);
+        if (!rc && !(n >= 16 && n <= 4096 && n == floor(n)))
+            return fail(r, "'camera_pixels' must be a whole number from 16 to 4096");
+        if (!rc) g->cam_pixels = (int)n;
+        return rc;
+    }
+    case G_CNOISE: {
+        int rc = number(r, w[0], a, &g->cam_read_noise);
+        if (!rc && !(g->cam_read_noise >= 0 && g->cam_read_noise <= 1000))
+            return fail(r, "'camera_read_noise' must be from 0 to 1000 electrons");
+        return rc;
+    }
+    case G_CSEED: {
+        int rc = number(r, w[0], a, &g->cam_seed);
+        if (!rc && !(g->cam_seed >= 0 && g->cam_seed <= 4e9 && g->cam_seed == floor(g->cam_seed)))
+            return fail(r, "'camera_seed' must be a whole number from 0 to 4000000000");
+        return rc;
+    }
+    case G_WAIST: return positive(r, w[0], a, 10, &g->beam_waist);
     }
     return 0;
 }
@@ -333,6 +358,11 @@ static void defaults(rg_rig *g, const rig_api *geo)
     g->tick_us = 250;
     g->home_timeout_s = 30;
     g->sim_interlock_open_ms = -1;
+    g->cam_pitch = 0.02;
+    g->cam_pixels = 128;
+    g->cam_read_noise = 5;
+    g->cam_seed = 1;
+    g->beam_waist = 0.2;
 }
 
 int rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,

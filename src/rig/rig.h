@@ -265,6 +265,13 @@ typedef struct rg_rig {
     double sim_interlock_open_ms; /* simulator: it opens at this time (ms); < 0 never */
     int geom_keys;              /* number of geometry lines read */
     rg_geometry geom;
+    /* the camera at the detector point, for closed-loop frames (README "Rig files") */
+    int cam_frames;             /* camera frames|none: 1 = scans check synthetic frames */
+    double cam_pitch;           /* camera_pitch MM (default 0.02) */
+    int cam_pixels;             /* camera_pixels N: an N x N sensor (default 128) */
+    double cam_read_noise;      /* camera_read_noise E: electrons rms (default 5) */
+    double cam_seed;            /* camera_seed N: noise seed of the first frame (default 1) */
+    double beam_waist;          /* beam_waist MM: the laser's waist radius (default 0.2) */
 } rg_rig;
 
 enum rg_backend { RG_BACKEND_SIM, RG_BACKEND_GPIOD, RG_BACKEND_NULL };
