@@ -25,11 +25,7 @@ static int plot_methods(const char *png, int n, const double *rms, const double 
                         double crb)
 {
     const imaging_api *im = imaging_get_api(IMAGING_ABI);
-    size_t len = strlen(png);
-    if (len < 5 || strcmp(png + len - 4, ".png")) {
-        fprintf(stderr, "bench_centroid: %s: the plot's name must end in .png\n", png);
-        return 1;
-    }
+    size_t len = strlen(png);          /* ends in .png: main checked before measuring */
     char *svg = malloc(len + 1), err[256], cpu[128] = "", note[256], crbname[64];
     if (!im || !im->draw || !svg) return 1;
     memcpy(svg, png, len - 4);
@@ -110,6 +106,10 @@ int main(int argc, char **argv)
     long iters = 0;
     uint64_t z = 12345;
     char err[256];
+    if (png && (strlen(png) < 5 || strcmp(png + strlen(png) - 4, ".png"))) {
+        fprintf(stderr, "bench_centroid: %s: the plot's name must end in .png\n", png);
+        return 1;
+    }
     for (int m = 0; m < NMETH; m++) tm[m] = malloc(sizeof(double) * n);
     if (n < 1 || !c || !tsyn || !tread) return 1;
     for (int k = 0; k < n; k++) {
@@ -181,14 +181,19 @@ int main(int argc, char **argv)
     printf("BENCH centroid_vs_read %.2f ratio\n", med[0] / read_us);
     printf("BENCH frame_synth_ms %.3f ms\n", it_median(tsyn, n) * 1e3);
     printf("BENCH frame_synth_shot_ms %.3f ms\n", it_median(tshot, 21) * 1e3);
-    if (tsv) {
-        FILE *o = fopen(tsv, "w");
+    if (tsv) {   /* written beside its name and renamed: never a half table */
+        char part[4096];
+        snprintf(part, sizeof part, "%s.part", tsv);
+        FILE *o = fopen(part, "w");
+        int bad = !o;
         if (o) {
             fprintf(o, "method\trms_px\tus_per_frame\n");
             for (int m = 0; m < NMETH; m++)
                 fprintf(o, "%s\t%.5f\t%.2f\n", meth_name[m], rms[m], med[m]);
-            fclose(o);
+            bad = ferror(o) | fclose(o);
+            if (bad || rename(part, tsv)) { bad = 1; remove(part); }
         }
+        if (bad) { fprintf(stderr, "bench_centroid: cannot write %s\n", tsv); return 1; }
     }
     fa->centroider_free(c);
     return png ? plot_methods(png, n, rms, med, crb) : 0;
