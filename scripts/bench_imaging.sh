@@ -2,7 +2,8 @@
 # bench_imaging.sh -- the imaging engine's frame and centroid figures (issue 10):
 # centroid accuracy against the Cramer-Rao bound on 1000 synthetic 640x480 16-bit frames
 # and the time per frame of each method (tests/imaging/bench_centroid.c; the method
-# table goes to build/bench/centroid_methods.tsv for the plot), the synthesis time, and
+# table goes to build/bench/centroid_methods.tsv and is plotted, error against time on
+# log-log axes, to build/bench/centroid_methods.png and .svg), the synthesis time, and
 # the cost of loading the module for the first frame and the camera module for the first
 # video frame (tests/imaging/bench_load.c, median of 7 fresh processes).
 # BENCH_QUICK=1: 200 frames, 3 processes.
@@ -14,7 +15,10 @@ n=1000; runs=7
 [ -n "$BENCH_QUICK" ] && { n=200; runs=3; }
 echo "# machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; one thread"
 mkdir -p build/bench
-"$B/bench_centroid" "$n" build/bench/centroid_methods.tsv || exit 1
+# (its PLOT box/marker lines, the pixels of the markers, are for the tests)
+out=$("$B/bench_centroid" "$n" build/bench/centroid_methods.tsv build/bench/centroid_methods.png) || exit 1
+printf '%s\n' "$out" | grep -v '^PLOT [bm]'
+
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT
 "$B/bench_load" build/lib --make-avi "$tmp/v.avi" || exit 1

@@ -135,6 +135,7 @@ static int draw_plot(const im_plot *p, const im_out *out, im_plot_info *info, ch
     Frame f = {90, 50, W - (legend ? lw + 70 : 30), (double)H - 70, xmin, xmax, ymin, ymax,
                p->logx != 0, p->logy != 0};
     if (f.x1 - f.x0 < 120) f.x1 = f.x0 + 120;
+    info->box_x0 = f.x0; info->box_y0 = f.y0; info->box_x1 = f.x1; info->box_y1 = f.y1;
     Canvas c(W, H);
     axes(c, f, p->xlabel, p->ylabel);
     if (p->zero_line && !p->logy) c.line(f.at(xmin, 0), f.at(xmax, 0), GREY, 1);
@@ -145,7 +146,15 @@ static int draw_plot(const im_plot *p, const im_out *out, im_plot_info *info, ch
             if (ok(s->x[k], s->y[k])) pts.push_back(f.at(s->x[k], s->y[k]));
         int style = s->style ? s->style : IM_LINES | IM_MARKERS;
         if (style & IM_LINES) c.polyline(pts, palette(i), 1.6);
-        if (style & IM_MARKERS) for (Pt q : pts) marker(c, q, i, palette(i));
+        if (style & IM_MARKERS)
+            for (int k = 0, j = 0; k < s->n; k++) {
+                if (!ok(s->x[k], s->y[k])) continue;
+                Pt q = pts[j++];
+                marker(c, q, i, palette(i));
+                if (info->nmark < IM_MAXPLOTMARK)
+                    info->mark[info->nmark] = {i, k, q.x, q.y};
+                info->nmark++;
+            }
     }
     double th = Canvas::text_height(1), ly = f.y0 + th;
     for (int i = 0; i < p->nseries; i++) {

@@ -138,9 +138,18 @@ typedef struct im_plot {
     const im_series *series;
     const char *note;          /* a line under the legend, or NULL */
 } im_plot;
+/* A marker the plot drew: point `point` of series `series`, centred on pixel (x, y). */
+typedef struct im_plot_mark { int series, point; double x, y; } im_plot_mark;
+#define IM_MAXPLOTMARK 64
 typedef struct im_plot_info {
     int skipped;               /* points left out (not finite, <= 0 on a log axis) */
     double xmin, xmax, ymin, ymax;   /* the axes' ranges */
+    /* The plot area in PNG pixels: xmin at x = box_x0, xmax at box_x1, ymax at
+     * box_y0 (top), ymin at box_y1; values placed linearly, or by log10 on a log axis. */
+    double box_x0, box_y0, box_x1, box_y1;
+    int nmark;                 /* markers drawn (IM_MARKERS series), the first
+                                  IM_MAXPLOTMARK of them in mark[] */
+    im_plot_mark mark[IM_MAXPLOTMARK];
 } im_plot_info;
 
 typedef struct im_draw_api im_draw_api;

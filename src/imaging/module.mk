@@ -102,6 +102,7 @@ build/fuzz_frame: tests/imaging/fuzz_frame.c $(IM_FUZZSRC) $(IM_HDR) | $(DEPS)
 all: build/lib/lensmat-imaging.so build/lib/lensmat-camera.so
 MODULE_TEST_BINS  += build/lib/lensmat-imaging.so build/asan/lib/lensmat-imaging.so \
                      build/lib/lensmat-camera.so build/asan/lib/lensmat-camera.so \
-                     build/fuzz_frame $(IM_TBIN) build/obj/imaging_tests/bench_load
+                     build/fuzz_frame $(IM_TBIN) build/obj/imaging_tests/bench_load \
+                     build/obj/imaging_tests/bench_centroid
 MODULE_BENCH_BINS += build/lib/lensmat-imaging.so build/lib/lensmat-camera.so $(IM_BBIN)
 -include $(IM_OBJ:.o=.d) $(IM_SOBJ:.o=.d)

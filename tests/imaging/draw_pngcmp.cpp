@@ -7,7 +7,11 @@
  *   draw_pngcmp tick FILE.png X Y R G B
  *       where the drawing shows a tick of colour (R,G,B) near pixel column X just
  *       above the axis row Y: the colour-weighted mean column of the matching pixels
- *       in rows Y-8 .. Y-3 and columns X-20 .. X+20; prints it (exit 1: none). */
+ *       in rows Y-8 .. Y-3 and columns X-20 .. X+20; prints it (exit 1: none).
+ *   draw_pngcmp blob FILE.png X Y R G B
+ *       where the drawing shows a marker of colour (R,G,B) near pixel (X, Y): the
+ *       colour-weighted mean x and y of the matching pixels within 6 pixels of it, and
+ *       their weight; prints "x y weight" (exit 1: none). */
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <cmath>
@@ -61,6 +65,24 @@ int main(int argc, char **argv)
         printf("%.3f\n", sx / sw);
         return 0;
     }
-    fprintf(stderr, "usage: draw_pngcmp cmp A B THRESH MAXCOUNT | tick FILE X Y R G B\n");
+    if (argc == 8 && !strcmp(argv[1], "blob")) {
+        cv::Mat m = load(argv[2]);
+        double X = atof(argv[3]), Y = atof(argv[4]), sw = 0, sx = 0, sy = 0;
+        int want[3] = {atoi(argv[7]), atoi(argv[6]), atoi(argv[5])};   /* BGR */
+        for (int y = (int)floor(Y) - 6; y <= (int)ceil(Y) + 6; y++)
+            for (int x = (int)floor(X) - 6; x <= (int)ceil(X) + 6; x++) {
+                if (y < 0 || x < 0 || y >= m.rows || x >= m.cols) continue;
+                if ((x - X) * (x - X) + (y - Y) * (y - Y) > 36) continue;
+                cv::Vec3b p = m.at<cv::Vec3b>(y, x);
+                double d = 0;
+                for (int c = 0; c < 3; c++) d = std::max(d, (double)std::abs(p[c] - want[c]));
+                if (d < 60) { double w = 1 - d / 60; sw += w; sx += w * x; sy += w * y; }
+            }
+        if (sw <= 0) { printf("no marker of that colour there\n"); return 1; }
+        printf("%.3f %.3f %.2f\n", sx / sw, sy / sw, sw);
+        return 0;
+    }
+    fprintf(stderr, "usage: draw_pngcmp cmp A B THRESH MAXCOUNT | tick FILE X Y R G B | "
+            "blob FILE X Y R G B\n");
     return 2;
 }

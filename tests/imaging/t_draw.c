@@ -78,6 +78,21 @@ static void plot_ranges(void)
     CHECK(info.skipped == 3, "plot: 0, -1 and NaN left off log axes (%d)", info.skipped);
     CHECK(info.xmin < 1 && info.xmax > 100 && info.ymin < 1e-9 && info.ymax > 1e-3,
           "plot: the axes hold the data (%g..%g, %g..%g)", info.xmin, info.xmax, info.ymin, info.ymax);
+    /* the markers drawn are the three points kept, each where the log axes put it:
+       x = 10 is half-way across decades 1..100, y = 1e-6 half-way up */
+    int at_data = info.nmark == 3;
+    for (int k = 0; k < info.nmark && k < 3; k++) {
+        const im_plot_mark *m = &info.mark[k];
+        double lx = (log10(x[m->point]) - log10(info.xmin)) / (log10(info.xmax) - log10(info.xmin));
+        double ly = (log10(y[m->point]) - log10(info.ymin)) / (log10(info.ymax) - log10(info.ymin));
+        at_data &= m->series == 0 && m->point == k &&
+                   fabs(m->x - (info.box_x0 + lx * (info.box_x1 - info.box_x0))) < 1e-6 &&
+                   fabs(m->y - (info.box_y1 - ly * (info.box_y1 - info.box_y0))) < 1e-6;
+    }
+    CHECK(at_data && info.box_x0 < info.box_x1 && info.box_y0 < info.box_y1 &&
+          fabs(info.mark[1].x - 0.5 * (info.mark[0].x + info.mark[2].x)) < 1e-6 &&
+          fabs(info.mark[1].y - 0.5 * (info.mark[0].y + info.mark[2].y)) < 1e-6,
+          "plot: 3 markers reported where the log axes put the data (%d)", info.nmark);
     double z[2] = {0, -1};
     s.x = z; s.y = z; s.n = 2;
     CHECK(D->plot(&p, &out, &info, err, sizeof err) == IM_EINVAL && strstr(err, "positive"),
