@@ -26,6 +26,9 @@ typedef struct tr_surf {
     double eps;                /* mesh: plane distances below this are "here" */
     int closed;                /* mesh: closed and consistently wound, its normals
                                   outward (1) or inward (-1); 0: not known closed */
+    uint32_t *weld;            /* mesh: nv, the first vertex at each one's coordinates */
+    uint32_t *vt_start, *vt_tri;   /* mesh: the triangles around each welded vertex
+                                  (tr_wt.c): vt_tri[vt_start[w] .. vt_start[w + 1]) */
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */
@@ -70,6 +73,15 @@ struct trace_scene {
     tr_pk_set entry_pk;
     double entry_z;            /* ... if it starts at z < entry_z */
 };
+
+/* tr_wt.c: adjacency and the watertight test in double (see there). */
+int    tr_wt_adjacency(tr_surf *f, uint32_t *weld);
+int    tr_wt_hit(const tr_surf *f, long prim, const double o[3], const double d[3],
+                 double *t);
+double tr_wt_margin(const tr_surf *f, long prim, double pad);
+int    tr_wt_ring(const tr_surf *f, long prim, const double o[3], const double d[3],
+                  long skip, double tmin, long *best, double *t, uint32_t *ex, int *nex,
+                  int cap);
 
 typedef struct tr_hitrec {
     int surf;
