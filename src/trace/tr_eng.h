@@ -79,6 +79,27 @@ int    tr_wt_adjacency(tr_surf *f, uint32_t *weld);
 int    tr_wt_hit(const tr_surf *f, long prim, const double o[3], const double d[3],
                  double *t);
 double tr_wt_margin(const tr_surf *f, long prim, double pad);
+/* Is barycentric distance m from an edge within tr_wt_margin(f, prim, pad)?  The same
+ * test without its square root or division (every mesh hit asks it). */
+static inline int tr_wt_near(const tr_surf *f, long prim, double m, double pad)
+{
+    const uint32_t *ix = f->idx + 3 * prim;
+    const double *a = f->vtx + 3 * ix[0], *b = f->vtx + 3 * ix[1], *c = f->vtx + 3 * ix[2];
+    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double e3[3] = {c[0] - b[0], c[1] - b[1], c[2] - b[2]}, n[3];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double l2 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    double l = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    if (l > l2) l2 = l;
+    l = e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2];
+    if (l > l2) l2 = l;
+    double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], k = 3 * pad;
+    /* m < min(1, 3 pad lmax / |n|)  <=>  m < 1 and m^2 |n|^2 < (3 pad)^2 lmax^2 */
+    return m < 1 && m * m * n2 < k * k * l2;
+}
 int    tr_wt_ring(const tr_surf *f, long prim, const double o[3], const double d[3],
                   long skip, double tmin, long *best, double *t, uint32_t *ex, int *nex,
                   int cap);
