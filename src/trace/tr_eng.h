@@ -79,6 +79,7 @@ int    tr_wt_adjacency(tr_surf *f, uint32_t *weld);
 int    tr_wt_hit(const tr_surf *f, long prim, const double o[3], const double d[3],
                  double *t);
 double tr_wt_margin(const tr_surf *f, long prim, double pad);
+#define TR_WT_KMAX 0.1
 /* Is barycentric distance m from an edge within tr_wt_margin(f, prim, pad)?  The same
  * test without its square root or division (every mesh hit asks it). */
 static inline int tr_wt_near(const tr_surf *f, long prim, double m, double pad)
@@ -97,8 +98,8 @@ static inline int tr_wt_near(const tr_surf *f, long prim, double m, double pad)
     l = e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2];
     if (l > l2) l2 = l;
     double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], k = 3 * pad;
-    /* m < min(1, 3 pad lmax / |n|)  <=>  m < 1 and m^2 |n|^2 < (3 pad)^2 lmax^2 */
-    return m < 1 && m * m * n2 < k * k * l2;
+    /* m < min(KMAX, 3 pad lmax / |n|)  <=>  m < KMAX and m^2 |n|^2 < (3 pad)^2 lmax^2 */
+    return m < TR_WT_KMAX && m * m * n2 < k * k * l2;
 }
 int    tr_wt_ring(const tr_surf *f, long prim, const double o[3], const double d[3],
                   long skip, double tmin, long *best, double *t, uint32_t *ex, int *nex,

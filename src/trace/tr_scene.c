@@ -394,7 +394,7 @@ static void user_bounds(const struct RTCBoundsFunctionArguments *a)
 
 /* A mesh goes to Embree with every triangle grown about its centroid until each edge
  * has moved out by 2 epad (what a float ray may stray from the double one, and more
- * than the vertices' own rounding), at most doubled in size: Embree then never misses
+ * than the vertices' own rounding), by a tenth at most: Embree then never misses
  * a triangle the double ray meets, at a shared edge or vertex or a mesh's boundary,
  * and tr_hit.c decides the hits within that margin of an edge in double
  * (tr_wt_margin).  So each triangle has its own three float vertices. */

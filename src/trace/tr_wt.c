@@ -78,7 +78,9 @@ int tr_wt_hit(const tr_surf *f, long prim, const double o[3], const double d[3],
 /* How far (in barycentric units) Embree's hit on triangle prim may lie from the true
  * triangle's edges: the triangle was grown about its centroid by k (tr_wt_grow), so
  * its true edges sit at barycentric k/(3(1+k)) of the grown one, and Embree's own
- * rounding adds at most as much again; below k the hit is decided here. */
+ * rounding adds at most as much again; below k the hit is decided here.  k is held
+ * to TR_WT_KMAX: the grown triangle then stays inside the triangles around its
+ * vertices, which are the ones asked. */
 double tr_wt_margin(const tr_surf *f, long prim, double pad)
 {
     const uint32_t *ix = f->idx + 3 * prim;
@@ -93,7 +95,7 @@ double tr_wt_margin(const tr_surf *f, long prim, double pad)
     double lmax = sqrt(fmax(v_dot(e1, e1), fmax(v_dot(e2, e2), v_dot(e3, e3))));
     double hmin = v_norm(n) / lmax;             /* the smallest altitude */
     double k = 3 * pad / hmin;
-    return k < 1 ? k : 1;
+    return k < TR_WT_KMAX ? k : TR_WT_KMAX;
 }
 
 /* The nearest of the triangles around triangle prim's three vertices that the ray
