@@ -26,6 +26,9 @@ typedef struct tr_surf {
     double eps;                /* mesh: plane distances below this are "here" */
     int closed;                /* mesh: closed and consistently wound, its normals
                                   outward (1) or inward (-1); 0: not known closed */
+    uint32_t *weld;            /* mesh: nv, the first vertex at each one's coordinates */
+    uint32_t *vt_start, *vt_tri;   /* mesh: the triangles around each welded vertex
+                                  (tr_wt.c): vt_tri[vt_start[w] .. vt_start[w + 1]) */
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */
@@ -70,6 +73,37 @@ struct trace_scene {
     tr_pk_set entry_pk;
     double entry_z;            /* ... if it starts at z < entry_z */
 };
+
+/* tr_wt.c: adjacency and the watertight test in double (see there). */
+int    tr_wt_adjacency(tr_surf *f, uint32_t *weld);
+int    tr_wt_hit(const tr_surf *f, long prim, const double o[3], const double d[3],
+                 double *t);
+double tr_wt_margin(const tr_surf *f, long prim, double pad);
+#define TR_WT_KMAX 0.1
+/* Is barycentric distance m from an edge within tr_wt_margin(f, prim, pad)?  The same
+ * test without its square root or division (every mesh hit asks it). */
+static inline int tr_wt_near(const tr_surf *f, long prim, double m, double pad)
+{
+    const uint32_t *ix = f->idx + 3 * prim;
+    const double *a = f->vtx + 3 * ix[0], *b = f->vtx + 3 * ix[1], *c = f->vtx + 3 * ix[2];
+    double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double e3[3] = {c[0] - b[0], c[1] - b[1], c[2] - b[2]}, n[3];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double l2 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    double l = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    if (l > l2) l2 = l;
+    l = e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2];
+    if (l > l2) l2 = l;
+    double n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2], k = 3 * pad;
+    /* m < min(KMAX, 3 pad lmax / |n|)  <=>  m < KMAX and m^2 |n|^2 < (3 pad)^2 lmax^2 */
+    return m < TR_WT_KMAX && m * m * n2 < k * k * l2;
+}
+int    tr_wt_ring(const tr_surf *f, long prim, const double o[3], const double d[3],
+                  long skip, double tmin, long *best, double *t, uint32_t *ex, int *nex,
+                  int cap);
 
 typedef struct tr_hitrec {
     int surf;

@@ -2,7 +2,8 @@
  * this ray meet next, and where (in double).  Embree's callbacks for analytic surfaces
  * and meshes, its float ray started where the double one enters its box, the surfaces
  * outside its range tested in double, the second chance at shared vertices of closed
- * meshes, coincident surfaces taken in order, and the lens shortcut's candidates. */
+ * meshes, hits near a mesh's edges and vertices decided in double (tr_wt.c),
+ * coincident surfaces taken in order, and the lens shortcut's candidates. */
 #include <float.h>
 #include <math.h>
 #include "tr_eng.h"
@@ -20,6 +21,9 @@ typedef struct tr_ctx {
     double best_t, best_n[3];
     int best_far;                    /* ... from a far start: its point best_q */
     double best_q[3];
+    const tr_surf *xs;               /* triangles xp[0..nx) of mesh xs: the double */
+    const uint32_t *xp;              /* test said the ray misses them */
+    int nx;
 } tr_ctx;
 
 /* Front-facing unit normal of an analytic surface from tr_shape_hit's. */
@@ -97,8 +101,11 @@ void tr_mesh_filter(const struct RTCFilterFunctionNArguments *a)
     if (a->N != 1 || !a->valid[0]) return;
     const tr_ctx *x = (const tr_ctx *)a->context;
     const tr_surf *f = a->geometryUserPtr;
-    if (x->last_surf != f->id) return;
     long prim = ((const unsigned *)a->hit)[5];    /* RTCHit.primID for N = 1 */
+    if (x->xs == f)
+        for (int i = 0; i < x->nx; i++)
+            if (x->xp[i] == (uint32_t)prim) { a->valid[0] = 0; return; }
+    if (x->last_surf != f->id) return;
     if (prim == x->last_prim) { a->valid[0] = 0; return; }
     if (!x->float_hits && !(tri_plane_t(f, prim, x->o, x->d) > f->eps)) a->valid[0] = 0;
 }
@@ -144,6 +151,51 @@ static void closed_retry(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
     }
 }
 
+/* Embree's hit on a mesh within its margin of an edge or vertex (tr_wt_margin) is
+ * decided in double: the nearest of the triangles around the hit triangle's vertices
+ * that the watertight test says the true ray meets (beyond the mesh's eps when it
+ * leaves that mesh, never the triangle it left).  If none does, Embree's triangle
+ * grew past the true one: the query is asked again without the triangles tested, a
+ * few times.  Ties go to the lower triangle number, so the answer never depends on
+ * Embree's order or on threads. */
+#define WT_ROUNDS 4
+#define WT_CAP 256
+static void near_edge(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
+                      const double o[3], const double d[3], int last_surf,
+                      long last_prim, double ta)
+{
+    uint32_t ex[WT_CAP];
+    int nex = 0;
+    for (int round = 0; round < WT_ROUNDS; round++) {
+        if (rh->hit.geomID == RTC_INVALID_GEOMETRY_ID) return;
+        const tr_surf *f = sc->surf[rh->hit.geomID];
+        if (!f->is_mesh) return;
+        long prim = rh->hit.primID, best;
+        double u = rh->hit.u, v = rh->hit.v, w = 1 - u - v, t;
+        double m = fmin(u, fmin(v, w));
+        if (!tr_wt_near(f, prim, m, 2 * sc->epad)) return;       /* well inside */
+        if (x->xs && x->xs != f) return;   /* one mesh's edges at a time: rare enough */
+        int leaving = last_surf == f->id;
+        if (tr_wt_ring(f, prim, o, d, leaving ? last_prim : -1, leaving ? f->eps : 0,
+                       &best, &t, ex, &nex, WT_CAP)) {
+            rh->hit.primID = (unsigned)best;
+            rh->ray.tfar = (float)(t - ta);
+            return;
+        }
+        /* the true ray misses them all: ask again without them */
+        x->xs = f;
+        x->xp = ex;
+        x->nx = nex;
+        x->best_surf = -1;
+        x->best_t = INFINITY;
+        x->best_far = 0;
+        rh->ray.tfar = INFINITY;
+        rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(sc->scn, &x->ec, rh);
+    }
+}
+
 /* Nearest hit among what Embree holds, its ray starting at o + ta d; 0 if none. */
 static int embree_nearest(const trace_scene *sc, int float_hits, const double o[3],
                           const double d[3], int last_surf, long last_prim, double ta,
@@ -162,6 +214,9 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     x.best_t = INFINITY;
     x.best_far = 0;
     x.ta = ta;
+    x.xs = NULL;
+    x.xp = NULL;
+    x.nx = 0;
     rh.ray.org_x = (float)(o[0] + ta * d[0] - sc->eoff[0]);
     rh.ray.org_y = (float)(o[1] + ta * d[1] - sc->eoff[1]);
     rh.ray.org_z = (float)(o[2] + ta * d[2] - sc->eoff[2]);
@@ -196,6 +251,7 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
             if (v_dot(n, d) * m->closed > 0) closed_retry(sc, &x, &rh, m, o, d, ta);
         }
     }
+    if (!float_hits) near_edge(sc, &x, &rh, o, d, last_surf, last_prim, ta);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
     const tr_surf *f = sc->surf[rh.hit.geomID];
     if (!f->is_mesh) {

@@ -90,6 +90,9 @@ void tr_scene_free(trace_scene *sc)
         free(sc->surf[i]->vtx);
         free(sc->surf[i]->idx);
         free(sc->surf[i]->media);
+        free(sc->surf[i]->weld);
+        free(sc->surf[i]->vt_start);
+        free(sc->surf[i]->vt_tri);
         free(sc->surf[i]);
     }
     free(sc->surf);
@@ -173,17 +176,17 @@ static uint64_t mix64(uint64_t x)
 
 /* Is the mesh closed (vertices welded where their coordinates are equal, every edge
  * used once in each direction)?  1: its normals point outward (positive volume), -1:
- * inward, 0: not closed, or out of memory. */
-static int mesh_closed(const tr_surf *f)
+ * inward, 0: not closed.  The welding is left in weld[nv] (for the adjacency);
+ * -2: out of memory. */
+static int mesh_closed(const tr_surf *f, uint32_t *weld)
 {
     size_t nv = (size_t)f->nv, cap = 16, ne = (size_t)f->ntri * 3, ecap = 16;
     while (cap < 2 * nv) cap *= 2;
     while (ecap < 2 * ne) ecap *= 2;
     long *slot = malloc(cap * sizeof *slot);
-    uint32_t *weld = malloc(nv * sizeof *weld);
     uint64_t *edge = malloc(ecap * sizeof *edge);
     int closed = 0;
-    if (!slot || !weld || !edge) goto out;
+    if (!slot || !edge) { closed = -2; goto out; }
     for (size_t i = 0; i < cap; i++) slot[i] = -1;
     for (size_t i = 0; i < nv; i++) {
         uint64_t b[3], h = 0;
@@ -200,6 +203,8 @@ static int mesh_closed(const tr_surf *f)
             }
         }
     }
+    free(slot);
+    slot = NULL;
     memset(edge, 0xff, ecap * sizeof *edge);          /* empty: all ones */
     double vol = 0;
     for (long t = 0; t < f->ntri; t++) {
@@ -230,7 +235,6 @@ static int mesh_closed(const tr_surf *f)
     closed = vol > 0 ? 1 : vol < 0 ? -1 : 0;
 out:
     free(slot);
-    free(weld);
     free(edge);
     return closed;
 }
@@ -312,7 +316,13 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     }
     double diag[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     f->eps = 1e-9 * v_norm(diag);
-    f->closed = mesh_closed(f);
+    uint32_t *weld = malloc((size_t)nv * sizeof *weld);
+    f->closed = weld ? mesh_closed(f, weld) : -2;
+    if (f->closed == -2 || tr_wt_adjacency(f, weld)) {
+        free(weld);
+        rc = fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
+        goto bad;
+    }
     sc->nclosed += f->closed != 0;
     if (mesh->underlying) {
         if (tr_shape_init(&f->shape, mesh->underlying, sc->err, sizeof sc->err)) {
@@ -330,6 +340,9 @@ bad:
     free(f->vtx);
     free(f->idx);
     free(f->media);
+    free(f->weld);
+    free(f->vt_start);
+    free(f->vt_tri);
     free(f);
     return rc;
 }
@@ -379,17 +392,32 @@ static void user_bounds(const struct RTCBoundsFunctionArguments *a)
     b->upper_z = nextafterf((float)(f->shape.hi[2] - c[2] + f->pad), INFINITY);
 }
 
+/* A mesh goes to Embree with every triangle grown about its centroid until each edge
+ * has moved out by 2 epad (what a float ray may stray from the double one, and more
+ * than the vertices' own rounding), by a tenth at most: Embree then never misses
+ * a triangle the double ray meets, at a shared edge or vertex or a mesh's boundary,
+ * and tr_hit.c decides the hits within that margin of an edge in double
+ * (tr_wt_margin).  So each triangle has its own three float vertices. */
 static int attach_mesh(trace_scene *sc, tr_surf *f)
 {
     RTCGeometry g = rtcNewGeometry(sc->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!g) return -1;
     float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                       3 * sizeof(float), (size_t)f->nv);
+                                       3 * sizeof(float), (size_t)f->ntri * 3);
     unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                            3 * sizeof(unsigned), (size_t)f->ntri);
     if (!v || !ix) { rtcReleaseGeometry(g); return -1; }
-    for (long i = 0; i < 3 * f->nv; i++) v[i] = (float)(f->vtx[i] - sc->eoff[i % 3]);
-    memcpy(ix, f->idx, (size_t)f->ntri * 3 * sizeof(unsigned));
+    for (long t = 0; t < f->ntri; t++) {
+        double c[3] = {0, 0, 0}, k = tr_wt_margin(f, t, 2 * sc->epad);
+        for (int q = 0; q < 3; q++)
+            for (int j = 0; j < 3; j++) c[j] += (f->vtx[3 * f->idx[3 * t + q] + j] - sc->eoff[j]) / 3;
+        for (int q = 0; q < 3; q++) {
+            const double *p = f->vtx + 3 * f->idx[3 * t + q];
+            for (int j = 0; j < 3; j++)
+                v[9 * t + 3 * q + j] = (float)(c[j] + (p[j] - sc->eoff[j] - c[j]) * (1 + k));
+            ix[3 * t + q] = (unsigned)(3 * t + q);
+        }
+    }
     rtcSetGeometryUserData(g, f);
     rtcSetGeometryIntersectFilterFunction(g, tr_mesh_filter);
     rtcCommitGeometry(g);
