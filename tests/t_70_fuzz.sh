@@ -1,11 +1,14 @@
 # t_70_fuzz.sh -- a short libFuzzer run of the answer reader, the number parser and
 # every dialogue (the first byte chooses it, see tests/fuzz_answers.c), from the seed
-# corpus tests/fuzz-corpus (the long run is `make fuzz`).
+# corpus tests/fuzz-corpus (the long run is `make fuzz`).  The seed is fixed
+# (FUZZ_SEED, default 1) so a check run is repeatable; `make fuzz` is not.
 fuzz_short() {
     mkdir -p "$WORK/fuzz"
-    "$TOP/build/fuzz_answers" -max_total_time="${FUZZ_SHORT_SECONDS:-15}" -timeout=5 \
+    "$TOP/build/fuzz_answers" -max_total_time="${FUZZ_SHORT_SECONDS:-15}" -timeout=5 -seed="${FUZZ_SEED:-1}" \
         -print_final_stats=1 -artifact_prefix="$WORK/" "$WORK/fuzz" "$TOP/tests/fuzz-corpus" > "$WORK/fuzz.log" 2>&1 ||
-        { tail -30 "$WORK/fuzz.log"; return 1; }
+        { grep -A25 'printed nan or inf\|ended with\|ERROR:' "$WORK/fuzz.log" | head -60
+          mkdir -p "$TOP/build/fuzz-crashes" && cp "$WORK"/crash-* "$TOP/build/fuzz-crashes/" 2>/dev/null
+          echo "(the input is kept in build/fuzz-crashes/)"; return 1; }
 }
 if [ -x "$TOP/build/fuzz_answers" ]; then
     check "fuzz: answer reader, number parser, every dialogue (short run)" fuzz_short

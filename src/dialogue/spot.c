@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
 #include <time.h>
 #include "ask.h"
 #include "dialogues.h"
@@ -131,6 +132,18 @@ static double now_us(void)
     return t.tv_sec * 1e6 + t.tv_nsec * 1e-3;
 }
 
+/* A result as text: fmt for a finite number, else a word (a noiseless frame has an
+ * unbounded SNR; a failed fit, undetermined uncertainties) -- never nan or inf. */
+typedef struct numtxt { char s[40]; } numtxt;
+static numtxt txt(const char *fmt, double v)
+{
+    numtxt t;
+    if (isnan(v)) snprintf(t.s, sizeof t.s, "undetermined");
+    else if (isinf(v)) snprintf(t.s, sizeof t.s, "unbounded");
+    else snprintf(t.s, sizeof t.s, fmt, v);
+    return t;
+}
+
 static int locate(sdlg *d)
 {
     enum { CAP = 16 };
@@ -150,9 +163,10 @@ static int locate(sdlg *d)
         lm_say(d->io, LM_BOTH, P(FAILED), err);
         return LM_FAIL;
     }
-    lm_say(d->io, LM_BOTH, P(BG), r.background, r.noise);
+    lm_say(d->io, LM_BOTH, P(BG), txt("%.2f", r.background).s, txt("%.2f", r.noise).s);
     if (r.outcome == IM_FOUND_NONE) {
-        lm_say(d->io, LM_BOTH, P(NONE), o.threshold, r.best_x, r.best_y, r.best_snr);
+        lm_say(d->io, LM_BOTH, P(NONE), o.threshold, txt("%.0f", r.best_x).s,
+               txt("%.0f", r.best_y).s, txt("%.2f", r.best_snr).s);
     } else if (r.outcome == IM_FOUND_ONE) {
         lm_say(d->io, LM_BOTH, "%s", P(ONE));
     } else {
@@ -161,8 +175,9 @@ static int locate(sdlg *d)
         lm_say(d->io, LM_BOTH, P(SEVERAL), r.ndetected, more);
     }
     for (int i = 0; i < r.nspots; i++) {
-        lm_say(d->io, LM_BOTH, P(SPOT), i + 1, s[i].x, s[i].sx, s[i].y, s[i].sy, s[i].w,
-               s[i].amp, s[i].power, s[i].snr);
+        lm_say(d->io, LM_BOTH, P(SPOT), i + 1, txt("%.4f", s[i].x).s, txt("%.4f", s[i].sx).s,
+               txt("%.4f", s[i].y).s, txt("%.4f", s[i].sy).s, txt("%.3f", s[i].w).s,
+               txt("%.1f", s[i].amp).s, txt("%.6g", s[i].power).s, txt("%.1f", s[i].snr).s);
         if (s[i].flags & IM_SF_SATURATED) lm_say(d->io, LM_BOTH, P(FLAG_SAT), s[i].nsat);
         if (s[i].flags & IM_SF_EDGE) lm_say(d->io, LM_BOTH, "%s", P(FLAG_EDGE));
         if (s[i].flags & IM_SF_FIT_FAILED) lm_say(d->io, LM_BOTH, "%s", P(FLAG_FIT));
