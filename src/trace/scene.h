@@ -111,9 +111,11 @@ int  sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
                   long *ntri, char *err);
 /* Validate triangles (finite, non-degenerate): 0 or -1 with the triangle's number. */
 int  sc_check_triangles(const double *tri, long ntri, const char *name, char *err);
-/* A whole scene file with its mesh and media files: 0 or -1 (err set). */
+/* A whole scene file with its mesh and media files (scene_load.c): 0 or -1 (err
+ * set). */
 int  sc_load(const char *path, sc_scene *sc, char *err);
 void sc_free(sc_scene *sc);
+void sc_scene_defaults(sc_scene *sc);   /* an empty scene with the default settings */
 /* The rays of a point source (hexapolar rings filling the disc of `radius` about
  * `toward`, perpendicular to from->toward): 1 + 3 rings (rings + 1) of them. */
 long sc_point_count(const sc_source *s);

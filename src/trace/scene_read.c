@@ -2,8 +2,9 @@
  * line, '#' comments), the document's triangle files (three lines "x y z" per
  * triangle, as opticrt reads sphercap.t), media files ("n1 n2" per triangle, as
  * opticrt's p.n) and OBJ meshes (v and f lines).  Buffers in, plain data out, every
- * error as "FILE:LINE: what"; nothing here prints, opens a device or needs Embree,
- * so the whole file is fuzzed alone (tests/fuzz_trace_scene.c). */
+ * error as "FILE:LINE: what"; nothing here prints, opens a file or needs Embree, so
+ * the whole file is fuzzed alone (tests/fuzz_trace_scene.c).  Reading a scene from
+ * disk with its meshes is scene_load.c. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -11,7 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
 #include "scene.h"
 
 #define PI 3.14159265358979323846
@@ -1016,7 +1016,7 @@ static int axial_pairs(sc_scene *sc, char *err)
     return rc;
 }
 
-static void scene_defaults(sc_scene *sc)
+void sc_scene_defaults(sc_scene *sc)
 {
     memset(sc, 0, sizeof *sc);
     sc->depth = 16;
@@ -1031,7 +1031,7 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
     reader r;
     int st;
 
-    scene_defaults(sc);
+    sc_scene_defaults(sc);
     reader_init(&r, text, len, name, err);
     if (!(sc->name = malloc(strlen(name) + 1))) return -1;
     strcpy(sc->name, name);
@@ -1065,182 +1065,4 @@ void sc_free(sc_scene *sc)
     free(sc->name);
     free(sc->dir);
     memset(sc, 0, sizeof *sc);
-}
-
-/* ---- files -------------------------------------------------------------------- */
-
-/* Read a whole file into a malloc'd buffer. */
-static char *slurp(const char *path, size_t *len, char *err)
-{
-    FILE *f = fopen(path, "rb");
-    char *buf = NULL;
-    size_t cap = 0, n = 0;
-    if (!f) {
-        snprintf(err, SC_ERRMAX, "%s: cannot open: %s", path, strerror(errno));
-        return NULL;
-    }
-    for (;;) {
-        size_t got;
-        if (n == cap) {
-            char *b;
-            cap = cap ? cap * 2 : 65536;
-            if (cap > ((size_t)1 << 32) || !(b = realloc(buf, cap))) {
-                snprintf(err, SC_ERRMAX, "%s: too large or out of memory", path);
-                free(buf);
-                fclose(f);
-                return NULL;
-            }
-            buf = b;
-        }
-        got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) break;
-    }
-    if (ferror(f)) {
-        snprintf(err, SC_ERRMAX, "%s: read error", path);
-        free(buf);
-        fclose(f);
-        return NULL;
-    }
-    fclose(f);
-    *len = n;
-    return buf;
-}
-
-/* dir/name unless name is absolute. */
-static char *join(const char *dir, const char *name)
-{
-    size_t a = strlen(dir), b = strlen(name);
-    char *p = malloc(a + b + 2);
-    if (!p) return NULL;
-    if (name[0] == '/' || !a) memcpy(p, name, b + 1);
-    else {
-        memcpy(p, dir, a);
-        p[a] = '/';
-        memcpy(p + a + 1, name, b + 1);
-    }
-    return p;
-}
-
-static int ends_with(const char *s, const char *suf)
-{
-    size_t a = strlen(s), b = strlen(suf);
-    return a >= b && !strcasecmp(s + a - b, suf);
-}
-
-/* Prefix err (a file's own message) with the scene line that named the file. */
-static int from_scene(const sc_surface *s, char *err)
-{
-    char tmp[SC_ERRMAX];
-    snprintf(tmp, sizeof tmp, "%s:%ld: %s", s->src, s->line, err);
-    memcpy(err, tmp, SC_ERRMAX);
-    return -1;
-}
-
-static int load_mesh(const sc_scene *sc, sc_surface *s, char *err)
-{
-    char *path = join(sc->dir, s->mesh_file), *text;
-    size_t len;
-    int rc;
-    if (!path) return snprintf(err, SC_ERRMAX, "out of memory"), -1;
-    if (!(text = slurp(path, &len, err))) { free(path); return from_scene(s, err); }
-    rc = ends_with(path, ".obj") ? sc_parse_obj(text, len, path, &s->tri, &s->ntri, err)
-                                 : sc_parse_triangles(text, len, path, &s->tri, &s->ntri, err);
-    free(text);
-    free(path);
-    if (rc) return from_scene(s, err);
-    if (!s->media_file) return 0;
-    if (!(path = join(sc->dir, s->media_file)))
-        return snprintf(err, SC_ERRMAX, "out of memory"), -1;
-    if (!(text = slurp(path, &len, err))) { free(path); return from_scene(s, err); }
-    rc = sc_parse_media(text, len, path, s->ntri, &s->media, err);
-    free(text);
-    free(path);
-    return rc ? from_scene(s, err) : 0;
-}
-
-/* ---- no output over an input ---------------------------------------------------- */
-
-/* The same existing file (device and inode: links and other spellings count)? */
-static int same_file(const char *a, const char *b)
-{
-    struct stat x, y;
-    return a && b && stat(a, &x) == 0 && stat(b, &y) == 0 && x.st_dev == y.st_dev &&
-           x.st_ino == y.st_ino;
-}
-
-/* out (or out.part, which the trace writes first) is input?  0, or -1 with err. */
-static int clash(const sc_scene *sc, const char *what, const char *out, const char *in,
-                 const char *in_what, char *err)
-{
-    char *part = malloc(strlen(out) + 6);
-    int bad;
-    if (!part) return snprintf(err, SC_ERRMAX, "out of memory"), -1;
-    sprintf(part, "%s.part", out);
-    bad = strcmp(out, in) == 0 || strcmp(part, in) == 0 || same_file(out, in) ||
-          same_file(part, in);
-    free(part);
-    if (bad)
-        snprintf(err, SC_ERRMAX, "%s: output %s %s would overwrite %s %s: an output is "
-                 "never written over an input", sc->name, what, out, in_what, in);
-    return bad ? -1 : 0;
-}
-
-/* Every output (and its .part) against the scene file, its mesh and media files and
- * the other outputs, before anything is opened for writing. */
-static int outputs_over_inputs(const sc_scene *sc, const char *path, char *err)
-{
-    const char *what[3] = {"segments", "hits", "summary"};
-    const char *out[3] = {sc->out_segments, sc->out_hits, sc->out_summary};
-    for (int i = 0; i < 3; i++) {
-        if (!out[i]) continue;
-        if (clash(sc, what[i], out[i], path, "the scene file", err)) return -1;
-        for (int j = 0; j < i; j++)
-            if (out[j] && (clash(sc, what[i], out[i], out[j], "output", err) ||
-                           clash(sc, what[j], out[j], out[i], "output", err)))
-                return -1;
-        for (int k = 0; k < sc->nsurf; k++) {
-            const char *f[2] = {sc->surf[k].mesh_file, sc->surf[k].media_file};
-            for (int m = 0; m < 2; m++) {
-                if (!f[m]) continue;
-                char *in = join(sc->dir, f[m]);
-                if (!in) return snprintf(err, SC_ERRMAX, "out of memory"), -1;
-                int rc = clash(sc, what[i], out[i], in, m ? "the media file" :
-                               "the mesh file", err);
-                free(in);
-                if (rc) return -1;
-            }
-        }
-    }
-    return 0;
-}
-
-int sc_load(const char *path, sc_scene *sc, char *err)
-{
-    size_t len;
-    char *text = slurp(path, &len, err), *slash;
-    if (!text) { scene_defaults(sc); return -1; }
-    if (sc_parse_scene(text, len, path, sc, err)) { free(text); return -1; }
-    free(text);
-    if (!(sc->dir = malloc(strlen(path) + 1))) goto oom;
-    strcpy(sc->dir, path);
-    slash = strrchr(sc->dir, '/');
-    if (slash) *slash = '\0';
-    else sc->dir[0] = '\0';
-    for (int i = 0; i < sc->nsurf; i++) {
-        sc_surface *s = &sc->surf[i];
-        if (s->shape == SC_MESH && load_mesh(sc, s, err)) goto bad;
-        if (s->shape != SC_MESH && s->tessellate &&
-            sc_tessellate(s, s->tessellate, &s->tri, &s->ntri, err)) {
-            from_scene(s, err);
-            goto bad;
-        }
-    }
-    if (outputs_over_inputs(sc, path, err)) goto bad;
-    return 0;
-oom:
-    snprintf(err, SC_ERRMAX, "%s: out of memory", path);
-bad:
-    sc_free(sc);
-    return -1;
 }
