@@ -67,10 +67,10 @@ build/asan/unit_%: tests/unit_%.c $(SANLIB)
 	$(CC) $(BASE) $(SAN) -Itests -o $@ $< $(SANLIB) $(LIBS)
 # The paraxial engine's benchmark (scripts/bench_paraxial.sh), linked the same way.
 build/obj/bench_paraxial: tests/bench_paraxial.c $(LIBOBJ)
-	$(CC) $(BASE) $(OPT) -o $@ $< $(LIBOBJ) $(LIBS)
+	$(CC) $(BASE) $(OPT) -Itests -o $@ $< $(LIBOBJ) $(LIBS)
 # The glass catalogue's achromat benchmark (scripts/bench_glass.sh).
 build/obj/bench_glass: tests/bench_glass.c $(LIBOBJ)
-	$(CC) $(BASE) $(OPT) -o $@ $< $(LIBOBJ) $(LIBS)
+	$(CC) $(BASE) $(OPT) -Itests -o $@ $< $(LIBOBJ) $(LIBS)
 
 # libFuzzer target for the answer reader, the number parser and every dialogue of
 # src/dialogue/table.c (clang from Debian): the core sources (not main.c) compiled

@@ -17,19 +17,7 @@
 #include <string.h>
 #include <time.h>
 #include "paraxial/paraxial.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
+#include "bench_util.h"
 
 /* |v - printed| in units of the printed string's last place */
 static double last_places(double v, const char *printed)

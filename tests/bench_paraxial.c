@@ -9,21 +9,9 @@
 #include <stdlib.h>
 #include <time.h>
 #include "paraxial/paraxial.h"
+#include "bench_util.h"
 
 #define NSURF 10000
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* A 10 000-surface random system and its full analysis; returns seconds. */
 static double one_run(double *sink)

@@ -8,13 +8,7 @@
 #include <stdint.h>
 #include <time.h>
 #include "ct.h"
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
+#include "bench_util.h"
 
 int main(int argc, char **argv)
 {

@@ -19,16 +19,11 @@
  * rig reaches within its travel).  "quick" as argv[1]: fewer repetitions. */
 #include <time.h>
 #include "rig/rt.h"
+#include "bench_util.h"
 
 static const rig_api *rg;
 static char err[1024];
 
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + t.tv_nsec * 1e-9;
-}
 /* CPU time of this thread: what the code costs when the machine is shared */
 static double cpu_now(void)
 {

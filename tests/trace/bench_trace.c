@@ -28,15 +28,9 @@
 #include <unistd.h>
 #include "tt.h"
 #include "mesh.h"
+#include "bench_util.h"
 
 static const trace_api *tr;
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 static int cmpd(const void *a, const void *b)
 {
