@@ -316,6 +316,15 @@ typedef const trace_api *(*trace_get_api_fn)(int abi);
 /* Exported by lensmat-trace.so: the table, or NULL if abi != TRACE_ABI. */
 const trace_api *trace_get_api(int abi);
 
+/* Also exported: the instruction sets the lens packets can run on in this build, best
+ * first (x86-64: "avx512", "avx2", "sse2"; arm64: "neon"; then "scalar", rays one by
+ * one): name i, or NULL past the last, *usable (may be NULL) 1 if this processor runs
+ * it.  trace_isa_active(): the one this process uses, chosen when the module loads:
+ * the best usable, or the one the environment variable LENSMAT_ISA names (if this
+ * processor cannot run that one, the best below it).  All give the same bits. */
+const char *trace_isa_name(int i, int *usable);
+const char *trace_isa_active(void);
+
 /* ---- a lens's geometry, checked without the module -------------------------------
  * Inline so that the dialogue can refuse an answer at its question without loading
  * the engine; tr_lens.c refuses the same lenses in add_lens and lens_fan.
