@@ -333,8 +333,11 @@ static inline void fresnel(vd n1, vd n2, vd ci, fres *f)
 }
 
 /* The step for lanes b .. b + W - 1 (on: the live ones); returns their calm bits
- * (bit i: lane b + i). */
-static inline unsigned chunk(const tr_pk *pin, tr_pk *pout, tr_pk_aux *x,
+ * (bit i: lane b + i).  Inlined into the step, so that the step's return clears the
+ * upper halves of the vector registers (vzeroupper) before the one-ray code runs:
+ * returning from a tail-called chunk left them dirty, and the SSE code after it ran
+ * a third slower (issue 13). */
+static inline __attribute__((always_inline)) unsigned chunk(const tr_pk *pin, tr_pk *pout, tr_pk_aux *x,
                              const tr_pk_set *cs, vm on, const tr_pk_opt *o, int b)
 {
     vpk vi, vo;
@@ -450,8 +453,9 @@ unsigned PK_FN(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *s,
             for (int l = 0; l < W; l++) x->status[b + l] = TR_PK_IDLE;
             continue;
         }
-        vm on;
-        for (int l = 0; l < W; l++) on[l] = mine & (1u << l) ? -1 : 0;
+        vm bit;
+        for (int l = 0; l < W; l++) bit[l] = 1LL << l;
+        vm on = (msplat(mine) & bit) != 0;
         calm |= chunk(in, out, x, s, on, o, b) << b;
     }
     return calm;
