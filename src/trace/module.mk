@@ -51,3 +51,24 @@ all: build/lib/lensmat-trace.so
 MODULE_TEST_BINS  += build/lib/lensmat-trace.so build/asan/lib/lensmat-trace.so $(TRACE_TBIN)
 MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
 -include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d)
+
+# Issue 13: the engine built for the x86-64 baseline (-march=x86-64: SSE2, no AVX
+# outside the two kernels tr_isa.c chooses at load) in its own folder build/x86-64/,
+# at -O1 without LTO to stay cheap; tests/t_61_trace_ports.sh runs its t_lens and
+# t_isa and checks its objects for AVX instructions.
+ifeq ($(shell uname -m),x86_64)
+TRACE_X86   := -O1 -march=x86-64 -mtune=generic
+TRACE_XOBJ  := $(patsubst src/%.c,build/x86-64/%.o,$(TRACE_SRC))
+build/x86-64/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(TRACE_X86) -fPIC -pthread -MMD -MP -c $< -o $@
+build/x86-64/lib/lensmat-trace.so: $(TRACE_XOBJ)
+	@mkdir -p $(@D)
+	$(CC) -shared $(TRACE_X86) -o $@ $(TRACE_XOBJ) $(TRACE_LIBS)
+build/x86-64/trace_tests/%: tests/trace/%.c build/x86-64/lib/lensmat-trace.so src/trace/trace.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(TRACE_X86) -pthread -Itests -o $@ $< build/x86-64/lib/lensmat-trace.so \
+	    -Wl,-rpath,$(abspath build/x86-64/lib) -lembree3 -lm
+MODULE_TEST_BINS += build/x86-64/trace_tests/t_lens build/x86-64/trace_tests/t_isa
+-include $(TRACE_XOBJ:.o=.d)
+endif

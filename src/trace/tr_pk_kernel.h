@@ -32,14 +32,14 @@ typedef long long vm __attribute__((vector_size(8 * PK_W)));   /* lane masks */
 #define W PK_W
 static inline vd splat(double a)
 {
-    vd r;
-    for (int i = 0; i < W; i++) r[i] = a;
+    vd r = {a};
+    for (int i = 1; i < W; i++) r[i] = a;
     return r;
 }
 static inline vm msplat(long long a)
 {
-    vm r;
-    for (int i = 0; i < W; i++) r[i] = a;
+    vm r = {a};
+    for (int i = 1; i < W; i++) r[i] = a;
     return r;
 }
 static inline vm mask_all(void) { return msplat(-1); }
@@ -72,7 +72,7 @@ static inline vd pick4(const double t[TR_PK], vm ix)
 static inline vm finite(vd x) { return vabs(x) <= DBL_MAX; }
 static inline vd vsqrt(vd x)
 {
-    vd r;
+    vd r = x;
     for (int i = 0; i < W; i++) r[i] = sqrt(x[i]);
     return r;
 }
@@ -210,7 +210,12 @@ static inline vm conic_hit(const tr_shape *g, int leaving, int farok, const vd o
 static inline vm plane_hit(const tr_shape *g, int leaving, int farok, const vd o[3],
                            const vd d[3], vd *t, vd p[3], vm *far)
 {
-    if (leaving) return mask_none();
+    if (leaving) {                       /* a plane is not met again */
+        *t = splat(INFINITY);
+        p[0] = p[1] = p[2] = splat(0);
+        *far = mask_none();
+        return mask_none();
+    }
     vd lo[3] = {o[0] - g->at[0], o[1] - g->at[1], o[2] - g->at[2]};
     vd tt = -lo[2] / d[2];
     *t = tt;
@@ -453,7 +458,7 @@ unsigned PK_FN(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *s,
             for (int l = 0; l < W; l++) x->status[b + l] = TR_PK_IDLE;
             continue;
         }
-        vm bit;
+        vm bit = {1};
         for (int l = 0; l < W; l++) bit[l] = 1LL << l;
         vm on = (msplat(mine) & bit) != 0;
         calm |= chunk(in, out, x, s, on, o, b) << b;
