@@ -17,9 +17,9 @@
  *                            through Embree (sequential shortcut off), same results
  *   trace_sum_1e8_{rays,error,balance}: 1e8 rays of total power 1, the summed powers
  *                            against n fl(1/n) and the balance (not in quick runs)
- *   trace_triplet_<isa>_mrays_per_s: the triplet figure with the packet kernel of one
- *                            instruction set (`bench_trace isa`, LENSMAT_ISA=<isa>;
- *                            `bench_trace isas` lists those this processor runs)
+ * `bench_trace isa` prints one triplet run's Mrays/s with the packet kernel of this
+ * process (LENSMAT_ISA=<isa>), `bench_trace isas` the kernels this processor runs
+ * (scripts/bench_trace_isa.sh: BENCH trace_triplet_<isa>_mrays_per_s).
  * `bench_trace triplet` prints the triplet figures alone, `bench_trace sum` the sums. */
 #define _DEFAULT_SOURCE 1      /* wait4 */
 #include <embree3/rtcore.h>
@@ -323,14 +323,11 @@ static void triplet_child(void *arg)
 static void mem_fn(void *arg) { (void)arg; mem_child(); }
 
 /* Issue 13: the triplet figure of the packet kernel this process runs (LENSMAT_ISA
- * forces one; scripts/bench_trace.sh runs this once per instruction set the
- * processor has): one thread, median of three. */
+ * forces one; scripts/bench_trace_isa.sh runs this for each instruction set the
+ * processor has, in rounds, and takes the medians): one thread, one run. */
 static void triplet_isa(void)
 {
-    double r[3];
-    for (int i = 0; i < 3; i++) r[i] = triplet(1, 1128, NULL, NULL);
-    printf("BENCH trace_triplet_%s_mrays_per_s %.3f Mrays/s\n", trace_isa_active(),
-           median3(r[0], r[1], r[2]) / 1e6);
+    printf("%s %.4f\n", trace_isa_active(), triplet(1, 1128, NULL, NULL) / 1e6);
 }
 
 /* Issue 9's 1e8-ray row (too long for make check, which runs 1e7 in t_extreme): a
