@@ -1,5 +1,5 @@
 /* tr_lanes.c -- the packet orchestration: eight rays at a time through a sequential
- * lens on the packet step (tr_packet.c), each lane's books and records kept as the
+ * lens on the packet step (tr_pk_kernel.h), each lane's books and records kept as the
  * one-ray code (tr_trace.c) would keep them, a lane that leaves the shortcut finished
  * by the one-ray code; and the choice, per batch, between packets and rays one by one
  * (the same bits either way; with LENSMAT_ISA=scalar always one by one). */
@@ -140,7 +140,7 @@ static int lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr
 }
 
 /* Rays i0 .. i0+TR_LANES-1 of the worker side by side while each stays on the lens
- * shortcut, step by step in a packet (tr_packet.c); a lane that leaves it (no
+ * shortcut, step by step in a packet (tr_pk_kernel.h); a lane that leaves it (no
  * candidate hit, depth limit, a ray going back, TIR, reflections waiting) is finished
  * alone afterwards by trace_rest from where it left.  Every lane computes exactly what
  * trace_one would; its records wait in the lane's buffers and are passed on in ray
