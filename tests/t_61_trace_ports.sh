@@ -1,7 +1,8 @@
 # t_61_trace_ports.sh -- the trace engine on every processor (issue 13).  x86-64: the
 # engine built with -march=x86-64 (build/x86-64/, src/trace/module.mk) has no AVX
-# instruction outside the two kernels chosen at load, and its tests pass, the same
-# bits under every kernel this processor runs (t_isa) and with SSE2 forced (t_lens).
+# instruction outside the two kernels chosen at load, and the engine's tests pass on
+# it: the same bits under every kernel this processor runs (t_isa), the lens and
+# extreme-case tests with SSE2 forced.
 # arm64: every engine's C sources compile with Debian's aarch64 cross compiler
 # (gcc-aarch64-linux-gnu, scripts/install-deps.sh), warning-free, and the packet
 # kernel comes out as NEON vector code; skipped, saying so, without that compiler.
@@ -25,10 +26,12 @@ if [ "$(uname -m)" = x86_64 ]; then
     }
     check "trace -march=x86-64: no AVX instruction outside tr_pk_avx2.o, tr_pk_avx512.o" \
         no_avx
-    unit "$XB/trace_tests/t_isa"
-    printf '#!/bin/sh\nLENSMAT_ISA=sse2 exec "%s"\n' "$XB/trace_tests/t_lens" > "$PT/t_lens_sse2"
-    chmod +x "$PT/t_lens_sse2"
-    unit "$PT/t_lens_sse2"
+    for b in t_physics t_mesh t_watertight t_isa; do unit "$XB/trace_tests/$b"; done
+    for b in t_lens t_extreme; do           # the lens packets on the baseline kernel
+        printf '#!/bin/sh\nLENSMAT_ISA=sse2 exec "%s"\n' "$XB/trace_tests/$b" > "$PT/${b}_sse2"
+        chmod +x "$PT/${b}_sse2"
+        unit "$PT/${b}_sse2"
+    done
 fi
 
 if command -v aarch64-linux-gnu-gcc >/dev/null 2>&1; then

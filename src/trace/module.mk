@@ -54,8 +54,8 @@ MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
 
 # Issue 13: the engine built for the x86-64 baseline (-march=x86-64: SSE2, no AVX
 # outside the two kernels tr_isa.c chooses at load) in its own folder build/x86-64/,
-# at -O1 without LTO to stay cheap; tests/t_61_trace_ports.sh runs its t_lens and
-# t_isa and checks its objects for AVX instructions.
+# at -O1 without LTO to stay cheap; tests/t_61_trace_ports.sh runs its tests and
+# checks its objects for AVX instructions.
 ifeq ($(shell uname -m),x86_64)
 TRACE_X86   := -O1 -march=x86-64 -mtune=generic
 TRACE_XOBJ  := $(patsubst src/%.c,build/x86-64/%.o,$(TRACE_SRC))
@@ -69,6 +69,6 @@ build/x86-64/trace_tests/%: tests/trace/%.c build/x86-64/lib/lensmat-trace.so sr
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(TRACE_X86) -pthread -Itests -o $@ $< build/x86-64/lib/lensmat-trace.so \
 	    -Wl,-rpath,$(abspath build/x86-64/lib) -lembree3 -lm
-MODULE_TEST_BINS += build/x86-64/trace_tests/t_lens build/x86-64/trace_tests/t_isa
+MODULE_TEST_BINS += $(patsubst tests/trace/%.c,build/x86-64/trace_tests/%,$(TRACE_TESTS))
 -include $(TRACE_XOBJ:.o=.d)
 endif
