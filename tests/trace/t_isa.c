@@ -3,9 +3,9 @@
  * LENSMAT_ISA (avx512, avx2, sse2 or neon, and scalar: rays one by one), each child
  * tracing four lenses (the Cooke triplet with mounts, a singlet, a cemented doublet,
  * a plano-convex lens without mounts) from an off-axis point and from a collimated
- * grid, with Fresnel on and off and reflected rays on and off, and writing every hit,
- * every segment and the summary's counts and powers to a file; the files must be
- * equal byte for byte.  Also: the child runs the kernel it was asked for, and an
+ * grid (on two threads), with Fresnel on and off and reflected rays on and off, and
+ * writing every hit, every segment and the summary's counts and powers to a file;
+ * the files must be equal byte for byte.  Also: the child runs the kernel it was asked for, and an
  * unknown name falls back to the best one. */
 #define _DEFAULT_SOURCE 1
 #include <stdio.h>
@@ -85,7 +85,7 @@ static int child(const trace_api *tr, const char *path)
             tr->options_default(&o);
             o.fresnel = fresnel;
             o.reflections = reflections;
-            o.threads = 1;
+            o.threads = grid ? 2 : 1;           /* the grid on two threads */
             trace_sink sink = {&d, put_seg, put_hit, NULL};
             if (tr->add_lens(sc, &l) < 0 || tr->add_source(sc, &src, NULL) ||
                 tr->run(sc, &o, &sink, &sum)) {
