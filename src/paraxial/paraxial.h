@@ -373,8 +373,16 @@ typedef struct px_seidel {
     int nsurf;
     px_seidel_sums surf[PX_SEIDEL_MAXSURF], total;
     double u_last, n_last, h;  /* image-space marginal slope and index; H */
+    double ybar1;              /* chief-ray height at surface 1 (entrance pupil at
+                                  z = -ybar1/ubar1 from surface 1) */
+    int stop;                  /* the aperture stop (0-based surface) */
 } px_seidel;
 int px_seidel_run(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
                   double ubar1, px_seidel *out);
+/* The same with the aperture stop at surface `stop` (0-based; 0 is px_seidel_run):
+ * the chief ray enters at slope ubar1 and height ybar1 chosen so that it crosses
+ * the axis at the stop's vertex (PX_BAD if the stop is imaged at infinity). */
+int px_seidel_run_stop(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
+                       double ubar1, int stop, px_seidel *out);
 
 #endif
