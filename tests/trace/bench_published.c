@@ -11,6 +11,7 @@
  *   trace_lens_<lens>_rms_power_um    power-weighted (Fresnel s + p) about the
  *                                      power centroid (= bench_trace's figure)
  *   trace_lens_<lens>_transmitted     detected / emitted power
+ *   trace_lens_sasian_vs_triplet      the two lenses' Mrays/s, same run, alternated
  * and for Sasian's published fields 14.14 and 20 degrees (0.707 and 1 of the field):
  * the real chief ray aimed through the stop's centre, a 256 x 256 grid over the
  * paraxial entrance pupil about it, RMS unweighted and power-weighted about the
@@ -24,24 +25,30 @@ static int cmpd(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void axis_row(const trace_api *tr, const char *name, const pub_lens *pl, double zd,
-                     double r_pupil, long across)
+/* One on-axis run of each lens, alternated three times (the machine's speed drifts:
+ * the ratio of the same run's medians is the figure to compare). */
+static void axis_rows(const trace_api *tr, const char *const name[2], const pub_lens *pl[2],
+                      const double zd[2], const double r_pupil[2], long across)
 {
-    pub_result r[3];
-    double v[3];
-    for (int i = 0; i < 3; i++) {
-        if (pub_trace(tr, pl, zd, NULL, across, r_pupil, 1, &r[i])) {
-            fprintf(stderr, "bench_published: %s failed\n", name);
-            exit(1);
+    pub_result r[2][3];
+    double v[2][3];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 2; k++) {
+            if (pub_trace(tr, pl[k], zd[k], NULL, across, r_pupil[k], 1, &r[k][i])) {
+                fprintf(stderr, "bench_published: %s failed\n", name[k]);
+                exit(1);
+            }
+            v[k][i] = r[k][i].rays_per_s;
         }
-        v[i] = r[i].rays_per_s;
+    for (int k = 0; k < 2; k++) {
+        qsort(v[k], 3, sizeof v[k][0], cmpd);
+        printf("BENCH trace_lens_%s_mrays_per_s %.3f Mrays/s\n", name[k], v[k][1] / 1e6);
+        printf("BENCH trace_lens_%s_rms_chief_um %.3f um\n", name[k], r[k][0].rms_chief_um);
+        printf("BENCH trace_lens_%s_rms_power_um %.3f um\n", name[k], r[k][0].rms_power_centroid_um);
+        printf("BENCH trace_lens_%s_transmitted %.4f ratio\n", name[k], r[k][0].transmitted);
+        printf("BENCH trace_lens_%s_rays %ld rays\n", name[k], r[k][0].rays);
     }
-    qsort(v, 3, sizeof *v, cmpd);
-    printf("BENCH trace_lens_%s_mrays_per_s %.3f Mrays/s\n", name, v[1] / 1e6);
-    printf("BENCH trace_lens_%s_rms_chief_um %.3f um\n", name, r[0].rms_chief_um);
-    printf("BENCH trace_lens_%s_rms_power_um %.3f um\n", name, r[0].rms_power_centroid_um);
-    printf("BENCH trace_lens_%s_transmitted %.4f ratio\n", name, r[0].transmitted);
-    printf("BENCH trace_lens_%s_rays %ld rays\n", name, r[0].rays);
+    printf("BENCH trace_lens_%s_vs_%s %.3f ratio\n", name[0], name[1], v[0][1] / v[1][1]);
 }
 
 int main(void)
@@ -55,7 +62,21 @@ int main(void)
 
     if (pub_read(PUB_SASIAN, pub_sasian_sd, &sas)) return 1;
     double zd = sas.s[sas.nsurf - 1].z + PUB_SASIAN_IMAGE;
-    axis_row(tr, "sasian", &sas, zd, PUB_SASIAN_EPD / 2, across);
+
+    /* the second row: bench_trace's triplet, detector at its paraxial image */
+    tt_triplet(s, &l, 1);
+    memset(&cooke, 0, sizeof cooke);
+    memcpy(cooke.s, s, sizeof s);
+    cooke.nsurf = TT_NSURF;
+    cooke.lens = l;
+    cooke.lens.surf = cooke.s;
+    {
+        const char *const names[2] = {"sasian", "triplet"};
+        const pub_lens *lenses[2] = {&sas, &cooke};
+        const double zds[2] = {zd, tt_paraxial_image(&cooke.lens, -INFINITY)};
+        const double radii[2] = {PUB_SASIAN_EPD / 2, TT_EPD / 2};
+        axis_rows(tr, names, lenses, zds, radii, across);
+    }
 
     double enp = pub_enp(&sas, PUB_SASIAN_STOP), z0 = -10;
     static const struct { const char *tag; double frac; } fld[2] = {{"14deg", 0.707}, {"20deg", 1}};
@@ -74,14 +95,5 @@ int main(void)
         printf("BENCH trace_lens_sasian_%s_transmitted %.4f ratio\n", fld[f].tag, r.transmitted);
         free(rays);
     }
-
-    /* the second row: bench_trace's triplet, detector at its paraxial image */
-    tt_triplet(s, &l, 1);
-    memset(&cooke, 0, sizeof cooke);
-    memcpy(cooke.s, s, sizeof s);
-    cooke.nsurf = TT_NSURF;
-    cooke.lens = l;
-    cooke.lens.surf = cooke.s;
-    axis_row(tr, "triplet", &cooke, tt_paraxial_image(&cooke.lens, -INFINITY), TT_EPD / 2, across);
     return 0;
 }
