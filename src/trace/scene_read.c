@@ -492,8 +492,8 @@ static int parse_fields(reader *r, int first, const char *dname, const char *all
                 if (r->t[i].n >= NUMLEN || px_wavelength(b, &um) != PX_OK)
                     return fail(r, "%s: '%s' is not a wavelength (nm above 100, else um, "
                                 "or F d C e g hene)", what, b);
-                for (int j = 0; j < f->count[k]; j++)
-                    if (f->num[k][j] == um)
+                for (int j = 0; j < f->count[k]; j++)   /* (587.5618 is d) */
+                    if (fabs(f->num[k][j] - um) <= 1e-12 * um)
                         return fail(r, "%s: wavelength '%s' given twice", what, b);
                 f->num[k][f->count[k]++] = um;
                 i++;
