@@ -6,6 +6,10 @@
 # names wavelengths, and the example scenes keep the bytes they had before (checksums
 # in golden/trace/scenes.sha256, made by the tracer before wavelengths existed).
 
+# the engine's side: Beer-Lambert and every ray's lambda through its table (both builds)
+unit "$TOP/build/obj/trace_tests/t_absorb"
+unit "$TOP/build/asan/trace_tests/t_absorb"
+
 WW=$WORK/wavelength
 mkdir -p "$WW"
 GLASS=$TOP/data/glass.txt

@@ -224,10 +224,10 @@ static inline int on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack
         return 0;
     case TRACE_DETECT: {
         double s[3];
-        tr_emit_segment(w, out, r, ray, q, TRACE_END_DETECT, h->surf);
-        if (r->alpha > 0) p -= absorb_along(ty, r, h->t);
         s_vector(r, h->n, s);
         tr_pol_rotate(&r->pol, r->d, s);
+        tr_emit_segment(w, out, r, ray, q, TRACE_END_DETECT, h->surf);
+        if (r->alpha > 0) p -= absorb_along(ty, r, h->t);
         ty->detected += p;
         ty->hits++;
         tr_emit_hit(w, out, r, ray, h, q);
