@@ -6,6 +6,8 @@
 # names wavelengths, and the example scenes keep the bytes they had before (checksums
 # in golden/trace/scenes.sha256, made by the tracer before wavelengths existed).
 
+cd "$TOP" || return 1   # (a group before may have left the cwd elsewhere; the test
+                          #  binaries name their module relative to the top)
 # the engine's side: Beer-Lambert and every ray's lambda through its table (both builds)
 unit "$TOP/build/obj/trace_tests/t_absorb"
 unit "$TOP/build/asan/trace_tests/t_absorb"
