@@ -9,17 +9,20 @@ in=$1; out=$2
 awk '
 BEGIN { n = 0; nt = 0 }
 /^[ \t]*#/ || /^[ \t]*$/ { next }
+$2 == "k" {      # an extinction-coefficient table: thickness 0 in the C table
+    $0 = $1 " tau 0 " substr($0, index($0, " k ") + 3)
+}
 $2 == "tau" {
     if (!($1 in known)) bad(NR, "tau: " $1 " is not a glass of the catalogue (above)")
-    if (NF < 6 || (NF - 3) % 2) bad(NR, "expected NAME tau THICKNESS L1 T1 L2 T2 ...")
-    if ((NF - 3) / 2 > 32) bad(NR, "at most 32 points")
+    if (NF < 6 || (NF - 3) % 2) bad(NR, "expected NAME tau THICKNESS L1 T1 L2 T2 ... or NAME k L1 K1 ...")
+    if ((NF - 3) / 2 > 40) bad(NR, "at most 40 points")
     for (i = 3; i <= NF; i++)
         if ($i !~ /^[0-9]*\.?[0-9]+([eE][-+]?[0-9]+)?$/) bad(NR, "not a number: " $i)
-    if (!($3 + 0 > 0)) bad(NR, "the thickness must be positive")
+    if (!($3 + 0 > 0) && $3 != "0") bad(NR, "the thickness must be positive")
     l = ""; t = ""; prev = 0
     for (i = 4; i < NF; i += 2) {
         if (!($i + 0 > prev)) bad(NR, "wavelengths must ascend: " $i)
-        if ($(i + 1) + 0 > 1) bad(NR, "a transmittance above 1: " $(i + 1))
+        if ($3 != "0" && $(i + 1) + 0 > 1) bad(NR, "a transmittance above 1: " $(i + 1))
         prev = $i + 0
         l = l (i > 4 ? ", " : "") $i
         t = t (i > 4 ? ", " : "") $(i + 1)

@@ -140,6 +140,29 @@ output summary s.sum" && grep -q '^absorbed 0$' "$WW/clear/s.sum"
 }
 check "wavelength: a glass without transmittance data absorbs nothing" wl_clear
 
+# A metre of water at 632.8 nm: its absorption from Hale & Querry's extinction
+# coefficient (alpha = 4 pi k / lambda, linear between their points), here in awk.
+wl_water() {
+    wl_trace water "plane refract 1 water at 0 0 0 normal 0 0 1 disc 20
+plane refract water 1 at 0 0 1000 normal 0 0 1 disc 20
+plane detect at 0 0 1100 normal 0 0 1 disc 50
+source ray from 0 0 -5 dir 0 0 1 lambda 632.8
+reflections off
+output summary s.sum" || return 1
+    wn=$(sellmeier WATER 0.6328) || return 1
+    wa=$(awk -v l=0.6328 '$1 == "WATER" && $2 == "k" {
+        for (i = 3; i + 3 <= NF; i += 2) if (l >= $i && l <= $(i + 2)) {
+            pi = atan2(0, -1); a = 4 * pi * $(i + 1) / ($i * 1e-3)
+            b = 4 * pi * $(i + 3) / ($(i + 2) * 1e-3); u = (l - $i) / ($(i + 2) - $i)
+            printf "%.17g\n", a + u * (b - a); exit } }' "$GLASS")
+    awk -v n="$wn" -v a="$wa" '$1 == "detected" { got = $2 }
+        END { R = ((n - 1) / (n + 1)) ^ 2; want = (1 - R) ^ 2 * exp(-a * 1000)
+              e = (got - want) / want; if (e < 0) e = -e
+              printf "alpha %.5g /m: detected %.15g, expected %.15g\n", a * 1e3, got, want
+              exit !(e < 1e-12 && want < 0.75) }' "$WW/water/s.sum"
+}
+check "wavelength: a metre of water at 632.8 nm absorbs as Hale & Querry's k says" wl_water
+
 # The cornea rig's laser: a He-Ne Gaussian beam (632.8 nm) through an N-BK7 prism uses
 # n(632.8 nm), not n(d): its axial ray's deviation is Snell's with n(0.6328), and differs
 # from the d line's by more than 1e-5 rad.

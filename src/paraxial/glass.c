@@ -130,7 +130,8 @@ const px_tau_rec *px_glass_tau(const char *name, int k)
     return NULL;
 }
 
-/* The thickest table of a glass; NULL with *rc set when there is none. */
+/* The thickest table of a glass (a k table only when it has no other); NULL with *rc
+ * set when there is none. */
 static const px_tau_rec *thickest(const char *name, int *rc)
 {
     const px_tau_rec *best = NULL, *t;
@@ -141,14 +142,24 @@ static const px_tau_rec *thickest(const char *name, int *rc)
     return best;
 }
 
-/* The first and last points with t > 0 (the table's usable span), or -1. */
+/* The first and last points with t > 0 (the table's usable span), or -1.  (A k table
+ * is usable throughout.) */
 static int span(const px_tau_rec *t, int *last)
 {
     int i0 = 0, i1 = t->n - 1;
-    while (i0 < t->n && !(t->t[i0] > 0)) i0++;
-    while (i1 > i0 && !(t->t[i1] > 0)) i1--;
+    if (t->thickness > 0) {
+        while (i0 < t->n && !(t->t[i0] > 0)) i0++;
+        while (i1 > i0 && !(t->t[i1] > 0)) i1--;
+    }
     *last = i1;
     return i0 < t->n ? i0 : -1;
+}
+
+/* alpha (1/mm) at point i of a table. */
+static double alpha_at(const px_tau_rec *t, int i)
+{
+    if (t->thickness > 0) return -log(t->t[i]) / t->thickness;
+    return 4 * 3.14159265358979323846 * t->t[i] / (t->l[i] * 1e-3);
 }
 
 int px_glass_absorption_range(const char *name, double *lmin, double *lmax)
@@ -162,8 +173,8 @@ int px_glass_absorption_range(const char *name, double *lmin, double *lmax)
     return PX_OK;
 }
 
-/* ln t is linear in lambda between neighbouring points (a zero inside the span, an
- * opaque point between transparent ones, makes alpha infinite there). */
+/* alpha (so ln t) is linear in lambda between neighbouring points (a zero inside the
+ * span, an opaque point between transparent ones, makes alpha infinite there). */
 int px_glass_absorption(const char *name, double l, double *alpha)
 {
     int rc = PX_OK, i0, i1, i;
@@ -173,11 +184,11 @@ int px_glass_absorption(const char *name, double l, double *alpha)
     if ((i0 = span(t, &i1)) < 0 || l < t->l[i0] || l > t->l[i1]) return PX_GLASS_RANGE;
     for (i = i0; i < i1 && l > t->l[i + 1]; i++) {}
     if (i == i1 || l == t->l[i]) {
-        *alpha = -log(t->t[i]) / t->thickness;
+        *alpha = alpha_at(t, i);
     } else {
-        double a = -log(t->t[i]), b = -log(t->t[i + 1]);
+        double a = alpha_at(t, i), b = alpha_at(t, i + 1);
         double u = (l - t->l[i]) / (t->l[i + 1] - t->l[i]);
-        *alpha = (a + u * (b - a)) / t->thickness;
+        *alpha = a + u * (b - a);
     }
     if (*alpha < 0) *alpha = 0;       /* t = 1 printed: -log(1) = -0 */
     return PX_OK;
