@@ -14,7 +14,7 @@ if [ "$(uname -m)" = x86_64 ]; then
     # no_avx: no VEX/EVEX instruction (v-mnemonic, ymm, zmm) in any object but the
     # AVX2 and AVX-512 kernels
     no_avx() {
-        for o in "$XB"/trace/*.o; do
+        for o in "$XB"/trace/*.o "$XB"/trace/px/*.o; do
             case $o in */tr_pk_avx2.o|*/tr_pk_avx512.o) continue ;; esac
             n=$(objdump -d --no-show-raw-insn "$o" |
                 grep -cE '%[yz]mm|^ +[0-9a-f]+:[[:space:]]+v[a-z0-9]+[[:space:]]')
