@@ -3,3 +3,5 @@
 # --pupil dialogue: pupil data, chief rays, spots and fans per field and wavelength.
 unit "$TOP/build/obj/unit_pupil"
 unit "$TOP/build/asan/unit_pupil"
+unit "$TOP/build/obj/trace_tests/t_aim"
+unit "$TOP/build/asan/trace_tests/t_aim"
