@@ -5,3 +5,83 @@ unit "$TOP/build/obj/unit_pupil"
 unit "$TOP/build/asan/unit_pupil"
 unit "$TOP/build/obj/trace_tests/t_aim"
 unit "$TOP/build/asan/trace_tests/t_aim"
+
+# --pupil: the embedded example (doc/pupil-triplet.rx: the Zemax tutorial's Cooke
+# triplet, EPD 10, fields 0 14 20 degrees, d F C), run in a folder that links doc/.
+pupil_dir() { mkdir -p "$WORK/pu" && ln -sfn "$TOP/doc" "$WORK/pu/doc"; }
+pupil_example() {
+    pupil_dir && cd "$WORK/pu" && "$1" --pupil --example p.rec > p.out || return 1
+    # first-order data at d: efl, pupils, the stop's size (y-nu trace, pupil.c)
+    grep -q '^  efl 50.0213, f-number 5.002, working f-number 5.002' p.rec || return 1
+    grep -q '^  entrance pupil z= 11.5056, diameter 10; exit pupil z= 9.22129, diameter 10.2324; stop semi-diameter 3.80455' p.rec || return 1
+    # the chief ray's paraxial height at 14 degrees is efl tan(14 deg) = 12.4717
+    grep -q 'paraxial image height 12.4717 ' p.rec || return 1
+    # the vignetting of the 20-degree field by surface 1 (semi-diameter 8)
+    grep -q 'spot: 98 rays, 14 vignetted' p.rec || return 1
+    # replay: the grep'd record gives the same record
+    grep input: p.rec > p.in && "$1" --pupil p2.rec < p.in > /dev/null && cmp p.rec p2.rec
+}
+check "--pupil: example (triplet): efl, pupils, f-number, vignetting; replays exactly" pupil_example "$BIN"
+check "--pupil: the same under ASan/UBSan" pupil_example "$ASAN"
+
+# Every chief ray of the example (3 fields x 3 wavelengths) crosses the stop within
+# 1e-9 mm of its centre, and every ray of every spot within 1e-9 mm of its target.
+check "--pupil: chief rays hit the stop centre to 1e-9 mm, all aimed rays to 1e-9" sh -c "
+    cd '$WORK/pu' && n=\$(grep -c 'stop miss' p.rec) && [ \"\$n\" -eq 9 ] &&
+    awk '/stop miss/ { for (i = 1; i <= NF; i++) if (\$i == \"miss\") m = \$(i + 1);
+                       if (m + 0 > 1e-9) bad = 1 }
+         /stop residual at most/ { for (i = 1; i <= NF; i++) if (\$i == \"most\") m = \$(i + 1);
+                       if (m + 0 > 1e-9) bad = 1 }
+         END { exit bad }' p.rec"
+# On axis the spot is symmetric: its centroid is the chief ray's point (RMS equal).
+check "--pupil: on-axis spot: RMS about the chief ray = about the centroid" sh -c "
+    cd '$WORK/pu' && grep -A1 'field 1: 0 degrees' p.rec > /dev/null &&
+    awk '/field 1: 0 degrees/ { on = 1 } /field 2:/ { on = 0 }
+         on && /RMS radius/ { split(\$0, a, \"chief ray \"); split(a[2], b, \",\");
+                              split(\$0, c, \"centroid \"); split(c[2], e, \";\");
+                              n++; if (b[1] != e[1]) bad = 1 }
+         END { exit bad || n != 3 }' p.rec"
+
+# A plano-convex lens of index 1.5, R 50 (f = R/(n-1) = 100), stop 20 mm in front,
+# EPD 10: f/10, the entrance pupil is the stop (z = 0), and the exit pupil is the
+# stop's image by the lens: the stop lies 20 before H1 (the convex vertex, z = 20),
+# so 1/s' = 1/100 - 1/20, s' = -25 from H2, which lies t (n-1)/n = 5/3 right of H1:
+# z = 20 + 5/3 - 25 = -3.33333, diameter 10 * 25/20 = 12.5.
+pupil_pc() {
+    pupil_dir && cd "$WORK/pu" && printf '%s\n' thickness 'epd 10' 'field angle 0 5' \
+        'plane 20 air stop' '50 5 1.5' 'plane 0 air' > pc.rx &&
+    printf 'pc.rx\ngrid\n4\nn\n' > pc.in && "$1" --pupil -i pc.in pc.rec > /dev/null &&
+    grep -q '^  efl 100, f-number 10, ' pc.rec &&
+    grep -q '^  entrance pupil z= 0, diameter 10; exit pupil z= -3.33333, diameter 12.5; stop semi-diameter 5 ' pc.rec
+}
+check "--pupil: plano-convex behind a stop: f/10, EP = stop, XP at its image" pupil_pc "$BIN"
+
+# A file without stop, aperture or fields (the classic positions format of
+# doc/triplet.rx, object at z = -1000): they are asked, and echoed in the record.
+check "--pupil: what the file lacks is asked (stop, aperture, object heights)" sh -c "
+    cd '$WORK/pu' && printf 'doc/triplet.rx\n4\nepd\n10\n2\n0\n300\nhex\n4\nn\n' > t.in &&
+    '$BIN' --pupil -i t.in t.rec > /dev/null &&
+    grep -q 'stop at surface 4, EPD 10, object 1000 mm left of surface 1, 2 fields' t.rec &&
+    grep -q 'field 2: object height 300' t.rec && grep -q 'spot: 61 rays, 0 vignetted' t.rec &&
+    grep input: t.rec > t2.in && '$BIN' --pupil t2.rec < t2.in > /dev/null && cmp t.rec t2.rec"
+
+# Refusals: FILE:LINE and exit 2 in a replay; the record keeps the answers accepted.
+pupil_refuse() {  # NAME ANSWERS MESSAGE [FILE-LINES...]
+    name=$1 ans=$2 msg=$3; shift 3
+    check "$name" sh -c "
+        cd '$WORK/pu' && { [ \$# -eq 0 ] || printf '%s\n' \"\$@\" > bad.rx; } &&
+        printf '$ans' > bad.in; '$ASAN' --pupil -i bad.in bad.rec > /dev/null 2> bad.err
+        rc=\$?; [ \$rc -eq 2 ] && grep -qF -- \"$msg\" bad.err" sh "$@"
+}
+pupil_refuse "--pupil: a missing file is refused at its answer" 'nosuch.rx\n' \
+    "bad.in:1: the lens file: nosuch.rx: cannot be read"
+pupil_refuse "--pupil: stop 9 of 6 surfaces refused" 'doc/triplet.rx\n9\n' \
+    "'9': give a surface number from 1 to 6"
+pupil_refuse "--pupil: field angle 95 refused" 'bad.rx\n3\n95\n' \
+    "strictly between -90 and 90" thickness 'epd 10' 'index air' '50 5 1.5 stop' 'plane 0 air'
+pupil_refuse "--pupil: an afocal lens is refused with the reason" 'bad.rx\ngrid\n4\nn\n' \
+    "afocal" thickness 'epd 10' 'field angle 0 1' '50 0 1.5 stop' '-50 75 air' \
+    '25 0 1.5' '-25 0 air'
+pupil_refuse "--pupil: stop in the back focal plane, object at infinity: refused" \
+    'bad.rx\ngrid\n4\nn\n' "focal plane" thickness 'epd 10' 'field angle 0 1' \
+    '50 0 1.5' '-50 50 air' 'plane 0 air stop'

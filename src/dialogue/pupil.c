@@ -18,7 +18,7 @@
 #include "prompts_pupil.h"
 
 #define P(k) pupil_prompts[PUPIL_##k]
-#define CL(v) lm_clean(d->io, (v))
+#define CL(v) lm_clean(d->io, snap(d, (v)))
 #define WORD 4096
 #define MAXFIELD 16
 #define MAXSAMPLE 4096
@@ -35,7 +35,15 @@ typedef struct pdlg {
     int sampling, nsamp_arg, fans, fan_rays;
     int nsamp;
     double spx[MAXSAMPLE], spy[MAXSAMPLE];
+    double scale;              /* the lens's size: below 1e-13 of it a result is 0 */
 } pdlg;
+
+/* A centroid or a height that is zero but for rounding (1e-17 on the axis) prints as
+ * 0: the same on every build and in every replay. */
+static double snap(const pdlg *d, double v)
+{
+    return fabs(v) <= 1e-13 * d->scale ? 0.0 : v;
+}
 
 /* ---- the lens file ---------------------------------------------------------------- */
 
@@ -365,11 +373,14 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi)
         calc_say(&d->c, P(CHIEF_BAD), status_word(chief.status), chief.surface + 1);
         return LM_GO;
     }
+    /* paraxial chief-ray heights: at the paraxial image, and at the image plane the
+     * real rays are carried to (the distortion compares the real one with this) */
     par = fy * (p->yb[N] + p->ub[N + 1] * (w->rx.z_image - p->z[N]));
-    if (par != 0) snprintf(dist, sizeof dist, "%.4g %%", CL(100 * (chief.img[1] - par) / par));
+    if (snap(d, par) != 0)
+        snprintf(dist, sizeof dist, "%.4g %%", CL(100 * (chief.img[1] - par) / par));
     else snprintf(dist, sizeof dist, "-");
-    calc_say(&d->c, P(CHIEF), CL(par), CL(chief.img[1]), dist, chief.residual,
-             chief.iterations);
+    calc_say(&d->c, P(CHIEF), CL(fy * p->h_img), CL(par), CL(chief.img[1]), dist,
+             chief.residual, chief.iterations);
     /* the spot */
     double *xs = malloc(sizeof(double) * 2 * (size_t)d->nsamp);
     if (!xs) return LM_FAIL;
@@ -414,21 +425,22 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi)
     return LM_GO;
 }
 
-static void report_pupil(pdlg *d, const wl_ctx *w, double fmax)
+static void report_pupil(pdlg *d, const wl_ctx *w, double fbig)
 {
     const px_pupil *p = &w->p;
     const ln_lens *l = &d->lens;
     int inf = isinf(l->object), N = l->nsurf - 1;
-    double k = inf ? tan(fmax * DEG) : fmax;
+    double k = inf ? tan(fbig * DEG) : fbig;
     char a[32], b[32], c[32], e[32];
     calc_say(&d->c, P(FIRST), CL(p->efl), CL(p->fnum), CL(p->work_fnum), CL(p->na_obj),
              CL(p->na_img));
     calc_say(&d->c, P(PUPILS), fmt_len(a, sizeof a, p->z_ep),
              fmt_len(b, sizeof b, 2 * p->r_ep * w->s), fmt_len(c, sizeof c, p->z_xp),
              fmt_len(e, sizeof e, 2 * p->r_xp * w->s), CL(p->r_stop * w->s));
-    calc_say(&d->c, P(IMAGE), fmt_len(a, sizeof a, p->z_img), CL(p->mag),
-             CL(p->lagrange * w->s * k));
-    calc_say(&d->c, P(RAYS_HEAD), fmax);
+    if (inf) snprintf(b, sizeof b, "-");
+    else snprintf(b, sizeof b, "%.6g", CL(p->mag));
+    calc_say(&d->c, P(IMAGE), fmt_len(a, sizeof a, p->z_img), b, CL(p->lagrange * w->s * k));
+    calc_say(&d->c, P(RAYS_HEAD), fbig);
     snprintf(a, sizeof a, "-");
     calc_say(&d->c, P(RAYS_OBJ), a, CL(p->u[0] * w->s), a, CL(p->ub[0] * k));
     for (int i = 0; i <= N; i++)
@@ -464,13 +476,14 @@ static int compute(pdlg *d)
     const char *obj;
     wl_ctx *w;
     px_pupil prim;
-    double lp = ln_primary(l), z_image, zl = 0, fmax = 0;
+    double lp = ln_primary(l), z_image, zl = 0, fbig = 0;
     int nwl = l->nwl ? l->nwl : 1, rc = LM_GO;
     if (ln_to_csurf(l, cs, names, &obj, why, sizeof why) != LN_OK) return refuse(d, why);
     if (pupil_at(d, cs, obj, lp, &prim, why, sizeof why)) return refuse(d, why);
+    d->scale = fmax(fabs(prim.efl), prim.r_stop);
     for (int i = 0; i + 1 < l->nsurf; i++) zl += l->surf[i].t;
     for (int i = 0; i < l->nfield; i++)
-        if (fabs(l->field[i].y) > fabs(fmax)) fmax = l->field[i].y;
+        if (fabs(l->field[i].y) > fabs(fbig)) fbig = l->field[i].y;
     if (isinf(l->object)) snprintf(ob, sizeof ob, "%s", P(OBJ_INF));
     else snprintf(ob, sizeof ob, P(OBJ_AT), l->object, d->c.uname);
     calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
@@ -496,7 +509,7 @@ static int compute(pdlg *d)
         }
         w->s = prim.r_stop / w->p.r_stop;
         calc_say(&d->c, P(WL_HEAD), lambda * 1000);
-        report_pupil(d, w, fmax);
+        report_pupil(d, w, fbig);
         for (int f = 0; f < l->nfield && rc == LM_GO; f++) rc = one_field(d, w, f);
     }
     free(w);
