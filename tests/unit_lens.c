@@ -31,7 +31,7 @@ static int same_lens(const ln_lens *a, const ln_lens *b, char *why, size_t cap)
 /* why: 400 bytes */
 {
 #define DIFF(cond, ...) do { if (cond) { snprintf(why, cap, __VA_ARGS__); return 0; } } while (0)
-    DIFF(strcmp(a->title, b->title), "title '%s' / '%s'", a->title, b->title);
+    DIFF(strcmp(a->title, b->title), "title '%.60s' / '%.60s'", a->title, b->title);
     DIFF(strcmp(a->unit, b->unit), "unit");
     DIFF(a->object != b->object, "object %.17g / %.17g", a->object, b->object);
     DIFF(strcmp(a->obj_glass, b->obj_glass), "object glass");

@@ -226,6 +226,20 @@ void ln_format(double v, char *buf, size_t cap)
     if (strtod(fixed, NULL) == v && strlen(fixed) <= strlen(buf)) strcpy(buf, fixed);
 }
 
+void ln_format_radius(const ln_surface *s, char *buf, size_t cap)
+{
+    double r = s->r, c = s->c;
+    if (isinf(r) || r == 0) { snprintf(buf, cap, "plane"); return; }
+    for (int p = 1; p <= 17; p++) {
+        char t[40];
+        double v;
+        snprintf(t, sizeof t, "%.*g", p, r);
+        v = strtod(t, NULL);
+        if (v == r || 1 / v == c) { ln_format(v, buf, cap); return; }
+    }
+    ln_format(r, buf, cap);
+}
+
 void ln_notes_free(ln_notes *n)
 {
     free(n->s);

@@ -465,27 +465,6 @@ static void wl_text(double w, char *buf, size_t cap)
     else ln_format(w, buf, cap);
 }
 
-/* The shortest decimal that reads back as the radius r, or as a radius whose
- * reciprocal is the curvature c (a .zmx gives c: 1/c = -124.09999999999998 is
- * written -124.1, which reads back to the same c). */
-static void radius_text(double r, double c, char *buf, size_t cap)
-{
-    if (isinf(r) || r == 0) { snprintf(buf, cap, "plane"); return; }
-    for (int p = 1; p <= 17; p++) {
-        char t[40];
-        double v;
-        snprintf(t, sizeof t, "%.*g", p, r);
-        v = strtod(t, NULL);
-        if (v == r || (c != 0 && 1 / v == c)) {
-            ln_surface s;
-            ln_set_radius(&s, v);
-            ln_format(v, buf, cap);
-            if (s.c == c || v == r) return;
-        }
-    }
-    ln_format(r, buf, cap);
-}
-
 char *ln_write_rx(const ln_lens *l)
 {
     ln_buf b = {0};
@@ -544,7 +523,7 @@ char *ln_write_rx(const ln_lens *l)
     }
     for (int i = 0; i < l->nsurf; i++) {
         const ln_surface *s = &l->surf[i];
-        radius_text(s->r, s->c, a, sizeof a);
+        ln_format_radius(s, a, sizeof a);
         ln_format(s->t, c, sizeof c);
         ln_buf_printf(&b, "%-24s %-24s %s", a, c, s->glass[0] ? s->glass : "air");
         if (s->nd != 0) { ln_format(s->nd, a, sizeof a); ln_buf_printf(&b, " nd %s", a); }
