@@ -208,12 +208,36 @@ int ln_check(const ln_lens *l, const char *src, char *err, size_t cap)
 
 void ln_format(double v, char *buf, size_t cap)
 {
+    int p, e;
+    char fixed[64];
     if (isnan(v)) { snprintf(buf, cap, "nan"); return; }
     if (isinf(v)) { snprintf(buf, cap, v > 0 ? "inf" : "-inf"); return; }
-    for (int p = 1; p <= 17; p++) {
+    for (p = 1; p < 17; p++) {
         snprintf(buf, cap, "%.*g", p, v);
-        if (strtod(buf, NULL) == v) return;
+        if (strtod(buf, NULL) == v) break;
     }
+    if (p == 17) snprintf(buf, cap, "%.17g", v);
+    /* 1e+01 reads back, but a designer writes 10: plain decimals for exponents a
+     * table would print without one */
+    if (!strchr(buf, 'e') || v == 0) return;
+    e = (int)floor(log10(fabs(v)));
+    if (e < -5 || e >= 16) return;
+    snprintf(fixed, sizeof fixed, "%.*f", p - 1 - e > 0 ? p - 1 - e : 0, v);
+    if (strtod(fixed, NULL) == v && strlen(fixed) <= strlen(buf)) strcpy(buf, fixed);
+}
+
+void ln_format_radius(const ln_surface *s, char *buf, size_t cap)
+{
+    double r = s->r, c = s->c;
+    if (isinf(r) || r == 0) { snprintf(buf, cap, "plane"); return; }
+    for (int p = 1; p <= 17; p++) {
+        char t[40];
+        double v;
+        snprintf(t, sizeof t, "%.*g", p, r);
+        v = strtod(t, NULL);
+        if (v == r || 1 / v == c) { ln_format(v, buf, cap); return; }
+    }
+    ln_format(r, buf, cap);
 }
 
 void ln_notes_free(ln_notes *n)

@@ -179,5 +179,9 @@ char *ln_write_zmx(const ln_lens *l);
 /* The shortest decimal text that reads back as v ("inf", "-inf" for infinities):
  * buf of 32 bytes at least. */
 void ln_format(double v, char *buf, size_t cap);
+/* A surface's radius as a table prints it: "plane", or the shortest decimal that
+ * reads back as s->r or as a radius whose reciprocal is s->c (a .zmx curvature
+ * 1/-124.1 is written -124.1, not -124.09999999999998). */
+void ln_format_radius(const ln_surface *s, char *buf, size_t cap);
 
 #endif
