@@ -85,3 +85,13 @@ pupil_refuse "--pupil: an afocal lens is refused with the reason" 'bad.rx\ngrid\
 pupil_refuse "--pupil: stop in the back focal plane, object at infinity: refused" \
     'bad.rx\ngrid\n4\nn\n' "focal plane" thickness 'epd 10' 'field angle 0 1' \
     '50 0 1.5' '-50 50 air' 'plane 0 air stop'
+
+# A Zemax file (tests/zmx/AC254-100-A.zmx, Thorlabs' achromat: ENPD 22.86, stop at
+# surface 1, WAVL F d C): its pupils and focal length (Thorlabs: f 100.1 mm).
+check "--pupil: a .zmx (Thorlabs AC254-100-A): EPD from ENPD, efl 100.07, EP at the stop" sh -c "
+    cd '$WORK/pu' && ln -sfn '$TOP/tests' tests && printf 'tests/zmx/AC254-100-A.zmx\nhex\n3\nn\n' > z.in &&
+    '$BIN' --pupil -i z.in z.rec > /dev/null &&
+    grep -q 'stop at surface 1, EPD 22.86, object at infinity' z.rec &&
+    grep -q '^  efl 100.07, f-number 4.378' z.rec &&
+    grep -q '^  entrance pupil z= 0, diameter 22.86; ' z.rec &&
+    grep -q 'spot: 37 rays, 0 vignetted' z.rec"

@@ -191,6 +191,40 @@ static void wide_angle(const trace_api *tr)
           "and as the field cubed near the axis: miss(10)/miss(5) = %.2f", miss[1] / miss[0]);
 }
 
+/* The aimed on-axis rays, traced again by the Embree path (lens_fan, meridional rays
+ * at the heights found): the same image heights. */
+static void against_fan(const trace_api *tr)
+{
+    trace_rx_surface s[TT_NSURF];
+    trace_rx rx;
+    trace_lens_surface ls[TT_NSURF];
+    trace_lens l;
+    char err[256];
+    double ya, yb, h[5], y_aim[5], worst = 0;
+    triplet_rx(s, &rx, 3);
+    tt_triplet(ls, &l, 0);
+    base_rays(&rx, &ya, &yb);
+    rx.stop_radius = TT_EPD / 2 * fabs(ya);
+    for (int i = 0; i < 5; i++) {
+        trace_aim_req rq = {0};
+        trace_aim_ray out;
+        rq.infinite = 1;
+        rq.dir[2] = 1;
+        rq.py = -1 + 0.5 * i;
+        rq.guess[1] = rq.py * TT_EPD / 2;
+        if (tr->rx_aim(&rx, &rq, &out, err, sizeof err) || out.status) { worst = INFINITY; break; }
+        h[i] = out.o[1];
+        y_aim[i] = out.img[1];
+    }
+    trace_fan_ray fan[5];
+    int rc = isfinite(worst) ? tr->lens_fan(&l, -INFINITY, 0, rx.z_image, 5, h, fan, err,
+                                            sizeof err) : -1;
+    for (int i = 0; i < 5 && rc == TRACE_OK; i++) worst = fmax(worst, fabs(fan[i].y_image - y_aim[i]));
+    CHECK(rc == TRACE_OK && worst < 1e-12,
+          "aimed rim and zone rays, traced again through Embree (lens_fan): image heights "
+          "agree to %.2g mm", worst);
+}
+
 static void failures(const trace_api *tr)
 {
     trace_rx_surface s[TT_NSURF];
@@ -261,6 +295,7 @@ int main(void)
     paraxial_limit(tr);
     chief_rays(tr);
     wide_angle(tr);
+    against_fan(tr);
     failures(tr);
     return unit_failed();
 }
