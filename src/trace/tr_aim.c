@@ -200,7 +200,7 @@ static int check_req(const aim_sys *a, const trace_aim_req *rq, char *err, size_
         }
     } else {
         if (!isfinite(rq->obj[0]) || !isfinite(rq->obj[1]) || !isfinite(rq->obj[2]) ||
-            !(rq->obj[2] < a->g[0].lo[2])) {
+            !(rq->obj[2] < a->rx->surf[0].z)) {
             tr_set_err(err, cap, "the object point must lie left of the first surface");
             return -1;
         }

@@ -225,6 +225,29 @@ static void against_fan(const trace_api *tr)
           "agree to %.2g mm", worst);
 }
 
+/* A concave first surface (R -20) with the object 10 mm before its vertex, inside
+ * the sphere's reach: aimed like any other. */
+static void concave_front(const trace_api *tr)
+{
+    trace_rx_surface s[3];
+    trace_rx rx = {1, 3, s, 2, 1, 40};
+    trace_aim_ray out;
+    trace_aim_req rq = {0};
+    char err[256];
+    memset(s, 0, sizeof s);
+    s[0].z = 0;  s[0].radius = -20; s[0].n_right = 1.5;
+    s[1].z = 3;  s[1].radius = -12; s[1].n_right = 1;
+    s[2].z = 6;  s[2].radius = 0;   s[2].n_right = 1;
+    rq.obj[1] = 2;
+    rq.obj[2] = -10;
+    rq.py = 0.5;
+    rq.guess[1] = -0.1;
+    int rc = tr->rx_aim(&rx, &rq, &out, err, sizeof err);
+    CHECK(rc == TRACE_OK && out.status == TRACE_AIM_OK && fabs(out.stop[1] - 0.5) < 1e-9,
+          "concave front surface, object 10 before it: aimed (%s, residual %.2g)",
+          rc ? err : "ok", out.residual);
+}
+
 static void failures(const trace_api *tr)
 {
     trace_rx_surface s[TT_NSURF];
@@ -296,6 +319,7 @@ int main(void)
     chief_rays(tr);
     wide_angle(tr);
     against_fan(tr);
+    concave_front(tr);
     failures(tr);
     return unit_failed();
 }
