@@ -95,3 +95,16 @@ check "--pupil: a .zmx (Thorlabs AC254-100-A): EPD from ENPD, efl 100.07, EP at 
     grep -q '^  efl 100.07, f-number 4.378' z.rec &&
     grep -q '^  entrance pupil z= 0, diameter 22.86; ' z.rec &&
     grep -q 'spot: 37 rays, 0 vignetted' z.rec"
+
+# Object-space telecentric: the stop in the back focal plane of a convex-plane lens
+# (f = 100, H2 at its convex vertex) with a finite object, aperture by NA: the
+# entrance pupil is at infinity (printed as a word, no f-number), the chief ray of
+# the 2 mm field is parallel to the axis in object space and is still aimed.
+check "--pupil: object-space telecentric: EP at infinity, no f-number, chief ray aimed" sh -c "
+    cd '$WORK/pu' && printf '%s\n' thickness 'na 0.05' 'field height 0 2' 'object -200' \
+        'plane 4 1.5' '-50 100 air' 'plane 0 air stop' > tc.rx &&
+    printf 'tc.rx\nhex\n3\nn\n' > tc.in && '$ASAN' --pupil -i tc.in tc.rec > /dev/null &&
+    grep -q '^  efl 100, f-number -, ' tc.rec &&
+    grep -q '^  entrance pupil z= infinity, diameter infinity; exit pupil z= 104, diameter 10;' tc.rec &&
+    grep -q '^    object             -         0.05            -            0 ' tc.rec &&
+    [ \$(grep -c 'spot: 37 rays, 0 vignetted' tc.rec) -eq 2 ] && ! grep -qw 'inf\|nan' tc.rec"

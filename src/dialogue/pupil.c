@@ -241,10 +241,20 @@ static int ask_sampling(pdlg *d)
 
 /* ---- computing --------------------------------------------------------------------- */
 
+/* A length that may be at infinity (a telecentric pupil): the word, never "inf". */
 static const char *fmt_len(char *buf, size_t cap, double v)
 {
-    if (isinf(v)) snprintf(buf, cap, "%s", v > 0 ? "inf" : "-inf");
+    if (isinf(v)) snprintf(buf, cap, "%s", v > 0 ? "infinity" : "-infinity");
+    else if (isnan(v)) snprintf(buf, cap, "-");
     else snprintf(buf, cap, "%.6g", v == 0 ? 0.0 : v);
+    return buf;
+}
+
+/* A ratio that may be undefined (the f-number of an entrance pupil at infinity). */
+static const char *fmt_num(char *buf, size_t cap, double v)
+{
+    if (!isfinite(v)) snprintf(buf, cap, "-");
+    else snprintf(buf, cap, "%.4g", v == 0 ? 0.0 : v);
     return buf;
 }
 
@@ -432,12 +442,12 @@ static void report_pupil(pdlg *d, const wl_ctx *w, double fbig)
     int inf = isinf(l->object), N = l->nsurf - 1;
     double k = inf ? tan(fbig * DEG) : fbig;
     char a[32], b[32], c[32], e[32];
-    calc_say(&d->c, P(FIRST), CL(p->efl), CL(p->fnum), CL(p->work_fnum), CL(p->na_obj),
-             CL(p->na_img));
+    calc_say(&d->c, P(FIRST), CL(p->efl), fmt_num(a, sizeof a, p->fnum),
+             fmt_num(b, sizeof b, p->work_fnum), CL(p->na_obj), CL(p->na_img));
     calc_say(&d->c, P(PUPILS), fmt_len(a, sizeof a, p->z_ep),
              fmt_len(b, sizeof b, 2 * p->r_ep * w->s), fmt_len(c, sizeof c, p->z_xp),
              fmt_len(e, sizeof e, 2 * p->r_xp * w->s), CL(p->r_stop * w->s));
-    if (inf) snprintf(b, sizeof b, "-");
+    if (inf || !isfinite(p->mag)) snprintf(b, sizeof b, "-");
     else snprintf(b, sizeof b, "%.6g", CL(p->mag));
     calc_say(&d->c, P(IMAGE), fmt_len(a, sizeof a, p->z_img), b, CL(p->lagrange * w->s * k));
     calc_say(&d->c, P(RAYS_HEAD), fbig);
