@@ -223,7 +223,7 @@ static void thorlabs(const char *path, int utf16, double efl_pub, double bfl_pub
         CHECK(l.ap_kind == LN_AP_EPD && l.ap_value == 22.86, "ENPD 22.86");
         CHECK(l.nfield == 1 && l.field[0].y == 0, "one field, on axis (FTYP's count)");
         CHECK(notes.n == 1 && strstr(notes.s, "not read") && strstr(notes.s, "COAT") &&
-              strstr(notes.s, "VERS (line 1)"), "one note lists the keywords not read");
+              strstr(notes.s, ": VERS NOTE PFIL"), "one note lists the keywords not read");
         rc = ln_paraxial(&l, l.wl[0], &sys, err, sizeof err);
         CHECK(rc == LN_OK && px_first_order(&sys, &f) == PX_OK, "first order at 587.6 nm");
         if (rc == LN_OK) {

@@ -1,6 +1,7 @@
 /* lens.c -- the lens model itself: making and freeing a lens, radius and curvature,
  * the index of a surface's medium (through the paraxial engine's catalogue), sags,
  * the consistency check, and the shortest round-trip number text the writers use. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -228,14 +229,14 @@ void ln_format(double v, char *buf, size_t cap)
 
 void ln_format_radius(const ln_surface *s, char *buf, size_t cap)
 {
-    double r = s->r, c = s->c;
+    double r = s->r, c = s->c, tol = 1e-14 * fabs(c);
     if (isinf(r) || r == 0) { snprintf(buf, cap, "plane"); return; }
     for (int p = 1; p <= 17; p++) {
         char t[40];
         double v;
         snprintf(t, sizeof t, "%.*g", p, r);
         v = strtod(t, NULL);
-        if (v == r || 1 / v == c) { ln_format(v, buf, cap); return; }
+        if (v == r || fabs(1 / v - c) <= tol) { ln_format(v, buf, cap); return; }
     }
     ln_format(r, buf, cap);
 }

@@ -180,8 +180,11 @@ char *ln_write_zmx(const ln_lens *l);
  * buf of 32 bytes at least. */
 void ln_format(double v, char *buf, size_t cap);
 /* A surface's radius as a table prints it: "plane", or the shortest decimal that
- * reads back as s->r or as a radius whose reciprocal is s->c (a .zmx curvature
- * 1/-124.1 is written -124.1, not -124.09999999999998). */
+ * reads back as s->r or as a radius whose reciprocal is within 1e-14 relative of
+ * s->c (OpticStudio's CURV -7.798487093503899700E-003 is written -128.23, not
+ * -128.229999999999: its own 1/R is that far off).  So a thickness prescription
+ * written from a .zmx keeps each curvature to 1e-14; the .zmx writer writes
+ * curvatures exactly. */
 void ln_format_radius(const ln_surface *s, char *buf, size_t cap);
 
 #endif

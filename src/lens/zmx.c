@@ -96,7 +96,6 @@ typedef struct zr {
     int field_type;
     int nskip;                 /* keywords not read, each once */
     char skip[NSKIP][8];
-    long skip_line[NSKIP];
     int more_skipped;
 } zr;
 
@@ -124,7 +123,7 @@ static void skipped(zr *r, const char *key)
     for (int i = 0; i < r->nskip; i++) if (!strcmp(r->skip[i], key)) return;
     if (r->nskip == NSKIP) { r->more_skipped = 1; return; }
     snprintf(r->skip[r->nskip], sizeof r->skip[0], "%s", key);
-    r->skip_line[r->nskip++] = r->line;
+    r->nskip++;
 }
 
 static zsurf *cur(zr *r) { return r->nz ? &r->zs[r->nz - 1] : NULL; }
@@ -468,7 +467,7 @@ static int assemble(zr *r)
     if (r->nskip) {
         ln_buf b = {0};
         for (int i = 0; i < r->nskip; i++)
-            ln_buf_printf(&b, "%s%s (line %ld)", i ? ", " : "", r->skip[i], r->skip_line[i]);
+            ln_buf_printf(&b, "%s%s", i ? " " : "", r->skip[i]);
         if (ln_buf_done(&b))
             ln_note(r->notes, r->src, 0, "not read (display, tolerancing, optimisation, "
                     "coating and other data the lens model does not hold): %s%s", b.s,
