@@ -108,3 +108,15 @@ check "--pupil: object-space telecentric: EP at infinity, no f-number, chief ray
     grep -q '^  entrance pupil z= infinity, diameter infinity; exit pupil z= 104, diameter 10;' tc.rec &&
     grep -q '^    object             -         0.05            -            0 ' tc.rec &&
     [ \$(grep -c 'spot: 37 rays, 0 vignetted' tc.rec) -eq 2 ] && ! grep -qw 'inf\|nan' tc.rec"
+
+# Fields off the meridional plane: the triplet is round, so a field of 14 degrees in
+# x gives the 14-degree y field's image height and spot turned by 90 degrees (the
+# grid is symmetric about the diagonal), and 10 degrees in x and in y, whose
+# direction is 14.0 degrees off the axis, has the same distortion to 4 digits.
+check "--pupil: x fields: rotated image height and spot, the same distortion" sh -c "
+    cd '$WORK/pu' && sed 's/^field angle 0 14 20/field angle 14,0 0,14 10,10/' doc/pupil-triplet.rx > xy.rx &&
+    printf 'xy.rx\ngrid\n12\nn\n' > xy.in && '$BIN' --pupil -i xy.in xy.rec > /dev/null &&
+    grep -q 'real (12.4195, 0) (distortion 0.02805 %)' xy.rec &&
+    grep -q 'real 12.4195 (distortion 0.02805 %)' xy.rec &&
+    [ \$(grep -c 'RMS radius about the chief ray 0.0154774, about the centroid 0.0154311;' xy.rec) -ge 2 ] &&
+    grep -q 'real (8.78319, 8.78319) (distortion 0.02805 %)' xy.rec"

@@ -374,23 +374,41 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi)
     trace_aim_ray chief, r;
     aim_tally t = {0, 0};
     int N = l->nsurf - 1, inf = isinf(l->object), nok = 0, nvig = 0;
-    double sx = 0, sy = 0, sc = 0, par, fy = inf ? tan(f->y * DEG) : f->y;
-    char dist[32];
-    if (inf) calc_say(&d->c, P(FIELD_HEAD_ANGLE), fi + 1, f->y);
-    else calc_say(&d->c, P(FIELD_HEAD_HEIGHT), fi + 1, f->y);
+    double sx = 0, sy = 0, sc = 0;
+    double fx = inf ? tan(f->x * DEG) : f->x, fy = inf ? tan(f->y * DEG) : f->y;
+    char dist[32], hp[64], hi[64], hr[64];
+    if (f->x == 0) {
+        if (inf) calc_say(&d->c, P(FIELD_HEAD_ANGLE), fi + 1, f->y);
+        else calc_say(&d->c, P(FIELD_HEAD_HEIGHT), fi + 1, f->y);
+    } else {
+        if (inf) calc_say(&d->c, P(FIELD_HEAD_ANGLE_XY), fi + 1, f->x, f->y);
+        else calc_say(&d->c, P(FIELD_HEAD_HEIGHT_XY), fi + 1, f->x, f->y);
+    }
     if (aim(d, w, f, 0, 0, &chief, &t)) return LM_FAIL;
     if (chief.status != TRACE_AIM_OK) {
         calc_say(&d->c, P(CHIEF_BAD), status_word(chief.status), chief.surface + 1);
         return LM_GO;
     }
     /* paraxial chief-ray heights: at the paraxial image, and at the image plane the
-     * real rays are carried to (the distortion compares the real one with this) */
-    par = fy * (p->yb[N] + p->ub[N + 1] * (w->rx.z_image - p->z[N]));
-    if (snap(d, par) != 0)
-        snprintf(dist, sizeof dist, "%.4g %%", CL(100 * (chief.img[1] - par) / par));
-    else snprintf(dist, sizeof dist, "-");
-    calc_say(&d->c, P(CHIEF), CL(fy * p->h_img), CL(par), CL(chief.img[1]), dist,
-             chief.residual, chief.iterations);
+     * real rays are carried to (the distortion compares the real one with this,
+     * radially); x and y are separate paraxial rays, both the unit chief ray scaled */
+    {
+        double unit = p->yb[N] + p->ub[N + 1] * (w->rx.z_image - p->z[N]);
+        double px_ = fx * unit, py_ = fy * unit, rp = hypot(px_, py_);
+        double rr = hypot(chief.img[0], chief.img[1]);
+        if (snap(d, rp) != 0) snprintf(dist, sizeof dist, "%.4g %%", CL(100 * (rr - rp) / rp));
+        else snprintf(dist, sizeof dist, "-");
+        if (f->x == 0) {
+            snprintf(hp, sizeof hp, "%.6g", CL(fy * p->h_img));
+            snprintf(hi, sizeof hi, "%.6g", CL(py_));
+            snprintf(hr, sizeof hr, "%.6g", CL(chief.img[1]));
+        } else {
+            snprintf(hp, sizeof hp, "(%.6g, %.6g)", CL(fx * p->h_img), CL(fy * p->h_img));
+            snprintf(hi, sizeof hi, "(%.6g, %.6g)", CL(px_), CL(py_));
+            snprintf(hr, sizeof hr, "(%.6g, %.6g)", CL(chief.img[0]), CL(chief.img[1]));
+        }
+    }
+    calc_say(&d->c, P(CHIEF), hp, hi, hr, dist, chief.residual, chief.iterations);
     /* the spot */
     double *xs = malloc(sizeof(double) * 2 * (size_t)d->nsamp);
     if (!xs) return LM_FAIL;
