@@ -120,3 +120,11 @@ check "--pupil: x fields: rotated image height and spot, the same distortion" sh
     grep -q 'real 12.4195 (distortion 0.02805 %)' xy.rec &&
     [ \$(grep -c 'RMS radius about the chief ray 0.0154774, about the centroid 0.0154311;' xy.rec) -ge 2 ] &&
     grep -q 'real (8.78319, 8.78319) (distortion 0.02805 %)' xy.rec"
+
+# On a terminal: a missing file, a stop out of range, a bad sampling word and a count
+# too large are explained and asked again; the record keeps only accepted answers.
+if python3 -c 'import pty' 2>/dev/null; then
+    mkdir -p "$WORK/pu_tty"
+    check "--pupil on a tty: bad answers explained and asked again" \
+        python3 "$TOP/tests/tty_pupil.py" "$BIN" "$TOP" "$WORK/pu_tty"
+fi
