@@ -418,7 +418,7 @@ typedef struct px_pupil {
     /* the two rays: height at surface k, slope right of it; [0] of u, ub: object */
     double y[PX_PUPIL_MAXSURF], u[PX_PUPIL_MAXSURF + 1];
     double yb[PX_PUPIL_MAXSURF], ub[PX_PUPIL_MAXSURF + 1];
-    double efl;                           /* effective focal length n'/P ... -1/C */
+    double efl;                           /* effective focal length -1/C (px_first) */
     double z_ep, r_ep;                    /* entrance pupil */
     double z_xp, r_xp;                    /* exit pupil */
     double r_stop;                        /* the stop's semi-diameter */
