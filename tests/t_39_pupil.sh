@@ -79,6 +79,9 @@ pupil_refuse "--pupil: stop 9 of 6 surfaces refused" 'doc/triplet.rx\n9\n' \
     "'9': give a surface number from 1 to 6"
 pupil_refuse "--pupil: field angle 95 refused" 'bad.rx\n3\n95\n' \
     "strictly between -90 and 90" thickness 'epd 10' 'index air' '50 5 1.5 stop' 'plane 0 air'
+pupil_refuse "--pupil: a virtual object (right of surface 1) is refused at the file" \
+    'bad.rx\n' "a virtual object" thickness 'epd 10' 'field height 0 1' 'object 20' \
+    '50 5 1.5 stop' 'plane 0 air'
 pupil_refuse "--pupil: an afocal lens is refused with the reason" 'bad.rx\ngrid\n4\nn\n' \
     "afocal" thickness 'epd 10' 'field angle 0 1' '50 0 1.5 stop' '-50 75 air' \
     '25 0 1.5' '-25 0 air'

@@ -92,6 +92,12 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
                  "fields as object heights", word);
         r = LN_BAD;
     }
+    if (r == LN_OK && !isinf(l.object) && !(l.object > 0)) {
+        snprintf(err, sizeof err, "%s: the object lies %s surface 1 (a virtual object): "
+                 "rays are aimed only from a real object left of it, or from infinity",
+                 word, l.object == 0 ? "on" : "right of");
+        r = LN_BAD;
+    }
     if (r == LN_OK && l.nsurf > PX_PUPIL_MAXSURF) {
         snprintf(err, sizeof err, "%s: %d surfaces: at most %d", word, l.nsurf,
                  PX_PUPIL_MAXSURF);
