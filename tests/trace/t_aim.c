@@ -248,6 +248,43 @@ static void concave_front(const trace_api *tr)
           rc ? err : "ok", out.residual);
 }
 
+/* The triplet scaled by 1e-3 and 1e4, and a stop of 1e-9 of its size: the 20-degree
+ * chief ray and the rim ray still meet their targets to ~1e-14 of the lens's size. */
+static void scales(const trace_api *tr)
+{
+    double k[3] = {1e-3, 1e4, 1};
+    for (int c = 0; c < 3; c++) {
+        trace_rx_surface s[TT_NSURF];
+        trace_rx rx;
+        trace_aim_ray out;
+        char err[256];
+        double ya, yb, th = 20 * DEG;
+        triplet_rx(s, &rx, 3);
+        for (int i = 0; i < TT_NSURF; i++) { s[i].z *= k[c]; s[i].radius *= k[c]; }
+        base_rays(&rx, &ya, &yb);
+        double r_ep = c == 2 ? 1e-9 : TT_EPD / 2 * k[c];
+        rx.stop_radius = r_ep * fabs(ya);
+        double worst = 0;
+        int maxit = 0, ok = 1;
+        for (int j = 0; j < 2; j++) {
+            trace_aim_req rq = {0};
+            rq.infinite = 1;
+            rq.dir[1] = sin(th);
+            rq.dir[2] = cos(th);
+            rq.py = j;
+            rq.guess[1] = -yb / ya * tan(th) + j * r_ep;
+            int rc = tr->rx_aim(&rx, &rq, &out, err, sizeof err);
+            ok &= rc == TRACE_OK && out.status == TRACE_AIM_OK;
+            worst = fmax(worst, hypot(out.stop[0], out.stop[1] - j * rx.stop_radius));
+            if (out.iterations > maxit) maxit = out.iterations;
+        }
+        double size = 18 * k[c];
+        CHECK(ok && worst < 1e-13 * size, "triplet x %g%s: chief and rim rays on target to "
+              "%.2g (%.2g of its size), at most %d iterations", k[c],
+              c == 2 ? ", stop 1e-9" : "", worst, worst / size, maxit);
+    }
+}
+
 static void failures(const trace_api *tr)
 {
     trace_rx_surface s[TT_NSURF];
@@ -320,6 +357,7 @@ int main(void)
     wide_angle(tr);
     against_fan(tr);
     concave_front(tr);
+    scales(tr);
     failures(tr);
     return unit_failed();
 }
