@@ -80,6 +80,14 @@ build/fuzz_answers: tests/fuzz_answers.c $(LIBCORE) $(GEN) | $(DEPS)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
 	    tests/fuzz_answers.c $(LIBCORE) $(LIBS)
 
+# libFuzzer target for the lens model's readers (src/lens: thickness prescriptions,
+# .zmx), with the paraxial engine they build on.
+LENSFUZZ_SRC := $(wildcard src/lens/*.c src/paraxial/*.c)
+build/fuzz_lens: tests/fuzz_lens.c $(LENSFUZZ_SRC) $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
+	    tests/fuzz_lens.c $(LENSFUZZ_SRC) -lm
+
 # The transcribed original program, for differential tests (built from ../shared,
 # never copied into this tree).
 ORIG_DIR := ../shared/original-lensmat
@@ -91,6 +99,7 @@ build/original/lensmat: | $(DEPS)
 TEST_BINS := lensmat build/asan/lensmat build/fuzz_answers build/original/lensmat \
              $(patsubst tests/%.c,build/obj/%,$(UNIT)) \
              $(patsubst tests/%.c,build/asan/%,$(UNIT))
+TEST_BINS += build/fuzz_lens
 
 -include $(wildcard src/*/*.mk)
 
