@@ -116,10 +116,13 @@ bench: lensmat build/original/lensmat build/bench/benchrun build/bench/baseline 
        $(MODULE_BENCH_BINS)
 	@sh scripts/bench.sh
 
-fuzz: build/fuzz_answers
+fuzz: build/fuzz_answers build/fuzz_lens
 	@mkdir -p build/fuzz-corpus
 	build/fuzz_answers -max_total_time=$${FUZZ_SECONDS:-600} build/fuzz-corpus \
 	    tests/fuzz-corpus
+	@mkdir -p build/fuzz-lens-corpus
+	build/fuzz_lens -max_total_time=$${FUZZ_SECONDS:-600} build/fuzz-lens-corpus \
+	    tests/fuzz-lens
 
 example: lensmat
 	./lensmat --example example.rec
