@@ -97,6 +97,7 @@ typedef struct zr {
     int nskip;                 /* keywords not read, each once */
     char skip[NSKIP][8];
     int more_skipped;
+    unsigned aliased;          /* the aliases already noted */
 } zr;
 
 static int zbad(zr *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -152,6 +153,12 @@ static int new_surface(zr *r, const char *tok)
     return LN_OK;
 }
 
+/* OpticStudio's names for glasses lensmat's catalogue holds under another name:
+ * {OpticStudio, lensmat, where OpticStudio has it}. */
+static const char *const aliases[][3] = {
+    {"SILICA", "F_SILICA", "MISC catalogue's fused silica, Malitson 1965"},
+};
+
 /* GLAS NAME FIX? ? ND VD ...: the catalogue's glass, a model glass (___BLANK), a
  * 6-digit glass code, or a name with the file's nd/Vd as its fallback (noted). */
 static int glass(zr *r, zsurf *z, char **tok, int n)
@@ -186,6 +193,14 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
         }
         return LN_OK;
     }
+    for (size_t i = 0; i < sizeof aliases / sizeof *aliases; i++)
+        if (!strcasecmp(name, aliases[i][0])) {
+            if (!(r->aliased & (1u << i)))
+                ln_note(r->notes, r->src, r->line, "glass %s (OpticStudio's %s) is read as "
+                        "lensmat's %s, the same formula", name, aliases[i][2], aliases[i][1]);
+            r->aliased |= 1u << i;
+            name = aliases[i][1];
+        }
     if ((g = px_glass_find(name))) { snprintf(z->s.glass, LN_NAME_MAX, "%s", g->name); return LN_OK; }
     if (ln_parse_number(name, 0, &idx)) {   /* an index as a name: its shortest spelling */
         if (px_glass_index(name, PX_LAMBDA_D, &idx) == PX_OK) {
