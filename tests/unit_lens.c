@@ -288,6 +288,52 @@ static void zmx_notes(void)
     zmx_bad("MODE SEQ\nSURF 0\nSURF 1\n", "bad.zmx: 2 surfaces");
 }
 
+/* Reiley's OpticStudio file of US patent 5,831,776 example 1 (MIT licence, tests/zmx/
+ * SOURCE): a 248 nm lithography lens, 42 fused-silica and air surfaces, finite object,
+ * CRLF lines.  The file's own numbers: object field semi-height 47.99 (DIAM of the
+ * object surface) imaged to 12.01 (the image surface's), a 4x reduction; the
+ * designer's image distance 13.0765 (last DISZ), at NA 0.15 on the object side. */
+static void lithography(void)
+{
+    size_t len;
+    char *s = slurp("tests/zmx/US05831776-1.zmx", &len), err[LN_ERR_MAX];
+    ln_lens l;
+    ln_notes notes = {0};
+    px_system sys;
+    px_conj cj;
+    int rc;
+    CHECK(s != NULL, "US05831776-1.zmx reads from disk");
+    if (!s) return;
+    rc = ln_read_zmx(s, len, "US05831776-1.zmx", &l, &notes, err, sizeof err);
+    CHECK(rc == LN_OK, "US05831776-1.zmx reads (%s)", rc ? err : "ok");
+    if (!rc) {
+        CHECK(l.nsurf == 42 && l.stop == 19 && l.nwl == 1 && l.wl[0] == 0.248 &&
+              l.ap_kind == LN_AP_NA && l.ap_value == 0.15 && l.object == 110.8588354359,
+              "42 surfaces, stop on surface 20, 248 nm, NA 0.15, object 110.86 left");
+        CHECK(!strcmp(l.surf[0].glass, "F_SILICA") && notes.s &&
+              strstr(notes.s, "US05831776-1.zmx:97: glass SILICA (OpticStudio's MISC"),
+              "OpticStudio's SILICA is read as F_SILICA, noted once with its line");
+        CHECK(notes.s && strstr(notes.s, "US05831776-1.zmx:38: FTYP 3"),
+              "its real-image-height fields are noted as skipped");
+        CHECK(l.nfield == 0, "so it has no field");
+        rc = ln_paraxial(&l, l.wl[0], &sys, err, sizeof err);
+        CHECK(rc == LN_OK, "paraxial system at 248 nm (%s)", rc ? err : "ok");
+        if (!rc) {
+            double m_file = -1.201117255762e1 / 4.799458807792e1;
+            rc = px_conjugate(&sys, -l.object, &cj);
+            CHECK(rc == PX_OK, "the object plane has an image");
+            CHECK(fabs(cj.lateral.v - m_file) < 2e-3, "paraxial magnification %.5f against "
+                  "the file's field heights 12.011/47.995 = %.5f", cj.lateral.v, m_file);
+            CHECK(fabs(cj.d2.v - l.surf[41].t) < 0.05, "paraxial image %.4f past the last "
+                  "surface against the designer's 13.0765", cj.d2.v);
+            px_system_free(&sys);
+        }
+        ln_free(&l);
+    }
+    ln_notes_free(&notes);
+    free(s);
+}
+
 int main(void)
 {
     rx_read();
@@ -299,5 +345,6 @@ int main(void)
     thorlabs("tests/zmx/AC254-100-A.zmx", 1, 100.1, 97.1, "SF5");
     thorlabs("tests/zmx/AC254-125-A.zmx", 0, 125.0, 122.0, "N-SF5");
     zmx_notes();
+    lithography();
     return unit_failed();
 }

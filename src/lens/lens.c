@@ -82,6 +82,7 @@ void ln_set_radius(ln_surface *s, double r)
 {
     if (r == 0 || isinf(r)) { s->r = INFINITY; s->c = 0; }
     else { s->r = r; s->c = 1 / r; }
+    s->by_curvature = 0;
 }
 
 void ln_set_curvature(ln_surface *s, double c)
@@ -89,6 +90,7 @@ void ln_set_curvature(ln_surface *s, double c)
     if (c == 0) { s->c = 0; s->r = INFINITY; }
     else { s->c = c; s->r = 1 / c; }
     if (isinf(s->r)) s->r = INFINITY;                   /* a subnormal curvature */
+    s->by_curvature = 1;
 }
 
 double ln_primary(const ln_lens *l) { return l->nwl ? l->wl[0] : PX_LAMBDA_D; }
@@ -195,9 +197,18 @@ int ln_check(const ln_lens *l, const char *src, char *err, size_t cap)
     if (l->ap_kind != LN_AP_NONE && !(l->ap_value > 0 && isfinite(l->ap_value)))
         return fail(err, cap, src, 0, "%sthe aperture %g must be a positive number", "",
                     l->ap_value);
-    if (l->ap_kind == LN_AP_NA && !(l->ap_value < 1e3))
-        return fail(err, cap, src, 0, "%sthe numerical aperture %g is too large", "",
-                    l->ap_value);
+    if (l->ap_kind == LN_AP_NA && ln_index(l, -1, ln_primary(l), &n, NULL, why, sizeof why) ==
+        LN_OK && !(l->ap_value < n))
+        return fail(err, cap, src, 0, "%sthe numerical aperture %g is not below the object "
+                    "medium's index", "", l->ap_value);
+    for (int w = 0; w < l->nwl; w++)
+        if (!(l->wl_weight[w] >= 0) || !isfinite(l->wl_weight[w]))
+            return fail(err, cap, src, 0, "%sthe weight of wavelength %g must be a number "
+                        ">= 0", "", w + 1);
+    for (int f = 0; f < l->nfield; f++)
+        if (!(l->field[f].weight >= 0) || !isfinite(l->field[f].weight))
+            return fail(err, cap, src, 0, "%sthe weight of field %g must be a number >= 0",
+                        "", f + 1);
     for (int f = 0; f < l->nfield; f++)
         if (!isfinite(l->field[f].x) || !isfinite(l->field[f].y) ||
             (l->field_kind == LN_FIELD_ANGLE &&
@@ -236,7 +247,10 @@ void ln_format_radius(const ln_surface *s, char *buf, size_t cap)
         double v;
         snprintf(t, sizeof t, "%.*g", p, r);
         v = strtod(t, NULL);
-        if (v == r || fabs(1 / v - c) <= tol) { ln_format(v, buf, cap); return; }
+        if (v == r || (s->by_curvature && fabs(1 / v - c) <= tol)) {
+            ln_format(v, buf, cap);
+            return;
+        }
     }
     ln_format(r, buf, cap);
 }

@@ -51,6 +51,7 @@ typedef struct ln_surface {
     int nasph;                     /* terms given: asph[0..nasph-1] */
     double asph[LN_ASPH_MAX];      /* coefficient of r^(2i+2): asph[0] r^2, asph[1] r^4 ... */
     long line;                     /* the line of the file that started it (0: none) */
+    int by_curvature;              /* 1: c is the number given (ln_set_curvature), r = 1/c */
 } ln_surface;
 
 /* Aperture kinds. */
@@ -179,12 +180,12 @@ char *ln_write_zmx(const ln_lens *l);
 /* The shortest decimal text that reads back as v ("inf", "-inf" for infinities):
  * buf of 32 bytes at least. */
 void ln_format(double v, char *buf, size_t cap);
-/* A surface's radius as a table prints it: "plane", or the shortest decimal that
- * reads back as s->r or as a radius whose reciprocal is within 1e-14 relative of
- * s->c (OpticStudio's CURV -7.798487093503899700E-003 is written -128.23, not
- * -128.229999999999: its own 1/R is that far off).  So a thickness prescription
- * written from a .zmx keeps each curvature to 1e-14; the .zmx writer writes
- * curvatures exactly. */
+/* A surface's radius as a table prints it: "plane"; a radius given as such, its
+ * shortest decimal (exact); a radius derived from a curvature (by_curvature), the
+ * shortest decimal whose reciprocal lies within 1e-14 relative of c (OpticStudio's
+ * CURV -7.798487093503899700E-003 is written -128.23, not -128.229999999999: its own
+ * 1/R is that far off).  So a thickness prescription written from a .zmx keeps each
+ * curvature to 1e-14; the .zmx writer writes curvatures exactly. */
 void ln_format_radius(const ln_surface *s, char *buf, size_t cap);
 
 #endif

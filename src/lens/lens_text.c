@@ -109,3 +109,29 @@ int ln_split(char *line, int hash, char **tok, int max)
         if (hash && *p == '#') { *p = '\0'; return n; }
     }
 }
+
+void ln_title(char *dst, const char *src, size_t n)
+{
+    size_t k = 0;
+    while (n && (*src == ' ' || (unsigned char)*src < 0x20 || *src == 0x7f)) src++, n--;
+    for (size_t i = 0; i < n && k < LN_TITLE_MAX - 1; i++) {
+        unsigned char c = (unsigned char)src[i];
+        dst[k++] = c < 0x20 || c == 0x7f ? ' ' : (char)c;
+    }
+    while (k && dst[k - 1] == ' ') k--;
+    dst[k] = '\0';
+}
+
+void ln_glass_spelling(char *g)
+{
+    char a[26], b[26], *slash = strchr(g, '/');
+    double v, w;
+    if (ln_parse_number(g, 0, &v)) { ln_format(v, g, LN_NAME_MAX); return; }
+    if (!slash) return;
+    *slash = '\0';
+    if (ln_parse_number(g, 0, &v) && ln_parse_number(slash + 1, 0, &w)) {
+        ln_format(v, a, sizeof a);
+        ln_format(w, b, sizeof b);
+        snprintf(g, LN_NAME_MAX, "%s/%s", a, b);
+    } else *slash = '/';
+}

@@ -18,8 +18,16 @@ void ln_note(ln_notes *n, const char *src, long line, const char *fmt, ...)
  * "infinity" only with allow_inf).  1 with *v set, else 0. */
 int ln_parse_number(const char *tok, int allow_inf, double *v);
 
+/* A title from n bytes of src: control bytes become blanks, blanks trimmed at both
+ * ends, at most LN_TITLE_MAX - 1 bytes (so every writer's title reads back). */
+void ln_title(char *dst, const char *src, size_t n);
+
+/* A number or a model glass ND/VD in its shortest spelling (1.50 is 1.5, 1.6/40.0
+ * is 1.6/40), in place (g holds LN_NAME_MAX), so every writer spells it the same. */
+void ln_glass_spelling(char *g);
+
 #define LN_TOK_MAX 256
-#define LN_TOKS 64
+#define LN_TOKS (LN_FIELD_MAX + 16)   /* a field line: 64 fields, its two words */
 /* Split a line (modified in place: blanks become NULs; '#' ends it when hash) into at
  * most max tokens; the count, or -1 if there are more or one is too long. */
 int ln_split(char *line, int hash, char **tok, int max);

@@ -64,7 +64,7 @@ static int classic_index(rd *r, const char *tok, char *out)
     size_t len = at ? (size_t)(at - tok) : strlen(tok);
     if (ln_parse_number(tok, 0, &n)) {
         if (!(n > 0)) return bad(r, "the index must be greater than 0");
-        snprintf(out, LN_NAME_MAX, "%s", tok);
+        ln_format(n, out, LN_NAME_MAX);
         return LN_OK;
     }
     memcpy(name, tok, len);
@@ -88,6 +88,7 @@ static int set_glass(rd *r, const char *tok, char *out)
                    "wavelengths line says where they are taken)", tok);
     if (strlen(tok) >= LN_NAME_MAX) return bad(r, "glass name '%.40s...' too long", tok);
     strcpy(out, tok);
+    ln_glass_spelling(out);
     return LN_OK;
 }
 
@@ -156,7 +157,6 @@ static int aperture(rd *r, int kind, const char *tok)
     if (r->have_ap) return bad(r, "one aperture only (epd, fnum or na)");
     if (number(r, "the aperture", tok, 0, &v)) return LN_BAD;
     if (!(v > 0)) return bad(r, "the aperture must be greater than 0");
-    if (kind == LN_AP_NA && !(v < 3)) return bad(r, "the numerical aperture %s is too large", tok);
     r->l->ap_kind = kind;
     r->l->ap_value = v;
     r->have_ap = 1;
@@ -268,10 +268,19 @@ static int keyword(rd *r, char **tok, int n)
         return LN_OK;
     }
     if (!strcmp(k, "index")) {
-        if (n != 2) return bad(r, "index GLASS");
+        if (n != 2 && !(r->thick && n > 2)) return bad(r, "index GLASS");
         if (r->have_index) return bad(r, "index given twice");
         r->have_index = 1;
-        return r->thick ? set_glass(r, tok[1], l->obj_glass) : classic_index(r, tok[1], l->obj_glass);
+        if (!r->thick) return classic_index(r, tok[1], l->obj_glass);
+        for (int i = 2; i < n; i += 2) {       /* index NAME nd V vd V: a file's nd, Vd */
+            double *dst = !strcmp(tok[i], "nd") ? &l->obj_nd : !strcmp(tok[i], "vd") ?
+                          &l->obj_vd : NULL;
+            if (!dst || i + 1 == n) return bad(r, "index GLASS [nd V] [vd V]");
+            if (number(r, tok[i], tok[i + 1], 0, dst)) return LN_BAD;
+            if (dst == &l->obj_nd ? !(v = *dst, v >= 1) : !(*dst >= 0))
+                return bad(r, "%s: nd must be at least 1, vd not negative", tok[i]);
+        }
+        return set_glass(r, tok[1], l->obj_glass);
     }
     if (!strcmp(k, "wavelength") || !strcmp(k, "wavelengths")) {
         if (!r->thick) {
@@ -344,12 +353,9 @@ static int title(rd *r, char *rest)
     if (r->l->nsurf) return bad(r, "title comes before the surfaces");
     if (!r->thick) return bad(r, "'title' is a keyword of thickness prescriptions");
     if (r->l->title[0]) return bad(r, "title given twice");
-    rest += strspn(rest, " \t");
     n = strlen(rest);
-    while (n && strchr(" \t\r", rest[n - 1])) n--;
-    if (n >= LN_TITLE_MAX) return bad(r, "title longer than %d bytes", LN_TITLE_MAX - 1);
-    memcpy(r->l->title, rest, n);
-    r->l->title[n] = '\0';
+    if (n >= LN_TITLE_MAX + 8) return bad(r, "title longer than %d bytes", LN_TITLE_MAX - 1);
+    ln_title(r->l->title, rest, n);
     return LN_OK;
 }
 
@@ -494,7 +500,12 @@ char *ln_write_rx(const ln_lens *l)
             ln_buf_printf(&b, "\n");
         }
     }
-    if (l->obj_glass[0]) ln_buf_printf(&b, "index %s\n", l->obj_glass);
+    if (l->obj_glass[0]) {
+        ln_buf_printf(&b, "index %s", l->obj_glass);
+        if (l->obj_nd != 0) { ln_format(l->obj_nd, a, sizeof a); ln_buf_printf(&b, " nd %s", a); }
+        if (l->obj_vd != 0) { ln_format(l->obj_vd, a, sizeof a); ln_buf_printf(&b, " vd %s", a); }
+        ln_buf_printf(&b, "\n");
+    }
     if (l->ap_kind != LN_AP_NONE) {
         ln_format(l->ap_value, a, sizeof a);
         ln_buf_printf(&b, "%s %s\n", l->ap_kind == LN_AP_EPD ? "epd" :
@@ -553,7 +564,7 @@ char *ln_write_rx(const ln_lens *l)
     if (l->nplanes)
         for (int i = 0; i < l->nplanes; i++) {
             ln_format(l->planes[i], a, sizeof a);
-            ln_buf_printf(&b, "object %s\n", a);
+            ln_buf_printf(&b, "object %s\n", isinf(l->planes[i]) ? "-infinity" : a);
         }
     else if (!isinf(l->object)) {
         ln_format(-l->object, a, sizeof a);

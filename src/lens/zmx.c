@@ -97,6 +97,7 @@ typedef struct zr {
     int nskip;                 /* keywords not read, each once */
     char skip[NSKIP][8];
     int more_skipped;
+    unsigned aliased;          /* the aliases already noted */
 } zr;
 
 static int zbad(zr *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -152,6 +153,12 @@ static int new_surface(zr *r, const char *tok)
     return LN_OK;
 }
 
+/* OpticStudio's names for glasses lensmat's catalogue holds under another name:
+ * {OpticStudio, lensmat, where OpticStudio has it}. */
+static const char *const aliases[][3] = {
+    {"SILICA", "F_SILICA", "MISC catalogue's fused silica, Malitson 1965"},
+};
+
 /* GLAS NAME FIX? ? ND VD ...: the catalogue's glass, a model glass (___BLANK), a
  * 6-digit glass code, or a name with the file's nd/Vd as its fallback (noted). */
 static int glass(zr *r, zsurf *z, char **tok, int n)
@@ -160,14 +167,20 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
     const px_glass_rec *g;
     const char *name = tok[1];
     if (n < 2) return zbad(r, "GLAS: a glass name is missing");
+    z->s.nd = z->s.vd = 0;                  /* a second GLAS line replaces the first */
     if (n >= 6 && (!ln_parse_number(tok[4], 0, &nd) || !ln_parse_number(tok[5], 0, &vd)))
         nd = vd = 0;
     if (!strcasecmp(name, "MIRROR"))
         return zbad(r, "GLAS MIRROR: reflecting surfaces are not supported (the lens model "
                     "is a sequence of refracting surfaces)");
     if (strlen(name) >= LN_NAME_MAX) return zbad(r, "GLAS: name too long");
+    for (const char *p = name; *p; p++)      /* what a prescription's column can hold */
+        if (*p <= ' ' || *p > '~' || *p == '@' || *p == '#' || *p == ',')
+            return zbad(r, "GLAS: '%s' is not a glass name lensmat takes (printable "
+                        "ASCII without @ # ,)", name);
+    if (!strcasecmp(name, "AIR")) { z->s.glass[0] = '\0'; return LN_OK; }
     if (!strcmp(name, "___BLANK")) {                        /* a model glass */
-        if (!(nd >= 1)) return zbad(r, "GLAS ___BLANK: a model glass needs nd (>= 1)");
+        if (!(nd > 0)) return zbad(r, "GLAS ___BLANK: a model glass needs nd (> 0)");
         if (vd == 0) ln_format(nd, z->s.glass, LN_NAME_MAX);
         else {
             char a[32], b[32];
@@ -180,7 +193,25 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
         }
         return LN_OK;
     }
+    for (size_t i = 0; i < sizeof aliases / sizeof *aliases; i++)
+        if (!strcasecmp(name, aliases[i][0])) {
+            if (!(r->aliased & (1u << i)))
+                ln_note(r->notes, r->src, r->line, "glass %s (OpticStudio's %s) is read as "
+                        "lensmat's %s, the same formula", name, aliases[i][2], aliases[i][1]);
+            r->aliased |= 1u << i;
+            name = aliases[i][1];
+        }
     if ((g = px_glass_find(name))) { snprintf(z->s.glass, LN_NAME_MAX, "%s", g->name); return LN_OK; }
+    if (ln_parse_number(name, 0, &idx)) {   /* an index as a name: its shortest spelling */
+        if (px_glass_index(name, PX_LAMBDA_D, &idx) == PX_OK) {
+            ln_format(idx, z->s.glass, LN_NAME_MAX);
+            return LN_OK;
+        }
+    } else if (px_glass_index(name, PX_LAMBDA_D, &idx) == PX_OK) {
+        snprintf(z->s.glass, LN_NAME_MAX, "%s", name);   /* a medium, a model ND/VD */
+        ln_glass_spelling(z->s.glass);
+        return LN_OK;
+    }
     snprintf(z->s.glass, LN_NAME_MAX, "%s", name);
     if (strlen(name) == 6 && strspn(name, "0123456789") == 6 && !(nd >= 1)) {
         nd = 1 + atoi(name) / 1000 / 1000.0;               /* 517642: nd 1.517, Vd 64.2 */
@@ -229,10 +260,10 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
     }
     if (!strcmp(k, "DISZ")) {
         if (znum(r, k, n > 1 ? tok[1] : NULL, &v)) return LN_BAD;
-        if (r->nz == 1) {                                   /* the object's distance */
-            if (v < 0 && !isinf(v)) return zbad(r, "DISZ %s: a virtual object (negative "
-                                                "object distance) is not supported", tok[1]);
-            r->l->object = isinf(v) ? INFINITY : v;
+        if (r->nz == 1) {            /* the object's distance (< 0: a virtual object) */
+            if (v == -INFINITY) return zbad(r, "DISZ -INFINITY: the object at infinity is "
+                                            "DISZ INFINITY");
+            r->l->object = v;
             return LN_OK;
         }
         if (isinf(v)) return zbad(r, "DISZ INFINITY: only the object may lie at infinity");
@@ -288,9 +319,7 @@ static int system_line(zr *r, const char *k, char **tok, int n, const char *rest
         len = strlen(rest);
         while (len && strchr(" \t\r", rest[len - 1])) len--;
         if (len >= 2 && rest[0] == '"' && rest[len - 1] == '"') { rest++; len -= 2; }
-        if (len >= LN_TITLE_MAX) len = LN_TITLE_MAX - 1;
-        memcpy(l->title, rest, len);
-        l->title[len] = '\0';
+        ln_title(l->title, rest, len);
         return LN_OK;
     }
     if (!strcmp(k, "MODE")) {
@@ -319,6 +348,7 @@ static int system_line(zr *r, const char *k, char **tok, int n, const char *rest
     }
     if (!strcmp(k, "FLOA")) {
         l->ap_kind = LN_AP_NONE;
+        l->ap_value = 0;
         ln_note(r->notes, r->src, r->line, "FLOA: the aperture floats by the stop's size "
                 "(no EPD, F/# or NA is set: the stop's semi-diameter gives it)");
         return LN_OK;
@@ -539,15 +569,22 @@ static void write_glass(ln_buf *b, const char *g, double nd, double vd)
         ln_buf_printf(b, "  GLAS %s 0 0 %s %s 0 0 0 0 0 0\r\n", g, a, c);
         return;
     }
-    if (px_glass_find(g) && px_glass_index(g, PX_LAMBDA_D, &n) == PX_OK &&
-        px_glass_abbe(g, &v) == PX_OK) {
+    if (px_glass_find(g)) {                 /* nd, Vd as OpticStudio lists them */
+        if (px_glass_index(g, PX_LAMBDA_D, &n) != PX_OK) n = 0;
+        if (px_glass_abbe(g, &v) != PX_OK) v = 0;
         ln_format(n, a, sizeof a);
         ln_format(v, c, sizeof c);
         ln_buf_printf(b, "  GLAS %s 0 0 %s %s 0 0 0 0 0 0\r\n", px_glass_find(g)->name, a, c);
         return;
     }
-    /* a model glass ND/VD, a number or a medium: OpticStudio's model glass */
     if (px_glass_index(g, PX_LAMBDA_D, &n) != PX_OK) n = 1;
+    if (!strchr(g, '/') && !ln_parse_number(g, 0, &v)) {  /* a medium lensmat names */
+        ln_format(n, a, sizeof a);
+        ln_buf_printf(b, "  GLAS %s 0 0 %s 0 0 0 0 0 0 0\r\n", g, a);
+        return;
+    }
+    /* a model glass ND/VD or a number: OpticStudio's model glass */
+    v = 0;
     if (strchr(g, '/')) v = strtod(strchr(g, '/') + 1, NULL);
     if (strchr(g, '/')) n = strtod(g, NULL);               /* its own nd, exactly */
     ln_format(n, a, sizeof a);
@@ -589,7 +626,12 @@ char *ln_write_zmx(const ln_lens *l)
     const char *unit = "MM";
     for (size_t i = 0; i < sizeof zu / sizeof *zu; i += 2)
         if (!strcmp(l->unit, zu[i])) unit = zu[i + 1];
-    ln_buf_printf(&b, "MODE SEQ\r\nNAME %s\r\nUNIT %s X W X CM MR CPMM\r\n", l->title, unit);
+    {   /* the reader takes one pair of quotes off a title: a quoted title keeps its own */
+        size_t n = strlen(l->title);
+        int q = n >= 2 && l->title[0] == '"' && l->title[n - 1] == '"';
+        ln_buf_printf(&b, "MODE SEQ\r\nNAME %s%s%s\r\nUNIT %s X W X CM MR CPMM\r\n",
+                      q ? "\"" : "", l->title, q ? "\"" : "", unit);
+    }
     if (l->ap_kind != LN_AP_NONE) {
         ln_format(l->ap_value, a, sizeof a);
         if (l->ap_kind == LN_AP_EPD) ln_buf_printf(&b, "ENPD %s\r\n", a);
