@@ -131,3 +131,23 @@ if python3 -c 'import pty' 2>/dev/null; then
     check "--pupil on a tty: bad answers explained and asked again" \
         python3 "$TOP/tests/tty_pupil.py" "$BIN" "$TOP" "$WORK/pu_tty"
 fi
+
+# SIGINT while many rays are aimed (16 fields x 8 wavelengths x 3169 spot rays and
+# two 101-ray fans, several seconds): exit 130 within a second, no further output.
+pupil_sigint() {
+    d=$WORK/pu_sig; rm -rf "$d"; mkdir -p "$d"
+    sed 's/^field angle 0 14 20/field angle 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15/;
+         s/^wavelengths d F C/wavelengths d F C e g 500 600 700/' "$TOP/doc/pupil-triplet.rx" > "$d/big.rx"
+    printf 'big.rx\nhex\n32\ny\n101\n' > "$d/in"
+    (cd "$d" && exec "$BIN" --pupil -i in r.rec > out 2> err) &
+    pid=$!
+    sleep 0.5
+    kill -INT "$pid"
+    t0=$(date +%s%N)
+    wait "$pid"; rc=$?
+    t1=$(date +%s%N)
+    [ "$rc" -eq 130 ] || { echo "exit $rc"; return 1; }
+    [ $(( (t1 - t0) / 1000000 )) -lt 1000 ] || { echo "took $(( (t1 - t0) / 1000000 )) ms"; return 1; }
+    ! grep -q 'Output was written' "$d/out"
+}
+check "--pupil: SIGINT while aiming exits 130 at once" pupil_sigint
