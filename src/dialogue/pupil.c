@@ -372,7 +372,62 @@ static void fan_cell(char *buf, size_t cap, const trace_aim_ray *r, double v)
                   r->surface + 1);
 }
 
-static int one_field(pdlg *d, const wl_ctx *w, int fi)
+/* The wave aberration of an aimed ray (Welford's W): the chief ray's optical path to
+ * the reference sphere minus the ray's, positive where the wavefront leads the
+ * sphere.  The sphere is centred on the chief ray's image point and passes through
+ * the chief ray's crossing of the paraxial exit pupil's plane; paths count from the
+ * object point, or (object at infinity) from the incoming plane wavefront through
+ * the origin (rx_aim's paths start on the plane z = 0: the ray's o . d added). */
+typedef struct wavefront {
+    int ok, inf;
+    double c[3], R, sign, n0, ni, w0, lambda;   /* lambda: in the lens's unit */
+} wavefront;
+
+static double ray_path(const wavefront *wf, const trace_aim_ray *r)
+{
+    double o = r->opl, pc[3], b, cc, disc;
+    if (wf->inf) o += wf->n0 * (r->o[0] * r->d[0] + r->o[1] * r->d[1] + r->o[2] * r->d[2]);
+    for (int k = 0; k < 3; k++) pc[k] = r->img[k] - wf->c[k];
+    b = r->img_dir[0] * pc[0] + r->img_dir[1] * pc[1] + r->img_dir[2] * pc[2];
+    cc = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2] - wf->R * wf->R;
+    disc = b * b - cc;
+    if (disc < 0) return NAN;
+    return o - wf->ni * (b + wf->sign * sqrt(disc));
+}
+
+/* W of ray r in waves (NaN: no sphere, or the ray misses it). */
+static double wave(const wavefront *wf, const trace_aim_ray *r)
+{
+    if (!wf->ok || r->status != TRACE_AIM_OK) return NAN;
+    return (wf->w0 - ray_path(wf, r)) / wf->lambda;
+}
+
+static double unit_mm(const char *u)
+{
+    return !strcmp(u, "cm") ? 10 : !strcmp(u, "m") ? 1000 : !strcmp(u, "in") ? 25.4 : 1;
+}
+
+static void wavefront_init(const pdlg *d, const wl_ctx *w, const trace_aim_ray *chief,
+                           double lambda_um, wavefront *wf)
+{
+    const px_pupil *p = &w->p;
+    memset(wf, 0, sizeof *wf);
+    if (!isfinite(p->z_xp) || !(chief->img_dir[2] > 0)) return;
+    double t = (p->z_xp - chief->img[2]) / chief->img_dir[2];
+    if (!(fabs(t) > 0)) return;
+    wf->inf = isinf(d->lens.object);
+    memcpy(wf->c, chief->img, sizeof wf->c);
+    wf->R = fabs(t);
+    wf->sign = t < 0 ? 1 : -1;
+    wf->n0 = w->rx.n_object;
+    wf->ni = w->surf[w->rx.nsurf - 1].n_right;
+    wf->lambda = lambda_um * 1e-3 / unit_mm(d->c.uname);
+    wf->ok = 1;
+    wf->w0 = ray_path(wf, chief);
+    if (!isfinite(wf->w0)) wf->ok = 0;
+}
+
+static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
 {
     const ln_lens *l = &d->lens;
     const ln_field *f = &l->field[fi];
@@ -415,7 +470,11 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi)
         }
     }
     calc_say(&d->c, P(CHIEF), hp, hi, hr, dist, chief.residual, chief.iterations);
-    /* the spot */
+    /* the spot and the wavefront */
+    wavefront wf;
+    int nw = 0;
+    double ws = 0, ws2 = 0, wmin = INFINITY, wmax = -INFINITY;
+    wavefront_init(d, w, &chief, lambda, &wf);
     double *xs = malloc(sizeof(double) * 2 * (size_t)d->nsamp);
     if (!xs) return LM_FAIL;
     for (int i = 0; i < d->nsamp; i++) {
@@ -424,6 +483,14 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi)
         if (r.status != TRACE_AIM_OK) { nvig++; continue; }
         xs[2 * nok] = r.img[0];
         xs[2 * nok + 1] = r.img[1];
+        double wv = wave(&wf, &r);
+        if (isfinite(wv)) {
+            nw++;
+            ws += wv;
+            ws2 += wv * wv;
+            wmin = fmin(wmin, wv);
+            wmax = fmax(wmax, wv);
+        }
         sx += r.img[0];
         sy += r.img[1];
         nok++;
@@ -442,17 +509,27 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi)
         calc_say(&d->c, P(SPOT_NONE), nvig);
     }
     free(xs);
+    if (nw) {
+        double m = ws / nw, var = ws2 / nw - m * m;
+        calc_say(&d->c, P(WAVE), CL(wf.R), CL(p->r_xp * w->s), CL(sqrt(var > 0 ? var : 0)),
+                 CL(wmax - wmin));
+    } else {
+        calc_say(&d->c, "%s", P(WAVE_NONE));
+    }
     if (d->fans) {
         calc_say(&d->c, "%s", P(FAN_HEAD));
         for (int i = 0; i < d->fan_rays; i++) {
             double q = -1 + 2.0 * i / (d->fan_rays - 1);
             trace_aim_ray rt, rs;
-            char a[32], b[32];
+            char a[32], b[32], c[32];
             if (lm_stop_requested()) return LM_FAIL;
             if (aim(d, w, f, 0, q, &rt, &t) || aim(d, w, f, q, 0, &rs, &t)) return LM_FAIL;
             fan_cell(a, sizeof a, &rt, rt.img[1] - chief.img[1]);
             fan_cell(b, sizeof b, &rs, rs.img[0] - chief.img[0]);
-            calc_say(&d->c, P(FAN_ROW), q, a, b);
+            double wt = wave(&wf, &rt);
+            if (isfinite(wt)) snprintf(c, sizeof c, "%.6g", CL(wt));
+            else snprintf(c, sizeof c, "-");
+            calc_say(&d->c, P(FAN_ROW), q, a, c, b);
         }
     }
     calc_say(&d->c, P(AIM_STATS), t.maxit, t.maxres, d->c.uname);
@@ -544,7 +621,7 @@ static int compute(pdlg *d)
         w->s = prim.r_stop / w->p.r_stop;
         calc_say(&d->c, P(WL_HEAD), lambda * 1000);
         report_pupil(d, w, fbig);
-        for (int f = 0; f < l->nfield && rc == LM_GO; f++) rc = one_field(d, w, f);
+        for (int f = 0; f < l->nfield && rc == LM_GO; f++) rc = one_field(d, w, f, lambda);
     }
     free(w);
     return rc;
