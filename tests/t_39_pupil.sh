@@ -180,7 +180,7 @@ check "--pupil: wave aberration W agrees with the ray fan (ey = -R/(n' r_xp) dW/
 # Off axis the paths start on the incoming plane wavefront, not on the plane z = 0:
 # counted from z = 0 the 14- and 20-degree fields would show a tilt of n y sin(field),
 # thousands of waves over the 10 mm pupil; the example's RMS W stays under 1 wave in
-# all 9 fields and wavelengths, and its on-axis W is symmetric in the fan.
+# all 9 fields and wavelengths.
 check "--pupil: wavefront: RMS W under 1 wave for every field (no tilt from the start plane)" sh -c "
     cd '$WORK/pu' && [ \$(grep -c 'RMS .* waves' p.rec) -eq 9 ] &&
     awk '/RMS .* waves/ { if (\$2 + 0 >= 1 || \$2 + 0 <= 0) bad = 1 } END { exit bad }' p.rec"
