@@ -9,7 +9,7 @@ unit "$TOP/build/asan/trace_tests/t_aim"
 # --pupil: the embedded example (doc/pupil-triplet.rx: the Zemax tutorial's Cooke
 # triplet, EPD 10, fields 0 14 20 degrees, d F C), run in a folder that links doc/.
 pupil_dir() { mkdir -p "$WORK/pu" && ln -sfn "$TOP/doc" "$WORK/pu/doc"; }
-pupil_example() {
+pupil_example() (   # a subshell: its cd stays inside
     pupil_dir && cd "$WORK/pu" && "$1" --pupil --example p.rec > p.out || return 1
     # first-order data at d: efl, pupils, the stop's size (y-nu trace, pupil.c)
     grep -q '^  efl 50.0213, f-number 5.002, working f-number 5.002' p.rec || return 1
@@ -20,7 +20,7 @@ pupil_example() {
     grep -q 'spot: 98 rays, 14 vignetted' p.rec || return 1
     # replay: the grep'd record gives the same record
     grep input: p.rec > p.in && "$1" --pupil p2.rec < p.in > /dev/null && cmp p.rec p2.rec
-}
+)
 check "--pupil: example (triplet): efl, pupils, f-number, vignetting; replays exactly" pupil_example "$BIN"
 check "--pupil: the same under ASan/UBSan" pupil_example "$ASAN"
 
@@ -47,13 +47,13 @@ check "--pupil: on-axis spot: RMS about the chief ray = about the centroid" sh -
 # stop's image by the lens: the stop lies 20 before H1 (the convex vertex, z = 20),
 # so 1/s' = 1/100 - 1/20, s' = -25 from H2, which lies t (n-1)/n = 5/3 right of H1:
 # z = 20 + 5/3 - 25 = -3.33333, diameter 10 * 25/20 = 12.5.
-pupil_pc() {
+pupil_pc() (   # a subshell: its cd stays inside
     pupil_dir && cd "$WORK/pu" && printf '%s\n' thickness 'epd 10' 'field angle 0 5' \
         'plane 20 air stop' '50 5 1.5' 'plane 0 air' > pc.rx &&
     printf 'pc.rx\ngrid\n4\nn\n' > pc.in && "$1" --pupil -i pc.in pc.rec > /dev/null &&
     grep -q '^  efl 100, f-number 10, ' pc.rec &&
     grep -q '^  entrance pupil z= 0, diameter 10; exit pupil z= -3.33333, diameter 12.5; stop semi-diameter 5 ' pc.rec
-}
+)
 check "--pupil: plano-convex behind a stop: f/10, EP = stop, XP at its image" pupil_pc "$BIN"
 
 # A file without stop, aperture or fields (the classic positions format of
