@@ -42,6 +42,12 @@ const lm_dialogue lm_dialogues[] = {
      lm_to_prescription, lm_to_prescription_example, NULL, 0},
     {"--colour", "per wavelength: glasses by name, focal lengths, colour, Abbe numbers",
      lm_colour, lm_colour_example, NULL, 0},
+    {"--to-zmx", "write any lens file (-i FILE: .zmx, prescription, record) as OpticStudio .zmx",
+     lm_to_zmx, lm_to_zmx_example, NULL, 0},
+    {"--to-thickness", "write any lens file (-i FILE) as a prescription by thickness",
+     lm_to_thickness, lm_to_thickness_example, NULL, 0},
+    {"--pupil", "a lens file's pupils, chief rays, spots and fans of rays aimed at the stop",
+     lm_pupil, lm_pupil_example, "trace", 0},
 };
 const size_t lm_ndialogues = sizeof lm_dialogues / sizeof lm_dialogues[0];
 
