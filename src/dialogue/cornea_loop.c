@@ -28,6 +28,13 @@ static double now(void)
     return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
+static double cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
 /* ---- the scan pattern ------------------------------------------------------------ */
 
 static int by_radius(const void *a, const void *b)
@@ -377,7 +384,7 @@ static int stopped(const cl_run *r) { return r->stop && r->stop(r->stop_ctx); }
 int cl_measure(cl_run *r, char *err, size_t cap)
 {
     const rig_api *rg = r->rg;
-    double t0 = now(), t;
+    double t0 = now(), c0 = cpu_now(), t;
     char e[RG_ERRMAX];
     rg_target *tg;
     memset(&r->tm, 0, sizeof r->tm);
@@ -508,6 +515,7 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     }
     pthread_mutex_destroy(&j.mu);
     r->tm.total = now() - t0;
+    r->tm.cpu = cpu_now() - c0;
     return 0;
 stop:
     pthread_mutex_destroy(&j.mu);

@@ -42,6 +42,7 @@ typedef struct cl_point {
 
 typedef struct cl_times {       /* seconds of wall clock, per part */
     double plan, machine, trace, frames, fit, check, total;
+    double cpu;                 /* the process's CPU seconds over the whole loop */
 } cl_times;
 
 typedef struct cl_run {

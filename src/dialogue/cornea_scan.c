@@ -405,7 +405,7 @@ static int run(cs *s, cl_run *r, rg_machine **m)
         say(s, "%s", CS(CHECK_NONE));
     /* times vary from run to run: stdout only, never in the record or the report */
     lm_say(c->io, LM_OUT, CS(TIMES), r->threads, r->tm.plan, r->tm.machine, r->tm.frames,
-           r->tm.fit, r->tm.check, r->tm.total);
+           r->tm.fit, r->tm.check, r->tm.total, r->tm.cpu);
     return LM_GO;
 }
 
