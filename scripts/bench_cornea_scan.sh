@@ -60,11 +60,12 @@ echo "# 1 thread: measurement $6 s (frames $3 s); record and report identical to
 echo "BENCH cornea_scan1000_1thread_s $6 s"
 echo "BENCH cornea_scan_threads_identical $same bool"
 # ---- error against run time ----
-if [ -n "$BENCH_QUICK" ]; then seeds="1 2"; big="1"; else seeds="1 2 3 4 5"; big="1 2"; fi
+if [ -n "$BENCH_QUICK" ]; then seeds="1 2"; mid="1 2"; big="1"
+else seeds="1 2 3 4 5 6 7 8 9 10"; mid="1 2 3 4 5"; big="1 2"; fi
 T=build/bench/cornea_scan.tsv
 echo "# points	time_s	R_err_um	Km_err_D	R_sd_um	Km_sd_D	fitted	seeds" > "$T"
 for n in 10 30 100 300 1000 3000 10000; do
-    ss=$seeds; [ "$n" -ge 10000 ] && ss=$big
+    ss=$seeds; [ "$n" -ge 1000 ] && ss=$mid; [ "$n" -ge 10000 ] && ss=$big
     : > "$O/row"
     for s in $ss; do
         scan e$n.$s $n frames $((100 + s)) || continue

@@ -1,9 +1,10 @@
 /* scan_plot.c -- the cornea scan's error against run time (scripts/bench_cornea_scan.sh)
  * plotted through the imaging engine's plot call: reads the bench's table (TSV: points,
- * seconds, RMS radius error um, RMS mean-K error D, ...; '#' lines skipped) and draws
- * log-log lines with markers, radius error in um and mean-K error in millidiopters
- * against the measurement's time, as PNG and SVG (NAME.svg beside it).  Prints where
- * each marker was drawn ("PLOT marker SERIES POINTS X Y").
+ * seconds, RMS radius error um, RMS mean-K error D, the fit's sd of each; '#' lines
+ * skipped) and draws log-log lines with markers, radius error in um and mean-K error in
+ * millidiopters against the measurement's time, with the fit's own sd as lines, as
+ * PNG and SVG (NAME.svg beside it).  Prints where each marker was drawn ("PLOT marker
+ * SERIES POINTS X Y").
  * Usage: scan_plot TABLE.tsv OUT.png "NOTE" */
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,13 +21,15 @@ int main(int argc, char **argv)
     }
     FILE *f = fopen(argv[1], "r");
     if (!f) { perror(argv[1]); return 1; }
-    double pts[MAXROW], t[MAXROW], r[MAXROW], k[MAXROW];
+    double pts[MAXROW], t[MAXROW], r[MAXROW], k[MAXROW], rs[MAXROW], ks[MAXROW];
     int n = 0;
     char line[512];
     while (n < MAXROW && fgets(line, sizeof line, f)) {
         if (line[0] == '#' || line[0] == '\n') continue;
-        if (sscanf(line, "%lf %lf %lf %lf", &pts[n], &t[n], &r[n], &k[n]) == 4) {
+        if (sscanf(line, "%lf %lf %lf %lf %lf %lf", &pts[n], &t[n], &r[n], &k[n], &rs[n],
+                   &ks[n]) == 6) {
             k[n] *= 1e3;
+            ks[n] *= 1e3;
             n++;
         }
     }
@@ -39,13 +42,15 @@ int main(int argc, char **argv)
     if (!svg) return 1;
     memcpy(svg, argv[2], len - 4);
     strcpy(svg + len - 4, ".svg");
-    im_series ser[2] = {
+    im_series ser[4] = {
         {"RMS apex radius error (um)", n, t, r, IM_LINES | IM_MARKERS},
         {"RMS mean K error (mD)", n, t, k, IM_LINES | IM_MARKERS},
+        {"the fit's own sd of R (um)", n, t, rs, IM_LINES},
+        {"the fit's own sd of mean K (mD)", n, t, ks, IM_LINES},
     };
     im_plot P = {"Cornea scan: error against run time (10 to 10 000 points)",
                  "time of the measurement (s): plan, trace, frames, centroids, fit, check",
-                 "RMS error", 1, 1, 0, 2, ser, argc > 3 ? argv[3] : NULL};
+                 "RMS error", 1, 1, 0, 4, ser, argc > 3 ? argv[3] : NULL};
     im_out out = {argv[2], svg, 900, 520, NULL, NULL};
     im_plot_info info;
     if (im->draw->plot(&P, &out, &info, err, sizeof err)) {
