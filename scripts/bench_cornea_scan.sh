@@ -17,7 +17,7 @@ mkdir -p "$O"
 cpu=$(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //')
 echo "# bench_cornea_scan on: $cpu, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
 answers() {     # answers N SOURCE SEED REPORT
-    if [ "$2" = frames ]; then src='frames\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480'
+    if [ "$2" = frames ]; then src='frames\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-'
     else src='model\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n14'; fi
     printf "biconic\n-\nspiral\n%s\n12\n$src\n%s\n%s\n" "$1" "$3" "$4"
 }

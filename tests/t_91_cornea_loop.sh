@@ -7,10 +7,9 @@
 CL=$WORK/cnloop
 mkdir -p "$CL"
 RIGGOLD=$TOP/golden/rig/example.rig
-# cl_answers PATTERN N ZONE SOURCE-ANSWERS... : the answers after the rig questions
-cl_frames() {   # cl_frames FILE N PITCH WIDTH HEIGHT REPORT [PATTERN]
-    printf 'biconic\n-\n%s\n%s\n12\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n%s\n%s\n%s\n1\n%s\n' \
-        "${7:-spiral}" "$2" "$3" "$4" "$5" "$6" > "$1"
+cl_frames() {   # cl_frames FILE N PITCH WIDTH HEIGHT REPORT [PATTERN [SAVE]]
+    printf 'biconic\n-\n%s\n%s\n12\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n%s\n%s\n%s\n%s\n1\n%s\n' \
+        "${7:-spiral}" "$2" "$3" "$4" "$5" "${8:--}" "$6" > "$1"
 }
 cl_run() {      # cl_run BIN IN REC [env...]: in $CL, stdout to REC.out
     bin=$1; in=$2; rec=$3; shift 3
@@ -99,7 +98,7 @@ cl_maps() {
 check "cornea loop: the model source maps no OpenCV, frames do" cl_maps
 # 7. on the simulated chip: move, expose, frame per point; the log ends laser off
 cl_sim() {
-    printf 'biconic\n%s\nsim\nsim.log\n2\nspiral\n30\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n1\nsrep.txt\n' \
+    printf 'biconic\n%s\nsim\nsim.log\n2\nspiral\n30\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-\n1\nsrep.txt\n' \
         "$RIGGOLD" > "$CL/s.in"
     cl_run "$BIN" s.in s.rec || { cat "$CL/s.rec.err"; return 1; }
     grep -q '^Pattern spiral: 30 targets to 4 deg, 30 planned, 30 exposed' "$CL/s.rec" &&
@@ -111,7 +110,7 @@ check "cornea loop: a 30-point scan on the simulated chip (30 exposures, laser o
 # 8. SIGTERM mid-scan on the simulated chip: exit 143, the laser off, drivers disabled,
 # no report (nor its .part) and the simulator's log complete
 cl_term() {
-    printf 'biconic\n%s\nsim\nk.log\n2\nspiral\n10000\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n1\nkrep.txt\n' \
+    printf 'biconic\n%s\nsim\nk.log\n2\nspiral\n10000\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-\n1\nkrep.txt\n' \
         "$RIGGOLD" > "$CL/k.in"
     (cd "$CL" && exec "$BIN" --cornea-scan -i k.in k.rec > k.out 2> k.err) &
     p=$!
@@ -134,3 +133,26 @@ cl_asan() {
         cmp "$CL/z1.rec" "$CL/z2.rec"
 }
 check "cornea loop: ASan build, frames and fit, the same record" cl_asan
+# 10. frames saved by a synthetic scan, then measured as a camera's (numbered files):
+# the same spots found (the noise now measured from each frame), the same cornea to
+# well within its uncertainty; no eye questions, no errors against a truth
+cl_camera() {
+    rm -f "$CL"/fr*.png
+    cl_frames "$CL/sv.in" 30 14 640 480 - spiral 'fr%04d.png'
+    cl_run "$BIN" sv.in sv.rec || { cat "$CL/sv.rec.err"; return 1; }
+    [ "$(ls "$CL"/fr*.png | wc -l)" -eq 30 ] && grep -q '^Frames saved as fr%04d.png (numbered 1 to 30)' "$CL/sv.rec" || return 1
+    printf 'biconic\n-\nspiral\n30\n12\ncamera\nfr%%04d.png\n14\ncrep2.txt\n' > "$CL/cam.in"
+    cl_run "$BIN" cam.in cam.rec || { cat "$CL/cam.rec.err"; return 1; }
+    grep -q '^Camera: frames from fr%04d.png' "$CL/cam.rec" && grep -q '^Spots: 30 fitted' "$CL/cam.rec" &&
+        ! grep -q -e '^Errors' -e 'simulated eye' "$CL/cam.rec" && grep -q '^Tracer check: .*agrees' "$CL/cam.rec" &&
+        awk 'FNR == 1 { f++ } /^apex radius R/ { r[f] = $4; s[f] = $6 }
+             END { d = r[1] - r[2]; exit !(d < 0.2 * s[1] && d > -0.2 * s[1]) }' "$CL/sv.rec" "$CL/cam.rec"
+}
+check "cornea loop: saved frames measured again as a camera's: the same cornea" cl_camera
+# a frame missing: the camera gave fewer frames than exposures, exit 2, no report
+cl_camera_short() {
+    rm -f "$CL/fr0030.png" "$CL/crep2.txt"
+    ! cl_run "$BIN" cam.in cam2.rec && grep -q 'fr%04d.png gave 29 frames for 30 exposures' "$CL/cam2.rec" &&
+        [ ! -e "$CL/crep2.txt" ] && ! grep -q '^Spots: ' "$CL/cam2.rec" && grep -q 'gave 29 frames' "$CL/cam2.rec.err"
+}
+check "cornea loop: a camera with fewer frames than exposures is an error" cl_camera_short

@@ -185,19 +185,64 @@ static int traced_hit(const cl_run *r, const rg_geometry *gt, const cn_plane *pl
     return 0;
 }
 
-/* One frame: the traced hit splatted as the camera's Gaussian spot into a full
- * sensor frame, located by the imaging engine's Gaussian fit. */
-static void frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, int k,
-                       const double hit[3], cl_point *q)
+/* The spot of one frame (synthetic or read), located by the imaging engine's
+ * Gaussian fit; read_noise 0: measured from the frame.  off_sensor: the traced hit
+ * lies outside the sensor (the reason given when no spot is found). */
+static void locate(const cl_run *r, im_centroider *cz, const im_frame *f, double read_noise,
+                   int off_sensor, cl_point *q)
+{
+    const im_frame_api *F = r->im->frame;
+    const double pitch = r->cam.pitch;
+    im_centroid_opt o;
+    im_centroid_result res;
+    im_spot sp[4];
+    char e[256];
+    memset(&o, 0, sizeof o);
+    o.method = IM_CM_GAUSS;
+    o.read_noise = read_noise;
+    q->spot.u = q->spot.v = NAN;
+    int rc = F->centroid(cz, f, &o, sp, 4, &res, e, sizeof e);
+    q->nspots = rc ? 0 : res.ndetected;
+    q->snr = rc ? 0 : res.best_snr;
+    if (rc || res.outcome == IM_FOUND_NONE) {
+        q->spot.status = CN_S_NONE;
+        if (rc) snprintf(q->why, sizeof q->why, "no centroid: %.70s", e);
+        else if (off_sensor) snprintf(q->why, sizeof q->why, "no spot: it lands off the sensor");
+        else snprintf(q->why, sizeof q->why, "no spot (best candidate SNR %.3g)", res.best_snr);
+        return;
+    }
+    q->x = sp[0].x;
+    q->y = sp[0].y;
+    q->snr = sp[0].snr;
+    if (res.outcome == IM_FOUND_SEVERAL) {
+        q->spot.status = CN_S_SEVERAL;
+        snprintf(q->why, sizeof q->why, "several spots in the frame (%d)", res.ndetected);
+        return;
+    }
+    if (sp[0].flags & (IM_SF_EDGE | IM_SF_FIT_FAILED | IM_SF_SATURATED)) {
+        q->spot.status = CN_S_NONE;
+        snprintf(q->why, sizeof q->why, "the spot at pixel (%.1f, %.1f) is %s", sp[0].x,
+                 sp[0].y, sp[0].flags & IM_SF_EDGE ? "cut by the sensor's edge"
+                          : sp[0].flags & IM_SF_SATURATED ? "saturated" : "not fitted");
+        return;
+    }
+    q->spot.u = (sp[0].x - 0.5 * (f->width - 1)) * pitch;
+    q->spot.v = (sp[0].y - 0.5 * (f->height - 1)) * pitch;
+    q->spot.sigma = pitch * sqrt(0.5 * (sp[0].sx * sp[0].sx + sp[0].sy * sp[0].sy));
+    q->spot.status = CN_S_OK;
+}
+
+/* One synthetic frame: the traced hit (NULL: none, the frame shows no spot) splatted
+ * as the camera's Gaussian spot into a full sensor frame at the detector point, saved
+ * when asked, then located.  Returns 0, or -1 when a frame could not be saved (why). */
+static int frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, int k,
+                      const double *hit, cl_point *q)
 {
     const im_frame_api *F = r->im->frame;
     const cl_camera *c = &r->cam;
     im_sensor s;
     im_spot_src src;
     im_hit h;
-    im_centroid_opt o;
-    im_centroid_result res;
-    im_spot sp[4];
     im_frame *f = NULL;
     char e[256];
     memset(&s, 0, sizeof s);
@@ -218,7 +263,7 @@ static void frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, i
        radius w pixels: peak * pi w^2 / 2 */
     double electrons = c->peak * s.gain * PI * c->spot_w * c->spot_w / 2;
     memset(&h, 0, sizeof h);
-    memcpy(h.p, hit, sizeof h.p);
+    if (hit) memcpy(h.p, hit, sizeof h.p);
     h.power = electrons / s.exposure * PLANCK_HC / LAMBDA_M;
     memset(&src, 0, sizeof src);
     src.kind = IM_SPOT_HITS_GAUSS;
@@ -226,47 +271,29 @@ static void frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, i
     src.nhits = 1;
     src.waist = c->spot_w * c->pitch;   /* path 0: the waist is the spot */
     src.beam_lambda = LAMBDA_M * 1e3;
-    q->spot.u = q->spot.v = NAN;
-    if (F->synth(&s, &src, 1, r->seed + (uint64_t)k, 1, &f, e, sizeof e)) {
-        q->spot.status = CN_S_NONE;
-        snprintf(q->why, sizeof q->why, "no frame: %.70s", e);
-        return;
+    if (F->synth(&s, &src, hit ? 1 : 0, r->seed + (uint64_t)k, 1, &f, e, sizeof e)) {
+        if (hit) {
+            q->spot.status = CN_S_NONE;
+            q->spot.u = q->spot.v = NAN;
+            snprintf(q->why, sizeof q->why, "no frame: %.70s", e);
+        }
+        return 0;
     }
-    memset(&o, 0, sizeof o);
-    o.method = IM_CM_GAUSS;
-    o.read_noise = c->read_noise / s.gain;
-    int rc = F->centroid(cz, f, &o, sp, 4, &res, e, sizeof e);
+    if (r->save && q->seq > 0) {
+        char name[4200], we[256];
+        snprintf(name, sizeof name, r->save, q->seq);
+        if (F->write(f, name, we, sizeof we)) {
+            snprintf(q->why, sizeof q->why, "frame not saved: %.70s", we);
+            F->frame_free(f);
+            return -1;
+        }
+    }
+    if (hit)
+        locate(r, cz, f, c->read_noise / s.gain,
+               fabs(q->hit_u) > 0.5 * c->width * c->pitch ||
+               fabs(q->hit_v) > 0.5 * c->height * c->pitch, q);
     F->frame_free(f);
-    q->nspots = rc ? 0 : res.ndetected;
-    q->snr = rc ? 0 : res.best_snr;
-    if (rc || res.outcome == IM_FOUND_NONE) {
-        q->spot.status = CN_S_NONE;
-        if (rc) snprintf(q->why, sizeof q->why, "no centroid: %.70s", e);
-        else if (fabs(q->hit_u) > 0.5 * c->width * c->pitch ||
-                 fabs(q->hit_v) > 0.5 * c->height * c->pitch)
-            snprintf(q->why, sizeof q->why, "no spot: it lands off the sensor");
-        else snprintf(q->why, sizeof q->why, "no spot (best candidate SNR %.3g)", res.best_snr);
-        return;
-    }
-    q->x = sp[0].x;
-    q->y = sp[0].y;
-    q->snr = sp[0].snr;
-    if (res.outcome == IM_FOUND_SEVERAL) {
-        q->spot.status = CN_S_SEVERAL;
-        snprintf(q->why, sizeof q->why, "several spots in the frame (%d)", res.ndetected);
-        return;
-    }
-    if (sp[0].flags & (IM_SF_EDGE | IM_SF_FIT_FAILED | IM_SF_SATURATED)) {
-        q->spot.status = CN_S_NONE;
-        snprintf(q->why, sizeof q->why, "the spot at pixel (%.1f, %.1f) is %s", sp[0].x,
-                 sp[0].y, sp[0].flags & IM_SF_EDGE ? "cut by the sensor's edge"
-                          : sp[0].flags & IM_SF_SATURATED ? "saturated" : "not fitted");
-        return;
-    }
-    q->spot.u = (sp[0].x - 0.5 * (c->width - 1)) * c->pitch;
-    q->spot.v = (sp[0].y - 0.5 * (c->height - 1)) * c->pitch;
-    q->spot.sigma = c->pitch * sqrt(0.5 * (sp[0].sx * sp[0].sx + sp[0].sy * sp[0].sy));
-    q->spot.status = CN_S_OK;
+    return 0;
 }
 
 /* ---- workers ----------------------------------------------------------------------- */
@@ -279,8 +306,17 @@ typedef struct job {
     int stopped;
     cn_plane pl, plf;
     rg_geometry gt, gf;         /* true eye; fitted eye */
-    int err;                    /* a worker could not start its centroider */
+    int err;                    /* a worker could not start its centroider (1) or
+                                   save a frame (2) */
 } job;
+
+static void fail_job(job *j)
+{
+    pthread_mutex_lock(&j->mu);
+    if (!j->err) j->err = 2;
+    j->stopped = 1;
+    pthread_mutex_unlock(&j->mu);
+}
 
 static int take(job *j)
 {
@@ -303,14 +339,21 @@ static void measure_one(job *j, im_centroider *cz, int k)
         snprintf(q->why, sizeof q->why, "no beam: %.80s", e);
         return;
     }
+    if (r->source == CL_SRC_CAMERA) return;       /* located as each frame was read */
     q->spot.sigma = r->sigma > 0 ? r->sigma : 1e-4;
     if (traced_hit(r, &j->gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
                    sizeof q->why)) {
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
+        /* the camera still takes the frame: it shows no spot */
+        if (r->source == CL_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
+            fail_job(j);
         return;
     }
-    if (r->source == CL_SRC_FRAMES) { frame_spot(r, cz, &j->pl, k, hit, q); return; }
+    if (r->source == CL_SRC_FRAMES) {
+        if (frame_spot(r, cz, &j->pl, k, hit, q)) fail_job(j);
+        return;
+    }
     uint64_t s = r->seed * 0x9E3779B97F4A7C15ull ^ (uint64_t)k * 0xD1B54A32D192ED03ull;
     double nu = gauss(&s), nv = gauss(&s);
     q->spot.u = q->hit_u + (r->sigma > 0 ? r->sigma * nu : 0);
@@ -340,7 +383,7 @@ static void *worker(void *arg)
     job *j = arg;
     cl_run *r = j->r;
     im_centroider *cz = NULL;
-    if (j->phase == 0 && r->source == CL_SRC_FRAMES) {
+    if (j->phase == 0 && r->source == CL_SRC_FRAMES && r->im) {
         cz = r->im->frame->centroider_new();
         if (!cz) {
             pthread_mutex_lock(&j->mu);
@@ -378,6 +421,26 @@ static int run_workers(job *j)
 }
 
 /* ---- the loop ----------------------------------------------------------------------- */
+
+/* The next frame of the camera (or video, or file sequence) for point q: its spot
+ * located, the noise measured from the frame.  0, or -1 with why in err. */
+static int camera_read(const cl_run *r, im_source *src, im_centroider *cz, cl_point *q,
+                       int got, char *err, size_t cap)
+{
+    const im_frame_api *F = r->im->frame;
+    im_frame *f = NULL;
+    char e[256];
+    int rc = F->source_next(src, &f, e, sizeof e);
+    if (rc <= 0) {
+        if (rc == 0) snprintf(err, cap, "%s gave %d frames for %d exposures", r->camera, got,
+                              r->nplanned);
+        else snprintf(err, cap, "%s", e);
+        return -1;
+    }
+    locate(r, cz, f, 0, 0, q);
+    F->frame_free(f);
+    return 0;
+}
 
 static int stopped(const cl_run *r) { return r->stop && r->stop(r->stop_ctx); }
 
@@ -423,6 +486,22 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     free(tg);
     t = now();
     r->tm.plan = t - t0;
+    /* a camera: its frames are read one per exposure, in scan order */
+    im_source *src = NULL;
+    im_centroider *ccz = NULL;
+    int got = 0;
+    if (r->source == CL_SRC_CAMERA) {
+        if (!r->im || !r->camera) { snprintf(err, cap, "no camera"); return CN_EINVAL; }
+        if (r->im->frame->source_open(r->camera, 1, 2000, &src, err, cap))
+            return CN_EINVAL;
+        if (!(ccz = r->im->frame->centroider_new())) {
+            r->im->frame->source_close(src);
+            snprintf(err, cap, "out of memory (centroider)");
+            return CN_ENOMEM;
+        }
+    }
+#define CAMERA_DONE() do { if (src) { r->im->frame->source_close(src); \
+        r->im->frame->centroider_free(ccz); src = NULL; } } while (0)
     /* run: move to each planned point and expose it on the machine */
     r->nexposed = 0;
     if (r->m) {
@@ -438,6 +517,7 @@ int cl_measure(cl_run *r, char *err, size_t cap)
             int rc = rg->move_steps(r->m, steps, r->stop, r->stop_ctx, e, sizeof e);
             if (!rc) rc = rg->expose(r->m, r->expose_ms, r->stop, r->stop_ctx, e, sizeof e);
             if (rc) {
+                CAMERA_DONE();
                 if (rc == RG_ESTOP || stopped(r)) { snprintf(err, cap, "stopped"); return CN_ESTOP; }
                 snprintf(err, cap, "point %d: %s", k + 1, e);
                 return CN_EINVAL;
@@ -447,8 +527,16 @@ int cl_measure(cl_run *r, char *err, size_t cap)
                     q->pose.j[jn] = steps[jn] / r->rig->axis[jn].steps_per *
                                     (jn == RG_J_U || jn == RG_J_V ? 1 : PI / 180);
             r->nexposed++;
+            if (src && camera_read(r, src, ccz, q, got++, err, cap)) { CAMERA_DONE(); return CN_EINVAL; }
         }
     }
+    for (int k = 0; src && !r->m && k < n; k++) {
+        if (!r->pt[k].planned) continue;
+        if (stopped(r)) { CAMERA_DONE(); snprintf(err, cap, "stopped"); return CN_ESTOP; }
+        if (camera_read(r, src, ccz, &r->pt[k], got++, err, cap)) { CAMERA_DONE(); return CN_EINVAL; }
+    }
+    CAMERA_DONE();
+    for (int k = 0, seq = 0; k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
     r->tm.machine = now() - t;
     /* detect: the traced spot of each exposure, its frame and centroid */
     job j;
@@ -461,7 +549,16 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     t = now();
     int st = run_workers(&j);
     r->tm.frames = now() - t;
-    if (j.err) { snprintf(err, cap, "out of memory (centroider)"); goto fail; }
+    if (j.err == 1) { snprintf(err, cap, "out of memory (centroider)"); goto fail; }
+    if (j.err == 2) {
+        for (int k = 0; k < n; k++)
+            if (!strncmp(r->pt[k].why, "frame not saved", 15)) {
+                snprintf(err, cap, "%s", r->pt[k].why);
+                break;
+            }
+        pthread_mutex_destroy(&j.mu);
+        return CN_EINVAL;
+    }
     if (st || stopped(r)) { snprintf(err, cap, "stopped"); goto stop; }
     /* fit */
     t = now();

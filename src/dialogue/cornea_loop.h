@@ -16,7 +16,9 @@ struct trace_api;
 struct imaging_api;
 
 enum { CL_SPIRAL, CL_RINGS, CL_GRID };          /* scan patterns */
-enum { CL_SRC_FRAMES, CL_SRC_MODEL };           /* where the spots come from */
+enum { CL_SRC_FRAMES, CL_SRC_MODEL, CL_SRC_CAMERA };   /* where the spots come from:
+                                   synthetic frames, the traced hit plus noise, or
+                                   frames read from a camera, video or files */
 
 /* The detector frames (the imaging benchmark's spot and noise by default). */
 typedef struct cl_camera {
@@ -37,6 +39,8 @@ typedef struct cl_point {
     double hit_u, hit_v;        /* the traced hit (mm, detector plane; NAN: none) */
     double x, y, snr;           /* frame: centroid (pixels) and SNR */
     int nspots;                 /* frame: spots detected */
+    int seq;                    /* frame number (1, 2, ...: the planned points in scan
+                                   order; 0: none) */
     char why[96];               /* why the point gave no spot */
 } cl_point;
 
@@ -60,6 +64,10 @@ typedef struct cl_run {
     int source;                 /* CL_SRC_* */
     double sigma;               /* model: centroid noise (mm) */
     cl_camera cam;
+    const char *camera;         /* CL_SRC_CAMERA: the source (imaging.h source_open) */
+    const char *save;           /* CL_SRC_FRAMES: write frame N to this %d pattern
+                                   (NULL: not saved) */
+    int have_truth;             /* 0: a real eye (camera): nothing to trace */
     uint64_t seed;
     int threads;                /* workers for the per-point work (>= 1) */
     /* machine (NULL: planned only) and its rig file (step sizes) */

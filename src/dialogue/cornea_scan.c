@@ -54,7 +54,7 @@ typedef struct cs {
     const rig_api *rg;
     rg_rig rig;
     int have_rig;
-    char rigname[WORD], log[WORD], report[WORD];
+    char rigname[WORD], log[WORD], report[WORD], camera[WORD], save[WORD];
     char *text;                 /* the report as said, for the report file */
     size_t len, cap;
 } cs;
@@ -149,15 +149,41 @@ static int check_report(void *ctx, const char *word, char *msg, size_t cap)
         snprintf(name, sizeof name, "%s%s", word, i ? ".part" : "");
         if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
         if (s->have_rig && same_file(name, s->rig.path)) {
-            snprintf(msg, cap, "'%s' is the rig file", name);
+            snprintf(msg, cap, CS(REPORT_IS_RIG), name);
             return -1;
         }
         if (s->log[0] && strcmp(s->log, "-") && !strcmp(word, s->log)) {
-            snprintf(msg, cap, "'%s' is the simulator's log", name);
+            snprintf(msg, cap, CS(REPORT_IS_LOG), name);
             return -1;
         }
     }
     return 0;
+}
+
+/* A pattern for saved frames: one %d (flags 0, width up to 2 digits), no other
+ * conversion, a picture extension the writer knows; the first name not an input. */
+static int check_save(void *ctx, const char *word, char *msg, size_t cap)
+{
+    cs *s = ctx;
+    int conv = 0;
+    const char *dot = strrchr(word, '.');
+    if (!strcmp(word, "-")) return 0;
+    for (const char *p = word; *p; p++) {
+        if (*p != '%') continue;
+        if (p[1] == '%') { p++; continue; }
+        p++;
+        if (*p == '0') p++;
+        for (int k = 0; k < 2 && *p >= '0' && *p <= '9'; k++) p++;
+        if (*p != 'd') { conv = -1; break; }
+        conv++;
+    }
+    if (conv != 1 || !dot || (strcmp(dot, ".png") && strcmp(dot, ".tif") && strcmp(dot, ".raw"))) {
+        snprintf(msg, cap, CS(SAVE_BAD), word);
+        return -1;
+    }
+    char name[WORD + 16];
+    snprintf(name, sizeof name, word, 1);
+    return lm_check_output(s->cc.io, name, msg, cap);
 }
 
 static int threads_wanted(void)
@@ -184,7 +210,7 @@ int lm_cornea_scan(lm_io *io)
     static const char *const models[] = {"sphere", "conic", "biconic", NULL};
     static const char *const chips[] = {"none", "sim", NULL};
     static const char *const patterns[] = {"spiral", "rings", "grid", NULL};
-    static const char *const sources[] = {"frames", "model", NULL};
+    static const char *const sources[] = {"frames", "model", "camera", NULL};
     cs *s = calloc(1, sizeof *s);
     cl_run *r = calloc(1, sizeof *r);
     rg_machine *m = NULL;
@@ -201,8 +227,8 @@ int lm_cornea_scan(lm_io *io)
     if (!rg || !cn) { rc = calc_fail(c, CS(NO_ENGINE)); goto out; }
     s->rg = rg;
     int model, chip = 0, pattern, source;
-    double np, zone, R, Q, cyl, axis, dx, dy, tx, ty, noise = 0, pitch, seed, w = 0, h = 0,
-           ms = 0;
+    double np, zone, R = 7.8, Q = 0, cyl = 0, axis = 0, dx = 0, dy = 0, tx = 0, ty = 0,
+           noise = 0, pitch, seed = 0, w = 0, h = 0, ms = 0;
     if ((rc = calc_choice(c, CS(MODEL), CS(MODEL_WHAT), models, &model)) ||
         (rc = lm_ask_word(io, CS(RIG_FILE), CS(RIG_FILE), CS(RIG_FILE_WHAT), check_rig, s,
                           s->rigname, sizeof s->rigname)))
@@ -212,22 +238,28 @@ int lm_cornea_scan(lm_io *io)
         if (chip == 1 &&
             ((rc = lm_ask_word(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
                                s->log, sizeof s->log)) ||
-             (rc = ranged(c, CS(EXPOSE), CS(EXPOSE_WHAT), "from 0.01 ms to the rig's max_on_ms",
+             (rc = ranged(c, CS(EXPOSE), CS(EXPOSE_WHAT), CS(EXPOSE_RANGE),
                           0.01, s->rig.max_on_ms, 0, &ms))))
             goto out;
     }
     if ((rc = calc_choice(c, CS(PATTERN), CS(PATTERN_WHAT), patterns, &pattern)) ||
         (rc = ranged(c, CS(POINTS), CS(POINTS_WHAT), CS(POINTS_RANGE), 10, 10000, 1, &np)) ||
         (rc = ranged(c, CS(ZONE), CS(ZONE_WHAT), CS(ZONE_RANGE), 0.5, 12, 0, &zone)) ||
-        (rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source)) ||
-        (rc = ranged(c, CS(R), CS(R_WHAT), CS(R_RANGE), 5, 12, 0, &R)) ||
+        (rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source)))
+        goto out;
+    if (source == CL_SRC_CAMERA &&
+        (rc = lm_ask_word(io, CS(CAMERA), CS(CAMERA), CS(CAMERA_WHAT), NULL, NULL, s->camera,
+                          sizeof s->camera)))
+        goto out;
+    if (source != CL_SRC_CAMERA &&      /* a real eye is what the camera sees */
+        ((rc = ranged(c, CS(R), CS(R_WHAT), CS(R_RANGE), 5, 12, 0, &R)) ||
         (rc = ranged(c, CS(Q), CS(Q_WHAT), CS(Q_RANGE), -1, 1, 0, &Q)) ||
         (rc = ranged(c, CS(CYL), CS(CYL_WHAT), CS(CYL_RANGE), 0, 8, 0, &cyl)) ||
         (rc = ranged(c, CS(AXIS), CS(AXIS_WHAT), CS(AXIS_RANGE), -360, 360, 0, &axis)) ||
         (rc = ranged(c, CS(DX), CS(DX_WHAT), CS(DEC_RANGE), -1, 1, 0, &dx)) ||
         (rc = ranged(c, CS(DY), CS(DY_WHAT), CS(DEC_RANGE), -1, 1, 0, &dy)) ||
         (rc = ranged(c, CS(TX), CS(TX_WHAT), CS(TILT_RANGE), -10, 10, 0, &tx)) ||
-        (rc = ranged(c, CS(TY), CS(TY_WHAT), CS(TILT_RANGE), -10, 10, 0, &ty)))
+        (rc = ranged(c, CS(TY), CS(TY_WHAT), CS(TILT_RANGE), -10, 10, 0, &ty))))
         goto out;
     if (source == CL_SRC_MODEL &&
         (rc = ranged(c, CS(NOISE), CS(NOISE_WHAT), CS(NOISE_RANGE), 0, 10, 0, &noise)))
@@ -236,9 +268,12 @@ int lm_cornea_scan(lm_io *io)
         goto out;
     if (source == CL_SRC_FRAMES &&
         ((rc = ranged(c, CS(WIDTH), CS(WIDTH_WHAT), CS(PX_RANGE), 16, 4096, 1, &w)) ||
-         (rc = ranged(c, CS(HEIGHT), CS(HEIGHT_WHAT), CS(PX_RANGE), 16, 4096, 1, &h))))
+         (rc = ranged(c, CS(HEIGHT), CS(HEIGHT_WHAT), CS(PX_RANGE), 16, 4096, 1, &h)) ||
+         (rc = lm_ask_word(io, CS(SAVE), CS(SAVE), CS(SAVE_WHAT), check_save, s, s->save,
+                           sizeof s->save))))
         goto out;
-    if ((rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)) ||
+    if ((source != CL_SRC_CAMERA &&
+         (rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed))) ||
         (rc = lm_ask_word(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), check_report, s,
                           s->report, sizeof s->report)))
         goto out;
@@ -262,6 +297,9 @@ int lm_cornea_scan(lm_io *io)
     r->cn = cn;
     r->g = &g;
     r->truth = eye;
+    r->have_truth = source != CL_SRC_CAMERA;
+    r->camera = source == CL_SRC_CAMERA ? s->camera : NULL;
+    r->save = source == CL_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
     r->pattern = pattern;
     r->npoints = (int)np;
     r->zone = zone * DEG;
@@ -276,7 +314,7 @@ int lm_cornea_scan(lm_io *io)
     r->check_tol = check_tol_um() * 1e-3;
     r->rig = &s->rig;
     if (!(r->pt = calloc((size_t)r->npoints, sizeof *r->pt))) {
-        rc = calc_fail(c, "out of memory\n");
+        rc = calc_fail(c, CS(NO_MEMORY));
         goto out;
     }
     if (s->have_rig) say(s, CS(RIG_LOADED), s->rig.path, g.cornea.R);
@@ -286,13 +324,16 @@ int lm_cornea_scan(lm_io *io)
         r->tr = tget ? tget(TRACE_ABI) : NULL;
         if (!r->tr) say(s, "%s", CS(NO_TRACER));
     }
-    if (source == CL_SRC_FRAMES) {
+    if (source != CL_SRC_MODEL) {
         imaging_get_api_fn iget =
             (imaging_get_api_fn)lm_engine_symbol("imaging", IMAGING_API_SYMBOL);
         r->im = iget ? iget(IMAGING_ABI) : NULL;
         if (!r->im || !r->im->frame) { rc = calc_fail(c, CS(NO_IMAGING)); goto out; }
-        say(s, CS(FRAMES_ON), r->cam.width, r->cam.height, pitch, r->cam.spot_w,
-            r->cam.peak, r->cam.bias, r->cam.read_noise);
+        if (source == CL_SRC_CAMERA)
+            say(s, CS(CAMERA_ON), s->camera, pitch);
+        else
+            say(s, CS(FRAMES_ON), r->cam.width, r->cam.height, pitch, r->cam.spot_w,
+                r->cam.peak, r->cam.bias, r->cam.read_noise);
     } else {
         say(s, CS(MODEL_ON), noise, r->sigma * 1e3);
     }
@@ -317,13 +358,16 @@ int lm_cornea_scan(lm_io *io)
         r->m = m;
     }
     rc = run(s, r, &m);
-    if (rc == LM_GO) {
+    if (rc == LM_GO && r->save) say(s, CS(SAVED), r->save, r->nplanned);
+    if (rc == LM_GO && r->have_truth) {
         cn_params t;
         cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
         say(s, CS(TRUTH), eye.R, eye.R2, km, cyl);
         say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km,
             model == CN_BICONIC ? remainder(r->res.k.K1_axis - fmod(axis + 360, 180), 180.0)
                                 : 0.0);
+    }
+    if (rc == LM_GO) {
         if (r->check_max > r->check_tol) {
             fprintf(stderr, "lensmat: ");
             fprintf(stderr, CS(CHECK_FAILED), r->check_max * 1e3, r->check_tol * 1e3);
@@ -335,7 +379,7 @@ int lm_cornea_scan(lm_io *io)
         char err[256];
         if (cs_write_report(s->report, s->text ? s->text : "", s->len, err, sizeof err)) {
             if (lm_stop_requested()) rc = LM_FAIL;
-            else rc = calc_fail(c, "the report file cannot be written\n");
+            else rc = calc_fail(c, CS(NO_REPORT));
             fprintf(stderr, "lensmat: ");
             fprintf(stderr, CS(REPORT_FAILED), s->report, err);
         } else {
@@ -365,10 +409,10 @@ static int run(cs *s, cl_run *r, rg_machine **m)
     int counts[6];
     cl_counts(r, counts);
     if (rc == CN_ESTOP || lm_stop_requested()) return LM_FAIL;
-    if (rc == CN_EINVAL && r->m) {              /* the machine refused or failed */
-        r->rg->close(*m);
-        *m = NULL;
+    if (rc == CN_EINVAL || rc == CN_ENOMEM) {   /* the machine, the camera or saving */
+        if (*m) { r->rg->close(*m); *m = NULL; }
         say(s, CS(MACHINE_FAILED), err);
+        fprintf(stderr, "lensmat: %s\n", err);
         return LM_FAIL;
     }
     say(s, CS(PLANNED), pname[r->pattern], r->npoints, r->zone / DEG, r->nplanned, r->nexposed);
