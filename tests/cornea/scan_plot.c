@@ -1,6 +1,6 @@
 /* scan_plot.c -- the cornea scan's error against run time (scripts/bench_cornea_scan.sh)
  * plotted through the imaging engine's plot call: reads the bench's table (TSV: points,
- * seconds, RMS radius error um, RMS mean-K error D, the fit's sd of each; '#' lines
+ * CPU seconds, RMS radius error um, RMS mean-K error D, the fit's sd of each; '#' lines
  * skipped) and draws log-log lines with markers, radius error in um and mean-K error in
  * millidiopters against the measurement's time, with the fit's own sd as lines, as
  * PNG and SVG (NAME.svg beside it).  Prints where each marker was drawn ("PLOT marker
@@ -49,7 +49,7 @@ int main(int argc, char **argv)
         {"the fit's own sd of mean K (mD)", n, t, ks, IM_LINES},
     };
     im_plot P = {"Cornea scan: error against run time (10 to 10 000 points)",
-                 "time of the measurement (s): plan, trace, frames, centroids, fit, check",
+                 "CPU time of the measurement (s): plan, trace, frames, centroids, fit, check",
                  "RMS error", 1, 1, 0, 4, ser, argc > 3 ? argv[3] : NULL};
     im_out out = {argv[2], svg, 900, 520, NULL, NULL};
     im_plot_info info;
