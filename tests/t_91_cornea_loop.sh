@@ -156,3 +156,20 @@ cl_camera_short() {
         [ ! -e "$CL/crep2.txt" ] && ! grep -q '^Spots: ' "$CL/cam2.rec" && grep -q 'gave 29 frames' "$CL/cam2.rec.err"
 }
 check "cornea loop: a camera with fewer frames than exposures is an error" cl_camera_short
+# SIGTERM while the frames are made and saved (no machine): exit 143, no report, no
+# half-written frame (each is written to a temporary name and renamed)
+cl_term_frames() {
+    mkdir -p "$CL/tf" && rm -f "$CL"/tf/*
+    cl_frames "$CL/tf.in" 10000 14 640 480 tf/rep.txt spiral 'tf/g%05d.png'
+    (cd "$CL" && exec "$BIN" --cornea-scan -i tf.in tf.rec > tf.out 2> tf.err) &
+    p=$!
+    sleep 1
+    kill -TERM "$p"
+    wait "$p"
+    rc=$?
+    [ "$rc" -eq 143 ] || { echo "exit $rc"; cat "$CL/tf.err"; return 1; }
+    n=$(ls "$CL/tf" | grep -c '^g[0-9]*\.png$')
+    [ ! -e "$CL/tf/rep.txt" ] && [ "$n" -gt 0 ] && [ "$n" -lt 10000 ] &&
+        [ "$(ls "$CL/tf" | grep -v '^g[0-9]*\.png$' | wc -l)" -eq 0 ] && ! grep -q '^Spots: ' "$CL/tf.out"
+}
+check "cornea loop: SIGTERM while frames are saved: exit 143, no report, no half-written frame" cl_term_frames
