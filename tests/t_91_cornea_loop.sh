@@ -173,3 +173,18 @@ cl_term_frames() {
         [ "$(ls "$CL/tf" | grep -v '^g[0-9]*\.png$' | wc -l)" -eq 0 ] && ! grep -q '^Spots: ' "$CL/tf.out"
 }
 check "cornea loop: SIGTERM while frames are saved: exit 143, no report, no half-written frame" cl_term_frames
+# 11. the same loop on the kernel's gpio-sim chip in qemu (../shared/tools/gpio-vm/run;
+# tests/cornea/vm_scan.sh inside the guest): a 10-point scan moved and exposed through
+# libgpiod, fitted, the laser low afterwards, the record replaying to the same report
+cl_vm() {
+    vm=${GPIO_VM:-$SHARED/tools/gpio-vm/run}
+    [ -x "$vm" ] || { echo "gpio-vm: $vm not found"; return 1; }
+    mkdir -p "$CL/vmlibs"
+    for l in $(ldd "$BIN" | grep -o '/[^ ]*libreadline[^ ]*'); do cp -L "$l" "$CL/vmlibs/"; done
+    (cd "$TOP" && GPIO_VM_FILES="tests/cornea/vm_scan.rig lensmat build/lib/lensmat-rig.so build/lib/lensmat-trace.so build/lib/lensmat-cornea.so $CL/vmlibs" \
+        "$vm" tests/cornea/vm_scan.sh) > "$CL/vm.out" 2>&1
+    rc=$?
+    tr -d '\r' < "$CL/vm.out" | grep -E '^(PASS|FAIL)'
+    [ "$rc" -eq 0 ] && [ "$(tr -d '\r' < "$CL/vm.out" | grep -c '^PASS')" -eq 7 ]
+}
+check "cornea loop: a 10-point scan on the gpio-sim chip (libgpiod), replayed" cl_vm

@@ -208,7 +208,7 @@ static int run(cs *s, cl_run *r, rg_machine **m);
 int lm_cornea_scan(lm_io *io)
 {
     static const char *const models[] = {"sphere", "conic", "biconic", NULL};
-    static const char *const chips[] = {"none", "sim", NULL};
+    static const char *const chips[] = {"none", "sim", "gpiod", NULL};
     static const char *const patterns[] = {"spiral", "rings", "grid", NULL};
     static const char *const sources[] = {"frames", "model", "camera", NULL};
     cs *s = calloc(1, sizeof *s);
@@ -235,9 +235,10 @@ int lm_cornea_scan(lm_io *io)
         goto out;
     if (s->have_rig) {
         if ((rc = calc_choice(c, CS(CHIP), CS(CHIP_WHAT), chips, &chip))) goto out;
-        if (chip == 1 &&
-            ((rc = lm_ask_word(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
-                               s->log, sizeof s->log)) ||
+        if ((chip == 1 &&
+             (rc = lm_ask_word(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
+                               s->log, sizeof s->log))) ||
+            (chip >= 1 &&
              (rc = ranged(c, CS(EXPOSE), CS(EXPOSE_WHAT), CS(EXPOSE_RANGE),
                           0.01, s->rig.max_on_ms, 0, &ms))))
             goto out;
@@ -337,8 +338,9 @@ int lm_cornea_scan(lm_io *io)
     } else {
         say(s, CS(MODEL_ON), noise, r->sigma * 1e3);
     }
-    if (chip == 1) {
+    if (chip >= 1) {
         rg_open_opts o = {RG_BACKEND_SIM, NULL, strcmp(s->log, "-") ? s->log : NULL, NULL, 0};
+        if (chip == 2) o = (rg_open_opts){RG_BACKEND_GPIOD, NULL, NULL, NULL, 1};
         char err[RG_ERRMAX];
         rg_pose p;
         hook_api = rg;
@@ -354,7 +356,8 @@ int lm_cornea_scan(lm_io *io)
         snprintf(buf, sizeof buf, "m1a %.4g deg, m1b %.4g deg, u %.4g mm, v %.4g mm, "
                  "m2a %.4g deg, m2b %.4g deg", p.j[0] / DEG, p.j[1] / DEG, p.j[2], p.j[3],
                  p.j[4] / DEG, p.j[5] / DEG);
-        say(s, CS(OPENED), buf);
+        say(s, CS(OPENED), chip == 2 ? s->rig.chip : "the simulator", buf);
+        lm_say(io, LM_OUT, "%s\n", rg->sched_note(m));   /* varies: not recorded */
         r->m = m;
     }
     rc = run(s, r, &m);
