@@ -31,7 +31,7 @@ median3() { sort -n | sed -n 2p; }
 # ---- 1000 points, three runs each way ----
 for i in 1 2 3; do
     t0=$(date +%s.%N); scan f$i 1000 frames 1 || exit 1; t1=$(date +%s.%N)
-    echo "$(tline f$i) $(echo "$t1 - $t0" | bc)" >> "$O/f.times.$$"
+    echo "$(tline f$i) $(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }')" >> "$O/f.times.$$"
     scan m$i 1000 model 1 || exit 1
     tline m$i >> "$O/m.times.$$"
 done
@@ -49,7 +49,7 @@ echo "BENCH cornea_scan1000_check_s $5 s"
 echo "BENCH cornea_scan1000_cpu_s $cmed s"
 echo "BENCH cornea_scan1000_command_s $8 s"
 echo "BENCH cornea_scan1000_model_s $mmed s"
-echo "BENCH cornea_scan1000_frames_vs_model $(echo "scale=2; $6 / $mmed" | bc) x"
+echo "BENCH cornea_scan1000_frames_vs_model $(awk -v a="$6" -v b="$mmed" 'BEGIN { printf "%.2f", a / b }') x"
 # ---- the same record and report whatever the thread count ----
 LENSMAT_THREADS=1 scan th1 1000 frames 1 th1.rep && mv th1.rep "$O/th1.rep"
 LENSMAT_THREADS=2 scan th2 1000 frames 1 th1.rep && mv th1.rep "$O/th2.rep"
