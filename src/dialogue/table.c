@@ -31,7 +31,7 @@ const lm_dialogue lm_dialogues[] = {
      lm_vision_example, NULL, 0},
     {"--cornea", "corneal radius <-> power, measuring accuracy (section 37)", lm_cornea,
      lm_cornea_example, NULL, 0},
-    {"--cornea-scan", "simulated cornea measurement: rig scan, fit, Sim K (issue 12)", lm_cornea_scan, lm_cornea_scan_example, "cornea", 0},
+    {"--cornea-scan", "cornea measurement: rig scan, traced spots, frames, centroids, fit, Sim K (issue 12)", lm_cornea_scan, lm_cornea_scan_example, "cornea", 0},
     {"--fit", "lens matrix from measurements (lsq), cardinal or nodal points (14, 24, 26)",
      lm_fit, lm_fit_example, "fit", 0},
     {"--spot", "laser-spot centroids in a detector frame: file, raw, synthetic or a stream (36, 46)",
