@@ -111,3 +111,14 @@ check "--to-zmx refuses to write over its input" lf_same_file
 check "--to-zmx --example and --to-thickness --example run" sh -c "cd '$WORK' &&
     '$BIN' --to-zmx --example ex.zmx 2>/dev/null && grep -q '^SURF 4' ex.zmx &&
     '$BIN' --to-thickness --example ex.rx 2>/dev/null && grep -q '^field angle 0 5$' ex.rx"
+
+# --trace reads a .zmx as a lens file (through the same classic answers)
+lf_trace() {
+    [ -f "$TOP/build/lib/lensmat-trace.so" ] || { echo "trace module not built"; return 1; }
+    rm -rf "$WORK/ltr"; mkdir -p "$WORK/ltr"; cd "$WORK/ltr" || return 1
+    printf 'record\n%s\n10\n1000\n1\nn\nn\n' "$ZMX/AC254-100-A.zmx" > in
+    "$BIN" --trace -i in t.rec > out 2> err || { cat err; return 1; }
+    grep -q '^Surface 2: radius -45.71, location 4, index right 1.672693462, semi-diameter 10' out &&
+    grep -q '^Near the axis (height 1e-05) the real trace meets the paraxial image' out
+}
+check "--trace takes Thorlabs' .zmx as its lens file" lf_trace
