@@ -616,11 +616,17 @@ static void write_surface(ln_buf *b, int k, const ln_surface *s, int stop, doubl
     }
 }
 
-char *ln_write_zmx(const ln_lens *l)
+char *ln_write_zmx(const ln_lens *lens)
 {
     ln_buf b = {0};
     ln_surface s0, img;
     char a[40];
+    /* OpticStudio wants a field and a wavelength: a lens without them is on axis at
+     * the d line, which is what the model means by none (ln_primary) */
+    ln_lens lv = *lens;
+    const ln_lens *l = &lv;
+    if (lv.nwl == 0) { lv.nwl = 1; lv.wl[0] = PX_LAMBDA_D; lv.wl_weight[0] = 1; }
+    if (lv.nfield == 0) { lv.nfield = 1; lv.field[0].x = lv.field[0].y = 0; lv.field[0].weight = 1; }
     int nrow = l->nfield > 12 ? l->nfield : 12;
     static const char *const zu[] = {"mm", "MM", "cm", "CM", "m", "METER", "in", "IN"};
     const char *unit = "MM";
@@ -655,7 +661,7 @@ char *ln_write_zmx(const ln_lens *l)
         ln_format(l->wl_weight[i], w, sizeof w);
         ln_buf_printf(&b, "WAVM %d %s %s\r\n", i + 1, a, w);
     }
-    if (l->nwl) ln_buf_printf(&b, "PWAV 1\r\n");
+    ln_buf_printf(&b, "PWAV 1\r\n");
     memset(&s0, 0, sizeof s0);
     write_surface(&b, 0, &s0, 0, l->object, l->obj_glass, l->obj_nd, l->obj_vd);
     for (int i = 0; i < l->nsurf; i++) {
