@@ -218,7 +218,8 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
         vd = (atoi(name) % 1000) / 10.0;
     }
     if (!(nd > 1)) return zbad(r, "glass %s is not in lensmat's catalogue (data/glass.txt) "
-                               "and the file gives no nd for it", name);
+                               "and the file gives no nd for it (add the glass's formula "
+                               "to data/glass.txt, or nd and Vd to this GLAS line)", name);
     z->s.nd = nd;
     z->s.vd = vd;
     ln_note(r->notes, r->src, r->line, "glass %s is not in lensmat's catalogue: taken as "
