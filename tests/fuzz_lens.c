@@ -17,9 +17,20 @@ static void expect_message(int rc, const char *err)
     if (rc && (!err[0] || !strstr(err, "fuzz."))) abort();
 }
 
-/* NULL if every value of a and b is the same, else what differs. */
-static const char *differ(const ln_lens *a, const ln_lens *b)
+/* No wavelength means the d line, no field the axis: as the .zmx writer spells them. */
+static void canon(ln_lens *l)
 {
+    if (l->nwl == 0) { l->nwl = 1; l->wl[0] = PX_LAMBDA_D; l->wl_weight[0] = 1; }
+    if (l->nfield == 0) { l->nfield = 1; l->field[0].x = l->field[0].y = 0; l->field[0].weight = 1; }
+}
+
+/* NULL if every value of a and b is the same, else what differs. */
+static const char *differ(const ln_lens *a0, const ln_lens *b0)
+{
+    ln_lens ca = *a0, cb = *b0;          /* shallow: only compared */
+    const ln_lens *a = &ca, *b = &cb;
+    canon(&ca);
+    canon(&cb);
     if (a->nsurf != b->nsurf) return "nsurf";
     if (a->stop != b->stop) return "stop";
     if (a->nwl != b->nwl) return "nwl";

@@ -334,6 +334,49 @@ static void lithography(void)
     free(s);
 }
 
+/* The bridge to the paraxial engine and the sag: px_csurf surfaces give the same
+ * first order as ln_paraxial; an asphere's r^2 term is part of the paraxial power;
+ * sags of a sphere, a paraboloid and an even asphere against their formulas. */
+static void bridge(void)
+{
+    const char *t = "thickness\nwavelengths d F C\n50 5 N-BK7 stop\n-50 40 1.6/40 a2 0.001\n"
+                    "plane 1 air\n";
+    ln_lens l;
+    char err[LN_ERR_MAX], names[8][LN_NAME_MAX];
+    px_csurf cs[8];
+    const char *obj;
+    px_colour col;
+    px_system sys;
+    px_first f;
+    ln_surface s;
+    int rc = ln_read_rx(t, strlen(t), "b.rx", &l, NULL, err, sizeof err);
+    CHECK(rc == LN_OK, "the bridge lens reads (%s)", rc ? err : "ok");
+    if (rc) return;
+    CHECK(ln_paraxial_curvature(&l.surf[1]) == -0.02 + 0.002, "a2 adds 2 a2 to the curvature");
+    CHECK(ln_to_csurf(&l, cs, names, &obj, err, sizeof err) == LN_OK && !strcmp(obj, "AIR") &&
+          cs[1].r == 1 / (-0.02 + 0.002) && !strcmp(cs[1].glass, "1.6/40") && cs[0].t == 5,
+          "px_csurf: paraxial radius, thickness, glass names, AIR for air");
+    CHECK(px_colour_fdc(cs, l.nsurf, obj, &col) == PX_OK, "px_colour_fdc runs on them");
+    rc = ln_paraxial(&l, PX_LAMBDA_F, &sys, err, sizeof err);
+    CHECK(rc == LN_OK && px_first_order(&sys, &f) == PX_OK &&
+          fabs(f.efl.v - col.first[0].efl.v) <= 1e-12 * fabs(f.efl.v),
+          "ln_paraxial at F gives px_colour's efl at F (%.12g)", f.efl.v);
+    if (rc == LN_OK) px_system_free(&sys);
+    ln_free(&l);
+    memset(&s, 0, sizeof s);
+    ln_set_radius(&s, 50);
+    CHECK(fabs(ln_sag(&s, 10) - (50 - sqrt(2400.0))) < 1e-12, "sphere sag R - sqrt(R^2 - h^2)");
+    s.conic = -1;
+    CHECK(fabs(ln_sag(&s, 10) - 1.0) < 1e-12, "paraboloid sag c h^2 / 2");
+    s.type = LN_EVENASPH;
+    s.nasph = 2;
+    s.asph[1] = 1e-5;
+    CHECK(fabs(ln_sag(&s, 10) - 1.1) < 1e-12, "even asphere: + a4 h^4");
+    s.type = LN_STANDARD;
+    s.conic = 5;
+    CHECK(isnan(ln_sag(&s, 21)) && !isnan(ln_sag(&s, 20)), "no real point past an oblate conic's edge: NaN");
+}
+
 int main(void)
 {
     rx_read();
@@ -346,5 +389,6 @@ int main(void)
     thorlabs("tests/zmx/AC254-125-A.zmx", 0, 125.0, 122.0, "N-SF5");
     zmx_notes();
     lithography();
+    bridge();
     return unit_failed();
 }

@@ -203,8 +203,7 @@ static char *slurp_all(FILE *in, const char *src, size_t *len, char *err, size_t
         *len += n;
         if (*len == room) {
             if (room > (size_t)LENS_FILE_MAX) {
-                snprintf(err, cap, "%s: longer than %ld MB: not a lens file", src,
-                         LENS_FILE_MAX >> 20);
+                snprintf(err, cap, LF(TOO_BIG), src, LENS_FILE_MAX >> 20);
                 free(s);
                 return NULL;
             }
@@ -218,7 +217,7 @@ static char *slurp_all(FILE *in, const char *src, size_t *len, char *err, size_t
         }
     }
     if (ferror(in)) {
-        snprintf(err, cap, "%s: cannot read: %s", src, strerror(errno));
+        snprintf(err, cap, LF(CANNOT_READ), src, strerror(errno));
         free(s);
         return NULL;
     }

@@ -437,7 +437,7 @@ static void keep_input_lines(char *s)
 /* The lens in text s (a prescription, a classic record or its answers; s is cut up).
  * LM_GO, or LM_FAIL with "FILE:LINE: why" in err. */
 static int lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, char *err,
-                        size_t cap)
+                        size_t cap, int quiet)
 {
     cursor c = {src, s, "", 0, err, cap};
     char asrc[600], *ans;
@@ -446,7 +446,7 @@ static int lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, 
     int rc;
     memset(lf, 0, sizeof *lf);
     if (lm_is_model_file(s, len)) {         /* by thickness, or a .zmx: lensfile.c */
-        if (lm_model_answers(src, s, len, &ans, &alen, 1, err, cap)) return LM_FAIL;
+        if (lm_model_answers(src, s, len, &ans, &alen, quiet, err, cap)) return LM_FAIL;
         snprintf(asrc, sizeof asrc, "%s (as classic answers)", src);
         c.src = asrc;
         c.next = ans;
@@ -495,7 +495,7 @@ int lm_read_lens(const char *path, lm_lens_file *lf, char *err, size_t cap)
     s = slurp_n(f, path, err, cap, &len, 1);
     fclose(f);
     if (!s) return LM_FAIL;
-    rc = lens_of_text(path, s, len, lf, err, cap);
+    rc = lens_of_text(path, s, len, lf, err, cap, 1);
     free(s);
     return rc;
 }
@@ -503,7 +503,7 @@ int lm_read_lens(const char *path, lm_lens_file *lf, char *err, size_t cap)
 int lm_lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, char *err,
                     size_t cap)
 {
-    return lens_of_text(src, s, len, lf, err, cap);
+    return lens_of_text(src, s, len, lf, err, cap, 1);
 }
 
 void lm_lens_file_free(lm_lens_file *lf)
@@ -547,7 +547,7 @@ int lm_to_prescription(lm_io *io)
     lm_lens_file lf;
     size_t len;
     char err[1200], *s = slurp_n(io->in, io->src, err, sizeof err, &len, 1);
-    if (!s || lens_of_text(io->src, s, len, &lf, err, sizeof err)) {
+    if (!s || lens_of_text(io->src, s, len, &lf, err, sizeof err, 0)) {
         free(s);
         say_error(err);
         return LM_FAIL;

@@ -155,7 +155,10 @@ void ln_notes_free(ln_notes *n);
 /* A lensmat prescription by thickness (rx.c; the format in README "Prescription
  * files").  text: the whole file (len bytes, NULs refused), src: its name for
  * messages.  A positions prescription (no `thickness` line) is read too: positions
- * become thicknesses.  l is ln_init'd here; on failure it is left empty. */
+ * become thicknesses, surface 1 moves to z = 0, and each index is taken as the
+ * classic dialogue takes it (a number; a medium's constant; a glass, or NAME@W, at
+ * the file's `wavelength` or d) and kept as that number: such a file is at one
+ * wavelength.  l is ln_init'd here; on failure it is left empty. */
 int ln_read_rx(const char *text, size_t len, const char *src, ln_lens *l,
                ln_notes *notes, char *err, size_t cap);
 /* Is this text a thickness prescription (a `thickness` line before any surface)? */
@@ -167,8 +170,11 @@ char *ln_write_rx(const ln_lens *l);
 /* Zemax OpticStudio sequential .zmx (zmx.c): UTF-8, Latin-1 or UTF-16LE/BE (with
  * or without a byte-order mark).  Read: SURF, TYPE STANDARD/EVENASPH, CURV, DISZ,
  * GLAS, DIAM, CONI, PARM, STOP, WAVL/WAVM/PWAV/WWGT, ENPD/FNUM/OBNA, FTYP, XFLN/YFLN
- * (XFLD/YFLD), FWGN/FWGT, NAME, UNIT; everything else is noted (ln_notes) once per
- * keyword, and each unsupported surface type or glass with its line. */
+ * (XFLD/YFLD), FWGN/FWGT, NAME, UNIT; everything else is noted (ln_notes) in one
+ * note, and each unsupported surface type or glass with its line.  Refused (LN_BAD):
+ * GLAS MIRROR, negative thicknesses, MODE NSC.  SURF 0 is the object (its DISZ
+ * `object`, its GLAS `obj_glass`), the last SURF the image (image_c, image_semi);
+ * wavelengths are reordered primary (PWAV) first. */
 int ln_read_zmx(const char *text, size_t len, const char *src, ln_lens *l,
                 ln_notes *notes, char *err, size_t cap);
 /* Does this text look like a .zmx (a SURF line and a VERS, MODE or UNIT line, in any

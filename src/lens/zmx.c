@@ -218,7 +218,8 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
         vd = (atoi(name) % 1000) / 10.0;
     }
     if (!(nd > 1)) return zbad(r, "glass %s is not in lensmat's catalogue (data/glass.txt) "
-                               "and the file gives no nd for it", name);
+                               "and the file gives no nd for it (add the glass's formula "
+                               "to data/glass.txt, or nd and Vd to this GLAS line)", name);
     z->s.nd = nd;
     z->s.vd = vd;
     ln_note(r->notes, r->src, r->line, "glass %s is not in lensmat's catalogue: taken as "
@@ -616,11 +617,17 @@ static void write_surface(ln_buf *b, int k, const ln_surface *s, int stop, doubl
     }
 }
 
-char *ln_write_zmx(const ln_lens *l)
+char *ln_write_zmx(const ln_lens *lens)
 {
     ln_buf b = {0};
     ln_surface s0, img;
     char a[40];
+    /* OpticStudio wants a field and a wavelength: a lens without them is on axis at
+     * the d line, which is what the model means by none (ln_primary) */
+    ln_lens lv = *lens;
+    const ln_lens *l = &lv;
+    if (lv.nwl == 0) { lv.nwl = 1; lv.wl[0] = PX_LAMBDA_D; lv.wl_weight[0] = 1; }
+    if (lv.nfield == 0) { lv.nfield = 1; lv.field[0].x = lv.field[0].y = 0; lv.field[0].weight = 1; }
     int nrow = l->nfield > 12 ? l->nfield : 12;
     static const char *const zu[] = {"mm", "MM", "cm", "CM", "m", "METER", "in", "IN"};
     const char *unit = "MM";
@@ -655,7 +662,7 @@ char *ln_write_zmx(const ln_lens *l)
         ln_format(l->wl_weight[i], w, sizeof w);
         ln_buf_printf(&b, "WAVM %d %s %s\r\n", i + 1, a, w);
     }
-    if (l->nwl) ln_buf_printf(&b, "PWAV 1\r\n");
+    ln_buf_printf(&b, "PWAV 1\r\n");
     memset(&s0, 0, sizeof s0);
     write_surface(&b, 0, &s0, 0, l->object, l->obj_glass, l->obj_nd, l->obj_vd);
     for (int i = 0; i < l->nsurf; i++) {
