@@ -350,6 +350,10 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     opt.threads = sc->threads;
     opt.escape_length = sc->escape;
     opt.batch = stop_batch(sc->depth);
+    /* LENSMAT_TRACE_BVH=1: every segment by Embree, the lens path (tr_seqscan.c) off --
+     * to check that it changes no bit of any output */
+    const char *bvh = getenv("LENSMAT_TRACE_BVH");
+    if (bvh && *bvh && strcmp(bvh, "0") != 0) opt.sequential = 0;
     o.err = err;
     o.stop = sc->stop;
     o.stop_ctx = sc->stop_ctx;

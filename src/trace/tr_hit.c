@@ -366,7 +366,8 @@ static inline int seq_cands(const trace_scene *sc, const trace_options *o,
         *cg = f->seqg;
         *nc = f->nseq;
     } else {
-        if (!(sc->nentry > 0 && org[2] < sc->entry_z)) return 0;
+        if (!(sc->nentry > 0 && org[2] < sc->entry_z && org[2] > sc->entry_zmin))
+            return 0;
         *cand = sc->entry;
         *cg = sc->entryg;
         *nc = sc->nentry;
