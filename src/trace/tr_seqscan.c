@@ -175,6 +175,16 @@ void tr_seq_detect(trace_scene *sc)
         }
     }
     if (bestp < 2) goto none;
+    /* the entry is the first slab with a refracting surface: a detector or a mirror
+     * left of the lens (behind the sources) is better left to Embree than made the
+     * slab the sources' rays must start left of */
+    for (;;) {
+        int refr = 0;
+        for (int i = slab[best0]; i < slab[best0 + 1]; i++)
+            refr |= sc->surf[z[i].id]->mat.kind == TRACE_REFRACT;
+        if (refr) break;
+        best0++;
+    }
     /* the hints: a refracting surface of slab k may meet slab k's and slab k+1's
      * members next (in the order they were added: ties go to the first, as Embree's
      * first-found does for add_lens's lens-then-mount order) */
