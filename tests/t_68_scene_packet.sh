@@ -7,7 +7,13 @@
 # beside it, a concave mirror behind a lens, a 45-degree fold mirror, a tilted and a
 # decentred lens and an aspheric one (no lens found), sources from the far side and
 # from inside the lens; Fresnel and reflections on and off.  The screen says how many
-# surfaces took the lens path; that number is checked too.
+# surfaces took the lens path; that number is checked too.  The engine's own test of
+# the same (scenes built through the table, hints made stale by later surfaces) is
+# tests/trace/t_seqscan.c.
+
+# the engine's side, through its table (tests/trace/t_seqscan.c)
+unit "$TOP/build/obj/trace_tests/t_seqscan"
+unit "$TOP/build/asan/trace_tests/t_seqscan"
 
 PK=$WORK/scenepkt
 mkdir -p "$PK"
@@ -80,6 +86,10 @@ pk_modes() {
 # the same surfaces listed backwards (ids against z), on two threads, with a point source
 { pk_triplet | awk '{ l[NR] = $0 } END { for (i = NR; i > 0; i--) print l[i] }'
   echo "source point from 0 0 -300 toward 0 0 0 radius 7 rings 12"; echo "threads 2"; } > "$PK/triplet_rev.body"
+# a mesh vane across the beam between the first and second elements: the lens path
+# starts after it (surfaces 3 to 6, their mounts and the detector)
+{ pk_triplet; echo "plane absorb at 0 3 6 normal 0 0 1 rect 20 2 tessellate 2"
+  echo "source collimated from 0 0 -5 dir 0 0 1 radius 7.9 grid 41"; } > "$PK/vane.body"
 { pk_singlet; echo "plane detect at 0 0 55.0190998600405 normal 0 0 1 disc 30"
   echo "source collimated from 0 0 -10 dir 0 0 1 radius 11.9 grid 31"
   echo "source fan from 0 -5 -40 dir 0 0.1 1 angle 12 rays 41"; } > "$PK/singlet.body"
@@ -146,6 +156,8 @@ if [ -f "$TOP/build/lib/lensmat-trace.so" ]; then
         pk_modes triplet 13 "$PK/triplet.body"
     check "scene lens path: the triplet listed backwards, 2 threads, point source" \
         pk_modes triplet_rev 13 "$PK/triplet_rev.body"
+    check "scene lens path: a mesh vane between two elements of the triplet" \
+        pk_modes vane 9 "$PK/vane.body"
     check "scene lens path: singlet, collimated and tilted fan" pk_modes singlet 3 "$PK/singlet.body"
     check "scene lens path: conic singlet" pk_modes conic 3 "$PK/conic.body"
     check "scene lens path: meshes before and after the lens (rays from either side of the plate)" \

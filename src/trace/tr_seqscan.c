@@ -15,11 +15,15 @@
  *     of at most two surfaces (a lens face and its mount) with gaps between them;
  *   - nothing else in the scene (meshes, spheres, tilted or decentred surfaces,
  *     surfaces of a slab with three) reaches into the z range of the slabs taken.
- * A ray from a source meets the first slab first if it starts left of it and right of
- * everything else on that side (entry_z, entry_zmin).  The run of slabs with the most
- * refracting conics is taken, if it has two at least; else the scene has no lens and
- * every segment goes through Embree.  A scene whose hints add_lens set (a lens alone)
- * keeps them; coincident surfaces turn the shortcut off (tr_scene.c). */
+ * The run of consecutive slabs with the most refracting conics is taken, if it has
+ * two at least (else the scene has no lens: every segment goes through Embree), from
+ * its first slab with a refracting surface.  A ray from a source meets that slab first
+ * if it starts left of it and right of everything else on that side (entry_z,
+ * entry_zmin).  Rays going back (d_z <= 0), reflected rays, rays starting inside the
+ * lens or left of something before it, and rays that miss the surfaces named are
+ * Embree's, as before.  A scene whose hints add_lens set (a lens alone) keeps them;
+ * coincident surfaces turn the shortcut off (tr_scene.c).  Cost: a sort of the
+ * surfaces per build. */
 #include <math.h>
 #include <stddef.h>
 #include "tr_eng.h"
@@ -91,27 +95,51 @@ static int power_surface(const tr_surf *f)
     return f->shape.fast == TR_FAST_CONIC && f->mat.kind == TRACE_REFRACT;
 }
 
-/* The axis line the most refracting conics share (1), or 0 if none has two. */
+typedef struct axp { double x, y; int id; } axp;
+
+static int by_axis(const void *a, const void *b)
+{
+    const axp *p = a, *q = b;
+    if (p->x != q->x) return p->x < q->x ? -1 : 1;
+    if (p->y != q->y) return p->y < q->y ? -1 : 1;
+    return p->id - q->id;
+}
+
+/* The axis line the most refracting conics share (ties: the one named first), 1; or 0
+ * if no line has two. */
 static int pick_axis(const trace_scene *sc, double *ax, double *ay)
 {
-    int best = 0;
+    axp *a = malloc((size_t)sc->nsurf * sizeof *a);
+    int na = 0, best = 0, bfirst = 0;
+    if (!a) return 0;
     for (int i = 0; i < sc->nsurf; i++) {
         const tr_surf *f = sc->surf[i];
-        if (!lens_kind(f, f->shape.at[0], f->shape.at[1]) || !power_surface(f)) continue;
-        int n = 0, seen = 0;
-        for (int j = 0; j < sc->nsurf && !seen; j++) {
-            const tr_surf *g = sc->surf[j];
-            if (!lens_kind(g, f->shape.at[0], f->shape.at[1]) || !power_surface(g)) continue;
-            if (j < i) seen = 1;           /* that axis was counted at its first */
-            n++;
-        }
-        if (!seen && n > best) {
-            best = n;
-            *ax = f->shape.at[0];
-            *ay = f->shape.at[1];
+        if (lens_kind(f, f->shape.at[0], f->shape.at[1]) && power_surface(f))
+            a[na++] = (axp){f->shape.at[0], f->shape.at[1], i};
+    }
+    qsort(a, (size_t)na, sizeof *a, by_axis);
+    for (int i = 0, j; i < na; i = j) {
+        for (j = i; j < na && a[j].x == a[i].x && a[j].y == a[i].y; j++) {}
+        if (j - i > best || (j - i == best && a[i].id < bfirst)) {
+            best = j - i;
+            bfirst = a[i].id;
+            *ax = a[i].x;
+            *ay = a[i].y;
         }
     }
+    free(a);
     return best >= 2;
+}
+
+/* Does [lo, hi] meet any of the disjoint intervals u[0..nu) (ascending)? */
+static int blocked(const zr *u, int nu, double lo, double hi)
+{
+    int a = 0, b = nu;                    /* the first with u.hi >= lo */
+    while (a < b) {
+        int m = a + (b - a) / 2;
+        if (u[m].hi >= lo) b = m; else a = m + 1;
+    }
+    return a < nu && u[a].lo <= hi;
 }
 
 /* Forget every hint (add_lens's of an earlier scene, this file's of an earlier build). */
@@ -154,25 +182,27 @@ void tr_seq_detect(trace_scene *sc)
         else shi = fmax(shi, z[i].hi);
     }
     slab[ns] = nl;
-    /* the best run of consecutive good slabs: at most two members each, nothing else
-     * reaching into [its first slab's lo, its last slab's hi] */
-    int best0 = -1, best1 = -1, bestp = 0;
-    for (int k0 = 0; k0 < ns; k0++) {
-        int p = 0;
-        double lo = INFINITY, hi = -INFINITY;
-        for (int k = k0; k < ns; k++) {
-            if (slab[k + 1] - slab[k] > 2) break;
-            double slo = z[slab[k]].lo, shk = -INFINITY;
-            for (int i = slab[k]; i < slab[k + 1]; i++) shk = fmax(shk, z[i].hi);
-            lo = fmin(lo, slo);
-            hi = shk;
-            int blocked = 0;
-            for (int b = nl; b < n && !blocked; b++)
-                blocked = z[b].lo <= hi && z[b].hi >= lo;
-            if (blocked) break;
-            for (int i = slab[k]; i < slab[k + 1]; i++) p += power_surface(sc->surf[z[i].id]);
-            if (p > bestp || (p == bestp && k0 == best0)) { bestp = p; best0 = k0; best1 = k; }
-        }
+    /* what else the scene holds, as disjoint z intervals (u, in place after z[nl]) */
+    qsort(z + nl, (size_t)nb, sizeof *z, by_lo);
+    zr *u = z + nl;
+    int nu = 0;
+    for (int i = 0; i < nb; i++) {
+        if (nu && !(u[i].lo > u[nu - 1].hi)) u[nu - 1].hi = fmax(u[nu - 1].hi, u[i].hi);
+        else u[nu++] = u[i];
+    }
+    /* the best run of consecutive good slabs (at most two members each, nothing else
+     * in them or between them): the most refracting conics, the first at a tie */
+    int best0 = -1, best1 = -1, bestp = 0, k0 = 0, p = 0;
+    shi = -INFINITY;                          /* now: the previous slab's hi */
+    for (int k = 0; k < ns; k++) {
+        double lo = z[slab[k]].lo, hi = -INFINITY;
+        for (int i = slab[k]; i < slab[k + 1]; i++) hi = fmax(hi, z[i].hi);
+        int ok = slab[k + 1] - slab[k] <= 2 && !blocked(u, nu, lo, hi);
+        if (ok && k > k0 && blocked(u, nu, shi, lo)) k0 = k, p = 0;   /* a gap blocked */
+        shi = hi;
+        if (!ok) { k0 = k + 1; p = 0; continue; }
+        for (int i = slab[k]; i < slab[k + 1]; i++) p += power_surface(sc->surf[z[i].id]);
+        if (p > bestp || (p == bestp && k0 == best0)) { bestp = p; best0 = k0; best1 = k; }
     }
     if (bestp < 2) goto none;
     /* the entry is the first slab with a refracting surface: a detector or a mirror
