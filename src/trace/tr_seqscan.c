@@ -36,6 +36,20 @@ _Static_assert(sizeof(trace_material) == sizeof(struct tr_seq_known_material),
                "trace_material has a new field: teach tr_seqscan.c whether the lens "
                "path (tr_packet.c) handles it, or refuse such surfaces there");
 
+/* ... and every field of a ray's working state (the packet carries these and no
+ * other: a wavelength or an attenuation added to tr_wray would not be updated there). */
+struct tr_seq_known_ray {
+    double o[3], d[3];
+    double n, len, opl;
+    tr_pol pol;
+    int depth, last_surf;
+    long last_prim;
+    uint32_t hist;
+};
+_Static_assert(sizeof(tr_wray) == sizeof(struct tr_seq_known_ray),
+               "tr_wray has a new field: teach tr_seqscan.c and tr_packet.c about it (or "
+               "find no lens in scenes that use it) before the lens path may run");
+
 typedef struct zr {
     double lo, hi;             /* z range, padded */
     int id;
