@@ -20,7 +20,7 @@ B=$(pwd)/build/obj/trace_tests/bench_trace
 [ -x "$LM" ] && [ -x "$B" ] || { echo "bench_trace_scene: lensmat or $B not built" >&2; exit 1; }
 W=$(mktemp -d); trap 'rm -rf "$W"' EXIT
 isa=$(grep -m1 -o -w 'avx512f' /proc/cpuinfo || grep -m1 -o -w 'avx2' /proc/cpuinfo || uname -m)
-echo "# bench_trace_scene on: $(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //'), $(nproc) cores, $isa, load $(cut -d' ' -f1-3 /proc/loadavg); one thread"
+echo "# bench_trace_scene on: $(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //'), $(nproc) cores, $isa (LENSMAT_ISA=${LENSMAT_ISA:-auto}), load $(cut -d' ' -f1-3 /proc/loadavg); one thread"
 GRID=${BENCH_QUICK:+400}
 awk -v grid="${GRID:-1128}" 'BEGIN {
     split("22.01359 -435.76044 -22.21328 20.29192 79.68360 -18.39533", R, " ")
