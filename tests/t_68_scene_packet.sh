@@ -86,6 +86,19 @@ pk_modes() {
 # the same surfaces listed backwards (ids against z), on two threads, with a point source
 { pk_triplet | awk '{ l[NR] = $0 } END { for (i = NR; i > 0; i--) print l[i] }'
   echo "source point from 0 0 -300 toward 0 0 0 radius 7 rings 12"; echo "threads 2"; } > "$PK/triplet_rev.body"
+# a meniscus (its faces overlap in z: one slab of two) before a singlet; with mounts
+# the meniscus's slab holds four and the singlet is left to Embree
+cat > "$PK/meniscus.body" <<'EOF'
+cap refract 1 1.6 vertex 0 0 0 radius 20 aperture 10
+cap refract 1.6 1 vertex 0 0 1.5 radius 25 aperture 10
+cap refract 1 1.5168 vertex 0 0 8 radius 50 aperture 12
+cap refract 1.5168 1 vertex 0 0 16 radius -50 aperture 12
+plane detect at 0 0 45 normal 0 0 1 disc 40
+source collimated from 0 0 -5 dir 0 0 1 radius 11 grid 31
+EOF
+{ cat "$PK/meniscus.body"
+  echo "plane absorb at 0 0 2.679491924311227 normal 0 0 1 disc 30 hole 10"
+  echo "plane absorb at 0 0 3.5871215252208 normal 0 0 1 disc 30 hole 10"; } > "$PK/meniscus_mounts.body"
 # a mesh vane across the beam between the first and second elements: the lens path
 # starts after it (surfaces 3 to 6, their mounts and the detector)
 { pk_triplet; echo "plane absorb at 0 3 6 normal 0 0 1 rect 20 2 tessellate 2"
@@ -158,6 +171,10 @@ if [ -f "$TOP/build/lib/lensmat-trace.so" ]; then
         pk_modes triplet_rev 13 "$PK/triplet_rev.body"
     check "scene lens path: a mesh vane between two elements of the triplet" \
         pk_modes vane 9 "$PK/vane.body"
+    check "scene lens path: a meniscus (faces overlapping in z) and a singlet" \
+        pk_modes meniscus 5 "$PK/meniscus.body"
+    check "scene lens path: the same with the meniscus mounted: the meniscus alone" \
+        pk_modes meniscus_mounts 4 "$PK/meniscus_mounts.body"
     check "scene lens path: singlet, collimated and tilted fan" pk_modes singlet 3 "$PK/singlet.body"
     check "scene lens path: conic singlet" pk_modes conic 3 "$PK/conic.body"
     check "scene lens path: meshes before and after the lens (rays from either side of the plate)" \

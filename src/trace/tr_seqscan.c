@@ -12,7 +12,9 @@
  *     without aspheric terms and planes, their frame the world's: axis exactly +z),
  *     on one axis line (the same vertex x and y), of the four known kinds;
  *   - their z ranges (the shapes' padded boxes), merged where they overlap, make slabs
- *     of at most two surfaces (a lens face and its mount) with gaps between them;
+ *     with gaps between them, at most four surfaces in two consecutive slabs (a face
+ *     and its mount, then the next face and its mount; or two faces of a cemented
+ *     doublet that overlap in z, then the next face);
  *   - nothing else in the scene (meshes, spheres, tilted or decentred surfaces,
  *     surfaces of a slab with three) reaches into the z range of the slabs taken.
  * The run of consecutive slabs with the most refracting conics is taken, if it has
@@ -204,15 +206,18 @@ void tr_seq_detect(trace_scene *sc)
         if (nu && !(u[i].lo > u[nu - 1].hi)) u[nu - 1].hi = fmax(u[nu - 1].hi, u[i].hi);
         else u[nu++] = u[i];
     }
-    /* the best run of consecutive good slabs (at most two members each, nothing else
-     * in them or between them): the most refracting conics, the first at a tie */
+    /* the best run of consecutive good slabs (nothing else in them or between them,
+     * at most four members in two consecutive ones: the candidates a surface names):
+     * the most refracting conics, the first at a tie */
     int best0 = -1, best1 = -1, bestp = 0, k0 = 0, p = 0;
     shi = -INFINITY;                          /* now: the previous slab's hi */
     for (int k = 0; k < ns; k++) {
         double lo = z[slab[k]].lo, hi = -INFINITY;
         for (int i = slab[k]; i < slab[k + 1]; i++) hi = fmax(hi, z[i].hi);
-        int ok = slab[k + 1] - slab[k] <= 2 && !blocked(u, nu, lo, hi);
-        if (ok && k > k0 && blocked(u, nu, shi, lo)) k0 = k, p = 0;   /* a gap blocked */
+        int ok = slab[k + 1] - slab[k] <= 4 && !blocked(u, nu, lo, hi);
+        if (ok && k > k0 && (blocked(u, nu, shi, lo) ||          /* a gap blocked, or */
+                             slab[k + 1] - slab[k - 1] > 4))      /* too many to name */
+            k0 = k, p = 0;
         shi = hi;
         if (!ok) { k0 = k + 1; p = 0; continue; }
         for (int i = slab[k]; i < slab[k + 1]; i++) p += power_surface(sc->surf[z[i].id]);
@@ -243,7 +248,7 @@ void tr_seq_detect(trace_scene *sc)
             if (sc->surf[z[i].id]->mat.kind == TRACE_REFRACT)
                 tr_scene_set_seq(sc, z[i].id, cand, nc);
     }
-    int e[2], ne = 0;
+    int e[4], ne = 0;
     for (int i = slab[best0]; i < slab[best0 + 1]; i++) e[ne++] = z[i].id;
     qsort(e, (size_t)ne, sizeof *e, by_id);
     double run_lo = z[slab[best0]].lo, zmin = -INFINITY;
