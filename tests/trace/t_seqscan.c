@@ -3,8 +3,10 @@
  * mesh added after it makes the engine look again (stale hints never used), a mesh
  * between two elements cuts the lens there, a rebuild after another surface finds it
  * anew; every trace gives the bits of the BVH trace (sequential off): hits, segments
- * and summary compared bytewise.  The summary says how many surfaces took the lens
- * path (trace_summary.lens_surfaces). */
+ * and summary compared bytewise; so do 300 random stacks of caps, conics, aspheres,
+ * planes, spheres and meshes of every kind (decentred and tilted now and then, some
+ * within another's sag) lit from both sides and from inside.  The summary says how
+ * many surfaces took the lens path (trace_summary.lens_surfaces). */
 #include <stdio.h>
 #include "unit.h"
 #include "tt.h"
@@ -48,8 +50,8 @@ static int same_both_ways(const trace_api *tr, trace_scene *sc, int fresnel,
     *lens = sum[1].lens_surfaces;
     *hits = sum[1].hits;
     int same = sum[0].lens_surfaces == 0 && r[0].h.n == r[1].h.n && r[0].s.n == r[1].s.n &&
-               !memcmp(r[0].h.p, r[1].h.p, r[0].h.n * sizeof(trace_hit)) &&
-               !memcmp(r[0].s.p, r[1].s.p, r[0].s.n * sizeof(trace_segment)) &&
+               (!r[0].h.n || !memcmp(r[0].h.p, r[1].h.p, r[0].h.n * sizeof(trace_hit))) &&
+               (!r[0].s.n || !memcmp(r[0].s.p, r[1].s.p, r[0].s.n * sizeof(trace_segment))) &&
                !memcmp(&sum[0].rays, &sum[1].rays, 10 * sizeof(uint64_t)) &&
                sum[0].max_depth_seen == sum[1].max_depth_seen &&
                !memcmp(&sum[0].emitted, &sum[1].emitted, 5 * sizeof(double));
@@ -78,6 +80,103 @@ static int add_plane(const trace_api *tr, trace_scene *sc, int kind, double z, d
     p.aperture = TRACE_AP_DISC;
     p.r_outer = r;
     return tr->add_surface(sc, &p, &m);
+}
+
+/* ---- random scenes: whatever the engine makes of them, the same bits both ways ---- */
+static uint64_t rng = 0x9e3779b97f4a7c15ULL;
+static double rnd(void)                   /* [0, 1), xorshift64* */
+{
+    rng ^= rng >> 12; rng ^= rng << 25; rng ^= rng >> 27;
+    return (double)((rng * 0x2545F4914F6CDD1DULL) >> 11) / 9007199254740992.0;
+}
+static double rr(double a, double b) { return a + (b - a) * rnd(); }
+
+/* A stack of on-axis caps and planes (some the packet's, some not: a conic, an
+ * asphere, a decentred or tilted one, a sphere, a mesh), of every kind, at random
+ * places along z, with sources from both sides and from inside. */
+static void random_scene(const trace_api *tr, trace_scene *sc)
+{
+    int ns = 3 + (int)(rnd() * 8);
+    double z = 0;
+    for (int i = 0; i < ns; i++) {
+        trace_surface t;
+        trace_material m = {TRACE_REFRACT, rr(1, 1.8), rr(1, 1.8)};
+        memset(&t, 0, sizeof t);
+        double q = rnd(), sd = rr(3, 10);
+        t.axis[2] = 1;
+        t.at[2] = z;
+        t.aperture = TRACE_AP_DISC;
+        if (q < 0.6) {                        /* a cap (a conic now and then) */
+            t.shape = TRACE_AXIAL;
+            double r = rr(1.2 * sd, 6 * sd);
+            t.radius = rnd() < 0.5 ? r : -r;
+            t.r_outer = sd;
+            if (rnd() < 0.2) t.conic = rr(-1, 0.5);
+            if (rnd() < 0.05) { t.nasph = 2; t.asph[1] = 1e-5; }
+        } else if (q < 0.85) {                /* a plane: a window, stop or detector */
+            t.shape = TRACE_PLANE;
+            t.r_outer = rr(sd, 3 * sd);
+            if (rnd() < 0.4) t.r_inner = rr(0.5, 0.9) * t.r_outer;
+        } else {                              /* a sphere */
+            t.shape = TRACE_SPHERE;
+            t.at[2] = z + 2;
+            t.at[0] = rr(-5, 5);
+            t.radius = rr(1, 3);
+        }
+        if (rnd() < 0.08) t.at[0] = 0.5;      /* decentred */
+        if (rnd() < 0.05) t.axis[1] = 0.1;    /* tilted */
+        double k = rnd();
+        if (k < 0.08) m.kind = TRACE_MIRROR;
+        else if (k < 0.15) m.kind = TRACE_ABSORB;
+        else if (k < 0.2) m.kind = TRACE_DETECT;
+        tr->add_surface(sc, &t, &m);
+        z += rnd() < 0.2 ? rr(0, 1) : rr(2, 8);   /* sometimes within the last's sag */
+    }
+    if (rnd() < 0.3) {                        /* a mesh somewhere along the way */
+        double zm = rr(-5, z + 5), v[9] = {-8, -8, zm, 8, -8, zm + 0.5, 0, 8, zm};
+        trace_mesh mesh = {v, 3, NULL, 1, NULL, NULL, 0};
+        trace_material g = {TRACE_REFRACT, 1, 1.3};
+        tr->add_mesh(sc, &mesh, &g);
+    }
+    trace_surface d;
+    trace_material md = {TRACE_DETECT, 1, 1};
+    memset(&d, 0, sizeof d);
+    d.shape = TRACE_PLANE;
+    d.at[2] = z + rr(5, 40);
+    d.axis[2] = 1;
+    d.r_outer = 60;
+    tr->add_surface(sc, &d, &md);
+    trace_source a = {0};
+    a.type = TRACE_SRC_CONE;
+    a.at[0] = rr(-2, 2); a.at[2] = rr(-40, -5); a.dir[2] = 1;
+    a.half_angle = rr(0.02, 0.3); a.rings = 8;
+    tr->add_source(sc, &a, NULL);
+    trace_source b = a;                      /* from the far side, or from inside */
+    b.at[2] = rnd() < 0.5 ? z + rr(1, 4) : rr(0, z);
+    b.dir[2] = rnd() < 0.5 ? -1 : 1;
+    b.rings = 5;
+    tr->add_source(sc, &b, NULL);
+}
+
+static void random_scenes(const trace_api *tr)
+{
+    int bad = 0, found = 0, n = 300;
+    for (int i = 0; i < n; i++) {
+        trace_scene *sc = tr->scene_new();
+        random_scene(tr, sc);
+        int v = i % 3, lens;
+        uint64_t hits;
+        if (!same_both_ways(tr, sc, v != 1, v == 2, &lens, &hits)) {
+            bad++;
+            printf("# random scene %d (Fresnel %d, reflections %d) differs\n", i, v != 1,
+                   v == 2);
+        }
+        found += lens > 0;
+        tr->scene_free(sc);
+    }
+    CHECK(bad == 0 && found > n / 4 && found < n,
+          "%d random scenes (lens found in %d): the lens path gives the BVH's bits", n,
+          found);
 }
 
 int main(void)
@@ -148,5 +247,6 @@ int main(void)
     CHECK(ok && lens == 0, "a tilted sheet through the whole lens: no lens path (%d), the "
           "BVH's bits", lens);
     tr->scene_free(sc);
+    random_scenes(tr);
     return unit_failed();
 }
