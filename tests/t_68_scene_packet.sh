@@ -188,6 +188,24 @@ if [ -f "$TOP/build/lib/lensmat-trace.so" ]; then
     check "scene lens path: sources from the far side" pk_modes farside 3 "$PK/farside.body"
     check "scene lens path: rays starting inside the lens" pk_modes inside 3 "$PK/inside.body"
 fi
+# the example scenes: every output they name the same both ways
+pk_examples() {
+    for e in singlet opticrt periscope prism; do
+        d=$PK/ex_$e
+        rm -rf "$d"
+        trace_session "$BIN" "$d/pk" scene "$TOP/scenes/$e.scene" n || { cat "$d/pk/err"; return 1; }
+        LENSMAT_TRACE_BVH=1 trace_session "$BIN" "$d/bvh" scene "$TOP/scenes/$e.scene" n ||
+            { cat "$d/bvh/err"; return 1; }
+        for f in $(ls "$d/pk"); do
+            case $f in in|out|err) continue ;; esac
+            cmp "$d/pk/$f" "$d/bvh/$f" || { echo "$e: $f differs"; return 1; }
+        done
+    done
+    grep -q '^Sequential lens: 3 surfaces' "$PK/ex_singlet/pk/out" || { echo "singlet: no lens found"; return 1; }
+}
+if [ -f "$TOP/build/lib/lensmat-trace.so" ]; then
+    check "scene lens path: the example scenes, every output the same both ways" pk_examples
+fi
 if [ -f "$TOP/build/asan/lib/lensmat-trace.so" ]; then
     pk_asan() {
         { cat "$PK/mesh.body"; pk_outputs; } > "$PK/asan.scene"
