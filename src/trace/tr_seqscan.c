@@ -13,10 +13,13 @@
  *     on one axis line (the same vertex x and y), of the four known kinds;
  *   - their z ranges (the shapes' padded boxes), merged where they overlap, make slabs
  *     with gaps between them, at most four surfaces in two consecutive slabs (a face
- *     and its mount, then the next face and its mount; or two faces of a cemented
- *     doublet that overlap in z, then the next face);
- *   - nothing else in the scene (meshes, spheres, tilted or decentred surfaces,
- *     surfaces of a slab with three) reaches into the z range of the slabs taken.
+ *     and its mount, then the next face and its mount; or the two faces of a
+ *     meniscus, which overlap in z, then the next face);
+ *   - nothing else in the scene (meshes, spheres, tilted, decentred or aspheric
+ *     surfaces, unknown kinds) reaches into the z range of the slabs taken.
+ * Ties: Embree's analytic hits go to the lower surface id at an equal distance
+ * (tr_hit.c), and the candidates named here are in id order within a slab (ties
+ * between slabs cannot happen: they are disjoint), the first taken at a tie.
  * The run of consecutive slabs with the most refracting conics is taken, if it has
  * two at least (else the scene has no lens: every segment goes through Embree), from
  * its first slab with a refracting surface.  A ray from a source meets that slab first
@@ -32,7 +35,7 @@
 
 /* A tripwire: the lens path knows every field of a material.  A new one (an
  * absorption coefficient, a dispersion) must be taught to tr_packet.c and tr_trace.c
- * alike -- or refused here (not_lens below) -- before this builds again. */
+ * alike -- or refused here (lens_kind below) -- before this builds again. */
 struct tr_seq_known_material { int kind; double n_front, n_back; };
 _Static_assert(sizeof(trace_material) == sizeof(struct tr_seq_known_material),
                "trace_material has a new field: teach tr_seqscan.c whether the lens "
@@ -55,7 +58,6 @@ _Static_assert(sizeof(tr_wray) == sizeof(struct tr_seq_known_ray),
 typedef struct zr {
     double lo, hi;             /* z range, padded */
     int id;
-    int lens;                  /* may be a lens surface (on the axis, fast shape) */
 } zr;
 
 static int by_lo(const void *a, const void *b)
@@ -175,7 +177,7 @@ void tr_seq_detect(trace_scene *sc)
     double ax = 0, ay = 0;
     int n = sc->nsurf;
     zr *z = NULL;
-    int *slab = NULL;          /* slab k: members z[first[k] .. first[k+1]) */
+    int *slab = NULL;          /* slab k: members z[slab[k] .. slab[k+1]) */
     clear_hints(sc);
     if (n < 2 || sc->ngroup || !pick_axis(sc, &ax, &ay)) goto none;
     z = malloc((size_t)n * sizeof *z);
@@ -184,10 +186,10 @@ void tr_seq_detect(trace_scene *sc)
     int nl = 0, nb = 0;
     for (int i = 0; i < n; i++) {             /* lens candidates first, the rest after */
         const tr_surf *f = sc->surf[i];
-        if (lens_kind(f, ax, ay)) { z[nl].id = i; z[nl].lens = 1; nl++; }
+        if (lens_kind(f, ax, ay)) z[nl++].id = i;
     }
     for (int i = 0; i < n; i++)
-        if (!lens_kind(sc->surf[i], ax, ay)) { z[nl + nb].id = i; z[nl + nb].lens = 0; nb++; }
+        if (!lens_kind(sc->surf[i], ax, ay)) { z[nl + nb].id = i; nb++; }
     for (int i = 0; i < n; i++) z_range(sc->surf[z[i].id], &z[i].lo, &z[i].hi);
     qsort(z, (size_t)nl, sizeof *z, by_lo);
     /* slabs: lens candidates whose ranges overlap, transitively */
@@ -235,8 +237,7 @@ void tr_seq_detect(trace_scene *sc)
         best0++;
     }
     /* the hints: a refracting surface of slab k may meet slab k's and slab k+1's
-     * members next (in the order they were added: ties go to the first, as Embree's
-     * first-found does for add_lens's lens-then-mount order) */
+     * members next, each slab's in id order (ties go to the lower id, as in Embree) */
     for (int k = best0; k <= best1; k++) {
         int cand[4], nc = 0;
         for (int kk = k; kk <= k + 1 && kk <= best1; kk++) {
