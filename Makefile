@@ -104,6 +104,7 @@ build/bench/%: tests/bench/%.c | $(DEPS)
 bench: lensmat build/original/lensmat build/bench/benchrun build/bench/baseline \
        build/obj/bench_paraxial \
        build/obj/bench_glass \
+       build/obj/unit_published \
        $(MODULE_BENCH_BINS)
 	@sh scripts/bench.sh
 

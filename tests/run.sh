@@ -46,6 +46,7 @@ for only in ${ONLY:-t_}; do
     for t in "$TOP"/tests/$only*.sh; do
         [ -f "$t" ] || continue
         [ -n "$VERBOSE" ] && echo "== $(basename "$t")"
+        cd "$TOP"    # a check that cd'd elsewhere must not move the next group
         . "$t"
     done
 done

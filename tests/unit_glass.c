@@ -170,6 +170,87 @@ static void achromat(void)
           c.long_colour, single.long_colour);
 }
 
+/* Internal transmittance (data/glass.txt tau lines) and px_glass_absorption. */
+static void transmittance(void)
+{
+    const px_tau_rec *t;
+    double a, b, lo, hi;
+    int tables = 0, points = 0, worst_i = 0;
+    double worst = 0;
+    /* every tabulated point comes back: exp(-alpha d) = t at d = the table's thickness,
+     * and Beer-Lambert's scaling to 10 mm: t10 = t^(10/d) */
+    for (int i = 0; i < px_glass_count(); i++) {
+        const char *name = px_glass_at(i)->name;
+        for (int k = 0; (t = px_glass_tau(name, k)); k++, tables++)
+            for (int j = 0; j < t->n; j++) {
+                if (!(t->t[j] > 0)) continue;
+                points++;
+                if (px_glass_absorption(name, t->l[j], &a) != PX_OK) { worst = 1; continue; }
+                double e;
+                if (t->thickness == 0) {    /* a k table: alpha = 4 pi k / lambda */
+                    double want = 4 * 3.14159265358979 * t->t[j] / (t->l[j] * 1e-3);
+                    e = fabs(a - want) / want;
+                } else {
+                    double back = exp(-a * t->thickness), t10 = exp(-10 * a);
+                    e = fabs(back - t->t[j]) + fabs(t10 - pow(t->t[j], 10 / t->thickness));
+                }
+                if (e > worst) { worst = e; worst_i = j; }
+            }
+    }
+    CHECK(tables >= 5 && points >= 100, "%d transmittance tables, %d points", tables, points);
+    CHECK(worst < 1e-12, "every tabulated transmittance reproduced, and its 10 mm value "
+          "consistent (worst error %.2g at point %d)", worst, worst_i);
+    /* against an independent reduction of SCHOTT's data: refractiveindex.info's
+     * extinction coefficient k of N-BK7 (from the 2017-01-20 SCHOTT catalogue), alpha =
+     * 4 pi k / lambda; its 5 digits against the catalogue's 3 */
+    {
+        static const double lk[][2] = {{0.310, 1.3679e-6}, {0.400, 1.0227e-8},
+                                       {1.970, 1.0933e-6}, {2.500, 8.1300e-6}};
+        for (int i = 0; i < 4; i++) {
+            double ref = 4 * 3.14159265358979 * lk[i][1] / (lk[i][0] * 1e-3);
+            CHECK(px_glass_absorption("n-bk7", lk[i][0], &a) == PX_OK &&
+                  fabs(a - ref) <= 2e-3 * ref + 1e-6,
+                  "N-BK7 alpha(%.3f um) = %.5g /mm, refractiveindex.info %.5g", lk[i][0], a,
+                  ref);
+        }
+    }
+    /* between points ln t is linear in lambda: halfway, alpha is the mean */
+    CHECK(px_glass_absorption("N-BK7", 0.305, &a) == PX_OK &&
+          fabs(a - (-log(0.05) - log(0.25)) / 2 / 25) < 1e-15,
+          "N-BK7 alpha(0.305) is the mean of its neighbours' (%.6g /mm)", a);
+    CHECK(px_glass_absorption("N-BK7", 0.6328, &a) == PX_OK && a > 0 && a < 1e-3,
+          "N-BK7 at the rig's 632.8 nm: alpha %.3g /mm (internal transmittance %.4f over "
+          "10 mm)", a, exp(-10 * a));
+    /* absorption rises steeply into the UV edge */
+    CHECK(px_glass_absorption("N-BK7", 0.33, &a) == PX_OK &&
+          px_glass_absorption("N-BK7", 0.5, &b) == PX_OK && a > 20 * b,
+          "N-BK7 absorbs more at 330 nm than at 500 nm (%.3g vs %.3g /mm)", a, b);
+    /* water from its extinction coefficient (Hale & Querry): 0.025 /m at 500 nm, and
+     * the red absorbs some 15 times more than the blue-green */
+    CHECK(px_glass_absorption("water", 0.5, &a) == PX_OK &&
+          fabs(a - 4 * 3.14159265358979 * 1e-9 / 5e-4) < 1e-18,
+          "water at 500 nm: alpha %.4g /m (Hale & Querry's k 1e-9)", a * 1e3);
+    CHECK(px_glass_absorption("WATER", 0.6328, &b) == PX_OK && b > 10 * a,
+          "water at 632.8 nm: alpha %.4g /m, %.0f times 500 nm's", b * 1e3, b / a);
+    CHECK(px_glass_absorption_range("water", &lo, &hi) == PX_OK && lo == 0.2 && hi == 1.2,
+          "water's absorption data span 0.2-1.2 um");
+    /* the range, and refusals */
+    CHECK(px_glass_absorption_range("N-BK7", &lo, &hi) == PX_OK && lo == 0.3 && hi == 2.5,
+          "N-BK7 transmittance data span 0.3-2.5 um");
+    CHECK(px_glass_absorption_range("F2", &lo, &hi) == PX_OK && lo == 0.334,
+          "F2's range starts at its first non-zero point (%.3f um)", lo);
+    CHECK(px_glass_absorption("N-BK7", 0.29, &a) == PX_GLASS_RANGE,
+          "N-BK7 at 290 nm: outside its data, refused");
+    CHECK(px_glass_absorption("N-BK7", 2.6, &a) == PX_GLASS_RANGE, "N-BK7 at 2.6 um refused");
+    CHECK(px_glass_absorption("F2", 0.325, &a) == PX_GLASS_RANGE,
+          "F2 below its first transparent point refused");
+    CHECK(px_glass_absorption("N-SF6", 0.5, &a) == PX_NO_TAU, "a glass without data: NO_TAU");
+    CHECK(px_glass_absorption("1.5168/64.17", 0.5, &a) == PX_NO_TAU, "a model glass: NO_TAU");
+    CHECK(px_glass_absorption("unobtainium", 0.5, &a) == PX_NO_GLASS, "an unknown name");
+    CHECK(px_glass_absorption("N-BK7", -1, &a) == PX_BAD &&
+          px_glass_absorption("N-BK7", NAN, &a) == PX_BAD, "a wavelength that is no number");
+}
+
 int main(void)
 {
     published_values();
@@ -178,5 +259,6 @@ int main(void)
     model_glass();
     singlet();
     achromat();
+    transmittance();
     return unit_failed();
 }

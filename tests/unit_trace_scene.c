@@ -285,6 +285,47 @@ static void point_source(void)
           "point rays fill the disc of radius 5 (outermost %.12g), unit, equal power", far);
 }
 
+/* Glasses for indices and wavelengths for sources (issue 14). */
+static void glasses_and_wavelengths(void)
+{
+    static const char text[] =
+        "cap refract 1 n-bk7 vertex 0 0 0 radius 50 aperture 10\n"
+        "cap refract glass N-BK7 1.5168/64.17 vertex 0 0 5 radius -50 aperture 10\n"
+        "plane detect at 0 0 60 normal 0 0 1 disc 30\n"
+        "source ray from 0 0 -5 dir 0 0 1 lambda F d C 632.8 0.5 medium water\n"
+        "source ray from 0 0 -5 dir 0 0 1\n";
+    char err[SC_ERRMAX];
+    sc_scene sc;
+    int rc = sc_parse_scene(text, sizeof text - 1, "wl.scene", &sc, err);
+    CHECK(rc == 0, "a scene with glasses and wavelengths reads (%s)", rc ? err : "ok");
+    if (rc) return;
+    CHECK(!strcmp(sc.surf[0].glass[0], "") && !strcmp(sc.surf[0].glass[1], "N-BK7") &&
+          sc.surf[0].n1 == 1 && fabs(sc.surf[0].n2 - 1.5168) < 1e-5,
+          "refract 1 n-bk7: a number and the catalogue's N-BK7 (n at d %.6f)", sc.surf[0].n2);
+    CHECK(!strcmp(sc.surf[1].glass[0], "N-BK7") && !strcmp(sc.surf[1].glass[1], "1.5168/64.17"),
+          "refract glass N-BK7 1.5168/64.17: a glass after the word glass, a model glass");
+    CHECK(sc.source[0].nlambda == 5 && sc.source[0].lambda[0] == PX_LAMBDA_F &&
+          sc.source[0].lambda[2] == PX_LAMBDA_C && fabs(sc.source[0].lambda[3] - 0.6328) < 1e-15 &&
+          sc.source[0].lambda[4] == 0.5 && !strcmp(sc.source[0].glass, "WATER"),
+          "lambda F d C 632.8 0.5: five wavelengths in um; medium water is the catalogue's");
+    CHECK(sc.named_wl == 1 && sc.source[1].nlambda == 0, "the scene names wavelengths");
+    CHECK(sc.nmismatch == 0, "N-BK7 after surface 1 and N-BK7 before surface 2 agree");
+    sc_free(&sc);
+    refused("plane refract 1 N-BK8 at 0 0 0 normal 0 0 1 disc 9\n"
+            "source ray from 0 0 -1 dir 0 0 1\n", "'N-BK8' is neither a number nor a glass");
+    refused("plane refract 1 glass at 0 0 0 normal 0 0 1 disc 9\n"
+            "source ray from 0 0 -1 dir 0 0 1\n", "'glass' needs a glass name");
+    refused("plane refract 1 1.5 at 0 0 0 normal 0 0 1 disc 9\n"
+            "source ray from 0 0 -1 dir 0 0 1 lambda\n", "needs at least one wavelength");
+    refused("plane refract 1 1.5 at 0 0 0 normal 0 0 1 disc 9\n"
+            "source ray from 0 0 -1 dir 0 0 1 lambda 0.05\n", "'0.05' is not a wavelength");
+    refused("plane refract 1 1.5 at 0 0 0 normal 0 0 1 disc 9\n"
+            "source ray from 0 0 -1 dir 0 0 1 lambda 1 2 3 4 5 6 7 8 9\n",
+            "more than 8 wavelengths");
+    refused("plane refract 1 1.5 at 0 0 0 normal 0 0 1 disc 9\n"
+            "source ray from 0 0 -1 dir 0 0 1 medium 1.6/2\n", "neither a number nor a glass");
+}
+
 int main(void)
 {
     good_scene();
@@ -293,5 +334,6 @@ int main(void)
     obj_files();
     tessellation();
     point_source();
+    glasses_and_wavelengths();
     return unit_failed();
 }

@@ -1,6 +1,7 @@
 /* glass.c -- the glass catalogue (data/glass.txt, compiled in by scripts/gen_glass.sh),
- * indices of catalogue and model glasses at a wavelength, wavelength shorthands and
- * Abbe numbers.  Pure functions: no I/O. */
+ * indices of catalogue and model glasses at a wavelength, wavelength shorthands, Abbe
+ * numbers, and absorption from the catalogue's internal-transmittance tables.  Pure
+ * functions: no I/O. */
 #include <ctype.h>
 #include <math.h>
 #include <stdlib.h>
@@ -119,5 +120,76 @@ int px_glass_abbe(const char *name, double *vd)
         (r = px_glass_index(name, PX_LAMBDA_C, &nc)) != PX_OK) return r;
     if (nf == nc) return PX_BAD;             /* no dispersion: Vd infinite */
     *vd = (nd - 1) / (nf - nc);
+    return PX_OK;
+}
+
+const px_tau_rec *px_glass_tau(const char *name, int k)
+{
+    for (int i = 0; i < PX_NTAU; i++)
+        if (!strcasecmp(name, px_tau_table[i].name) && k-- == 0) return &px_tau_table[i];
+    return NULL;
+}
+
+/* The thickest table of a glass (a k table only when it has no other); NULL with *rc
+ * set when there is none. */
+static const px_tau_rec *thickest(const char *name, int *rc)
+{
+    const px_tau_rec *best = NULL, *t;
+    for (int k = 0; (t = px_glass_tau(name, k)); k++)
+        if (!best || t->thickness > best->thickness) best = t;
+    if (!best) *rc = px_glass_find(name) || px_glass_index(name, PX_LAMBDA_D, &(double){0})
+                     == PX_OK ? PX_NO_TAU : PX_NO_GLASS;
+    return best;
+}
+
+/* The first and last points with t > 0 (the table's usable span), or -1.  (A k table
+ * is usable throughout.) */
+static int span(const px_tau_rec *t, int *last)
+{
+    int i0 = 0, i1 = t->n - 1;
+    if (t->thickness > 0) {
+        while (i0 < t->n && !(t->t[i0] > 0)) i0++;
+        while (i1 > i0 && !(t->t[i1] > 0)) i1--;
+    }
+    *last = i1;
+    return i0 < t->n ? i0 : -1;
+}
+
+/* alpha (1/mm) at point i of a table. */
+static double alpha_at(const px_tau_rec *t, int i)
+{
+    if (t->thickness > 0) return -log(t->t[i]) / t->thickness;
+    return 4 * 3.14159265358979323846 * t->t[i] / (t->l[i] * 1e-3);
+}
+
+int px_glass_absorption_range(const char *name, double *lmin, double *lmax)
+{
+    int rc = PX_OK, i0, i1;
+    const px_tau_rec *t = thickest(name, &rc);
+    if (!t) return rc;
+    if ((i0 = span(t, &i1)) < 0) return PX_GLASS_RANGE;
+    *lmin = t->l[i0];
+    *lmax = t->l[i1];
+    return PX_OK;
+}
+
+/* alpha (so ln t) is linear in lambda between neighbouring points (a zero inside the
+ * span, an opaque point between transparent ones, makes alpha infinite there). */
+int px_glass_absorption(const char *name, double l, double *alpha)
+{
+    int rc = PX_OK, i0, i1, i;
+    const px_tau_rec *t = thickest(name, &rc);
+    if (!(l > 0) || !isfinite(l)) return PX_BAD;
+    if (!t) return rc;
+    if ((i0 = span(t, &i1)) < 0 || l < t->l[i0] || l > t->l[i1]) return PX_GLASS_RANGE;
+    for (i = i0; i < i1 && l > t->l[i + 1]; i++) {}
+    if (i == i1 || l == t->l[i]) {
+        *alpha = alpha_at(t, i);
+    } else {
+        double a = alpha_at(t, i), b = alpha_at(t, i + 1);
+        double u = (l - t->l[i]) / (t->l[i + 1] - t->l[i]);
+        *alpha = a + u * (b - a);
+    }
+    if (*alpha < 0) *alpha = 0;       /* t = 1 printed: -log(1) = -0 */
     return PX_OK;
 }

@@ -330,6 +330,28 @@ int px_wavelength(const char *tok, double *um);
 /* Abbe number (nd - 1)/(nF - nC) of a glass (PX_GLASS_RANGE if F or C is outside). */
 int px_glass_abbe(const char *name, double *vd);
 
+/* Internal transmittance (data/glass.txt "tau" lines): a table of a glass's internal
+ * transmittance t[i] of a sample `thickness` mm thick at l[i] um (ascending); or
+ * ("k" lines, thickness 0) of its extinction coefficient k: alpha = 4 pi k / lambda. */
+#define PX_TAU_MAX 40
+typedef struct px_tau_rec {
+    const char *name;
+    double thickness;          /* mm; 0: t[] holds extinction coefficients k */
+    int n;
+    double l[PX_TAU_MAX], t[PX_TAU_MAX];
+} px_tau_rec;
+enum { PX_NO_TAU = 6 };        /* a glass (or medium) without transmittance data */
+/* The k-th table (0, 1, ...) of a glass (case-insensitive name), or NULL. */
+const px_tau_rec *px_glass_tau(const char *name, int k);
+/* The absorption coefficient alpha (1/mm; intensity falls as exp(-alpha L)) of a
+ * catalogue glass at lambda_um: -ln(t)/thickness of its thickest table (4 pi k/lambda
+ * of a k table, used when it has no transmittance table), alpha (so ln t) linear in
+ * lambda between the tabulated points.  PX_OK; PX_NO_TAU (no data: a model glass, a
+ * number, a glass without a table), PX_NO_GLASS, PX_GLASS_RANGE (outside the span of
+ * points with t > 0, which px_glass_absorption_range gives), PX_BAD. */
+int px_glass_absorption(const char *name, double lambda_um, double *alpha);
+int px_glass_absorption_range(const char *name, double *lmin, double *lmax);
+
 /* A prescription by thickness, per wavelength (colour.c): surface i has radius r
  * (0 or +-inf: plane), the medium `glass` (a catalogue or model glass name) to its
  * right, and thickness t to the next surface (the last surface's t is ignored).
@@ -373,8 +395,16 @@ typedef struct px_seidel {
     int nsurf;
     px_seidel_sums surf[PX_SEIDEL_MAXSURF], total;
     double u_last, n_last, h;  /* image-space marginal slope and index; H */
+    double ybar1;              /* chief-ray height at surface 1 (entrance pupil at
+                                  z = -ybar1/ubar1 from surface 1) */
+    int stop;                  /* the aperture stop (0-based surface) */
 } px_seidel;
 int px_seidel_run(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
                   double ubar1, px_seidel *out);
+/* The same with the aperture stop at surface `stop` (0-based; 0 is px_seidel_run):
+ * the chief ray enters at slope ubar1 and height ybar1 chosen so that it crosses
+ * the axis at the stop's vertex (PX_BAD if the stop is imaged at infinity). */
+int px_seidel_run_stop(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
+                       double ubar1, int stop, px_seidel *out);
 
 #endif

@@ -1,7 +1,9 @@
 /* seidel.c -- third-order (Seidel) aberration sums of a prescription by thickness:
- * a paraxial marginal and chief ray traced at the d line, each surface's
+ * a paraxial marginal and chief ray traced at the d line (the chief ray aimed at the
+ * centre of the aperture stop, which may be any surface), each surface's
  * contribution in Welford's forms (see paraxial.h), and the chromatic sums from the
- * catalogue's nF - nC. */
+ * catalogue's nF - nC.  Checked against ray-optics' published table for Sasian's
+ * Cooke triplet in tests/unit_published.c. */
 #include <math.h>
 #include <string.h>
 #include "paraxial.h"
@@ -18,16 +20,54 @@ static int medium(const char *g, double *n, double *dn)
     return PX_OK;
 }
 
+/* Height at surface `stop` of the paraxial ray that leaves surface 1 at height y
+ * with slope u (object space); PX_OK or an error. */
+static int height_at(const px_csurf *s, int stop, const char *obj_glass, double y,
+                     double u, double *h)
+{
+    double n, n2, dn;
+    int r;
+    if ((r = medium(obj_glass, &n, &dn)) != PX_OK) return r;
+    for (int k = 0; k < stop; k++) {
+        double c = (s[k].r == 0 || isinf(s[k].r)) ? 0 : 1 / s[k].r;
+        if ((r = medium(s[k].glass, &n2, &dn)) != PX_OK) return r;
+        u = (n * u - y * c * (n2 - n)) / n2;
+        n = n2;
+        if (!(s[k].t >= 0) || !isfinite(s[k].t)) return PX_BAD;
+        y += s[k].t * u;
+    }
+    *h = y;
+    return PX_OK;
+}
+
 int px_seidel_run(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
                   double ubar1, px_seidel *out)
+{
+    return px_seidel_run_stop(s, nsurf, obj_glass, y1, ubar1, 0, out);
+}
+
+int px_seidel_run_stop(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
+                       double ubar1, int stop, px_seidel *out)
 {
     double n, dn, y = y1, u = 0, yb = 0, ub = ubar1;
     int r;
     memset(out, 0, sizeof *out);
-    if (nsurf < 1 || nsurf > PX_SEIDEL_MAXSURF || !isfinite(y1) || !isfinite(ubar1))
+    if (nsurf < 1 || nsurf > PX_SEIDEL_MAXSURF || !isfinite(y1) || !isfinite(ubar1) ||
+        stop < 0 || stop >= nsurf)
         return PX_BAD;
     if ((r = medium(obj_glass, &n, &dn)) != PX_OK) return r;
+    if (stop > 0) {
+        /* Paraxial rays are linear in (height, slope) at surface 1: the chief ray is
+         * the combination of (0, ubar1) and (1, 0) that meets the stop on the axis. */
+        double ha, hb;
+        if ((r = height_at(s, stop, obj_glass, 0, ubar1, &ha)) != PX_OK ||
+            (r = height_at(s, stop, obj_glass, 1, 0, &hb)) != PX_OK) return r;
+        if (hb == 0 || !isfinite(ha / hb)) return PX_BAD;   /* stop imaged at infinity */
+        yb = -ha / hb;
+    }
     out->nsurf = nsurf;
+    out->stop = stop;
+    out->ybar1 = yb;
     out->h = n * (ub * y - u * yb);
     for (int k = 0; k < nsurf; k++) {
         double n2, dn2, c = (s[k].r == 0 || isinf(s[k].r)) ? 0 : 1 / s[k].r;

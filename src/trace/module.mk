@@ -13,6 +13,22 @@ TRACE_BENCH := $(wildcard tests/trace/bench_*.c)
 TRACE_TBIN  := $(patsubst tests/trace/%.c,build/obj/trace_tests/%,$(TRACE_TESTS)) \
                $(patsubst tests/trace/%.c,build/asan/trace_tests/%,$(TRACE_TESTS))
 TRACE_BBIN  := $(patsubst tests/trace/%.c,build/obj/trace_tests/%,$(TRACE_BENCH))
+# The scene front end names glasses: the paraxial engine's catalogue (src/paraxial,
+# libc and libm only) goes into the module as a static archive of position-independent,
+# hidden objects (only what glass.c needs is linked; nothing of it is exported).
+TRACE_PX    := $(wildcard src/paraxial/*.c)
+TRACE_PXA   := build/obj/trace/px/libpx.a
+TRACE_SPXA  := build/asan/trace/px/libpx.a
+build/obj/trace/px/%.o: src/paraxial/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@
+build/asan/trace/px/%.o: src/paraxial/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@
+$(TRACE_PXA): $(patsubst src/paraxial/%.c,build/obj/trace/px/%.o,$(TRACE_PX))
+	rm -f $@; ar rcs $@ $^
+$(TRACE_SPXA): $(patsubst src/paraxial/%.c,build/asan/trace/px/%.o,$(TRACE_PX))
+	rm -f $@; ar rcs $@ $^
 
 # The engine's own files (tr_*.c) are the hot loop of every trace: -O3, sqrt inlined
 # without the errno call (-fno-math-errno: same values), and link-time optimisation
@@ -30,12 +46,13 @@ build/asan/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(SAN) -fPIC -pthread -MMD -MP -c $< -o $@
 
-build/lib/lensmat-trace.so: $(TRACE_OBJ)
+build/lib/lensmat-trace.so: $(TRACE_OBJ) $(TRACE_PXA)
 	@mkdir -p $(@D)
-	$(CC) -shared $(OPT) $(TRACE_HOT) -ffp-contract=off -o $@ $(TRACE_OBJ) $(TRACE_LIBS)
-build/asan/lib/lensmat-trace.so: $(TRACE_SOBJ)
+	$(CC) -shared $(OPT) $(TRACE_HOT) -ffp-contract=off -o $@ $(TRACE_OBJ) $(TRACE_PXA) \
+	    $(TRACE_LIBS)
+build/asan/lib/lensmat-trace.so: $(TRACE_SOBJ) $(TRACE_SPXA)
 	@mkdir -p $(@D)
-	$(CC) -shared $(SAN) -o $@ $(TRACE_SOBJ) $(TRACE_LIBS)
+	$(CC) -shared $(SAN) -o $@ $(TRACE_SOBJ) $(TRACE_SPXA) $(TRACE_LIBS)
 
 # Engine tests and benches talk to the module through trace.h only (linked to the .so).
 build/obj/trace_tests/%: tests/trace/%.c build/lib/lensmat-trace.so src/trace/trace.h
@@ -50,4 +67,32 @@ build/asan/trace_tests/%: tests/trace/%.c build/asan/lib/lensmat-trace.so src/tr
 all: build/lib/lensmat-trace.so
 MODULE_TEST_BINS  += build/lib/lensmat-trace.so build/asan/lib/lensmat-trace.so $(TRACE_TBIN)
 MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
--include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d)
+-include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d) \
+    $(patsubst src/paraxial/%.c,build/obj/trace/px/%.d,$(TRACE_PX))
+
+# Issue 13: the engine built for the x86-64 baseline (-march=x86-64: SSE2, no AVX
+# outside the two kernels tr_isa.c chooses at load) in its own folder build/x86-64/,
+# at -O1 without LTO to stay cheap; tests/t_61_trace_ports.sh runs its tests and
+# checks its objects for AVX instructions.
+ifeq ($(shell uname -m),x86_64)
+TRACE_X86   := -O1 -march=x86-64 -mtune=generic
+TRACE_XOBJ  := $(patsubst src/%.c,build/x86-64/%.o,$(TRACE_SRC))
+build/x86-64/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(TRACE_X86) -fPIC -pthread -MMD -MP -c $< -o $@
+build/x86-64/trace/px/%.o: src/paraxial/%.c $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(TRACE_X86) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@
+build/x86-64/trace/px/libpx.a: $(patsubst src/paraxial/%.c,build/x86-64/trace/px/%.o,$(TRACE_PX))
+	rm -f $@; ar rcs $@ $^
+build/x86-64/lib/lensmat-trace.so: $(TRACE_XOBJ) build/x86-64/trace/px/libpx.a
+	@mkdir -p $(@D)
+	$(CC) -shared $(TRACE_X86) -o $@ $(TRACE_XOBJ) build/x86-64/trace/px/libpx.a \
+	    $(TRACE_LIBS)
+build/x86-64/trace_tests/%: tests/trace/%.c build/x86-64/lib/lensmat-trace.so src/trace/trace.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(TRACE_X86) -pthread -Itests -o $@ $< build/x86-64/lib/lensmat-trace.so \
+	    -Wl,-rpath,$(abspath build/x86-64/lib) -lembree3 -lm
+MODULE_TEST_BINS += $(patsubst tests/trace/%.c,build/x86-64/trace_tests/%,$(TRACE_TESTS))
+-include $(TRACE_XOBJ:.o=.d) $(patsubst src/paraxial/%.c,build/x86-64/trace/px/%.d,$(TRACE_PX))
+endif

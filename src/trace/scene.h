@@ -16,6 +16,9 @@ enum sc_source_type { SC_RAY, SC_FAN, SC_POINT, SC_CONE, SC_COLLIMATED, SC_GAUSS
 
 #define SC_MAXCOEF 8
 #define SC_ERRMAX 1024
+#define SC_GLASSMAX 32     /* longest glass name + 1 */
+#define SC_MAXWL 8         /* wavelengths of one source */
+#define SC_MAXWLS 64       /* distinct wavelengths of one scene */
 
 /* One surface.  Axial shapes (cap, conic, asphere) have a vertex, a unit axis and a
  * signed radius of curvature (centre at vertex + radius*axis; 0 = flat); their sag
@@ -27,7 +30,10 @@ enum sc_source_type { SC_RAY, SC_FAN, SC_POINT, SC_CONE, SC_COLLIMATED, SC_GAUSS
  * SC_MEDIA: per-triangle n1 n2 from a media file. */
 typedef struct sc_surface {
     int shape, kind;
-    double n1, n2;
+    double n1, n2;        /* refract: the indices (a glass's at the d line) */
+    char glass[2][SC_GLASSMAX];   /* refract: the glass each side names ("": n1/n2 is
+                                     a plain number), indices and absorption taken
+                                     from the catalogue at each traced wavelength */
     double at[3];         /* plane point, sphere centre, axial vertex */
     double axis[3];       /* plane normal, axial direction (unit) */
     double up[3];         /* rectangle orientation (plane only; unit, _|_ axis) */
@@ -64,6 +70,10 @@ typedef struct sc_source {
     int rings;                /* point, cone, gaussian: hexapolar rings */
     double power;             /* total power of the source (default 1) */
     double medium;            /* index where its rays start (default 1) */
+    char glass[SC_GLASSMAX];  /* ... a glass named for it ("": none) */
+    double lambda[SC_MAXWL];  /* its wavelengths, um (`lambda`: nm, um or F d C e g
+                                 hene), in the order given */
+    int nlambda;              /* 0: none named (the d line where a glass needs one) */
     int polarised;            /* 1: linear along pol[] (else unpolarised) */
     double pol[3];
     const char *src;          /* defined at src:line */
@@ -90,6 +100,8 @@ typedef struct sc_scene {
     int mismatch_error;       /* `mismatch error`: rays meeting a surface whose index
                                  on their side differs from theirs fail the trace */
     int nmismatch;            /* media that disagree, found when the scene is read */
+    int named_wl;             /* some source names its wavelengths: outputs carry a
+                                 wavelength column, the trace runs once per wavelength */
     char mismatch_where[256]; /* the first such pair: "FILE:LINE and FILE:LINE" ... */
 } sc_scene;
 

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include "paraxial/paraxial.h"
 #include "scene.h"
 
 #define PI 3.14159265358979323846
@@ -363,8 +364,12 @@ bad:
 /* ---- scene files -------------------------------------------------------------- */
 
 /* The keys a directive may carry, with their number of values.  ARGS_WORD: one
- * word (a file name); ARGS_VAR: numbers up to the next key. */
-enum { ARGS_WORD = -1, ARGS_VAR = -2 };
+ * word (a file name); ARGS_VAR: numbers up to the next key; ARGS_WL: wavelengths up
+ * to the next key (px_wavelength: nm above 100, else um, or F d C e g hene).  The
+ * values of `refract` and `medium` are indices: a number, or a glass (a catalogue
+ * name, a model glass ND/VD, a medium of the seed), optionally after the word
+ * `glass`. */
+enum { ARGS_WORD = -1, ARGS_VAR = -2, ARGS_WL = -3 };
 typedef struct keydef { const char *name; int nargs; } keydef;
 static const keydef keys[] = {
     {"refract", 2}, {"mirror", 0}, {"absorb", 0}, {"detect", 0}, {"media", ARGS_WORD},
@@ -374,7 +379,7 @@ static const keydef keys[] = {
     {"file", ARGS_WORD}, {"sphere", 4},
     {"from", 3}, {"dir", 3}, {"to", 6}, {"angle", 1}, {"rays", 1}, {"rings", 1},
     {"toward", 3}, {"grid", 1}, {"waist", 1}, {"wavelength", 1}, {"trunc", 1},
-    {"power", 1}, {"medium", 1}, {"pol", 3},
+    {"power", 1}, {"medium", 1}, {"pol", 3}, {"lambda", ARGS_WL},
 };
 #define NKEYS (int)(sizeof keys / sizeof keys[0])
 
@@ -384,6 +389,7 @@ typedef struct fields {
     double num[NKEYS][SC_MAXCOEF];
     int count[NKEYS];
     tok word[NKEYS];
+    char glass[NKEYS][2][SC_GLASSMAX];   /* index keys: a glass named ("": a number) */
 } fields;
 
 static int key_index(const tok *t)
@@ -414,6 +420,46 @@ static int word_in(const char *list, const char *w)
     return 0;
 }
 
+static int is_index_key(int k)
+{
+    return !strcmp(keys[k].name, "refract") || !strcmp(keys[k].name, "medium");
+}
+
+/* Does the token look like a number (only the characters of one)? */
+static int tok_numeric(const tok *t)
+{
+    for (size_t i = 0; i < t->n; i++)
+        if (!strchr("0123456789+-.eE", t->s[i])) return 0;
+    return t->n > 0;
+}
+
+/* A glass as an index value at r->t[*i] (after an optional word `glass`): its name
+ * into name, its index at the d line (or mid-range, for a glass with none at d) into
+ * *n; *i is left on its last token.  0 or -1 (error reported). */
+static int index_glass(reader *r, const char *what, int *i, char *name, double *n)
+{
+    const tok *t = &r->t[*i];
+    const px_glass_rec *g;
+    if (tok_is(t, "glass")) {
+        if (*i + 1 == r->nt || key_index(&r->t[*i + 1]) >= 0)
+            return fail(r, "%s: 'glass' needs a glass name", what);
+        t = &r->t[++*i];
+    }
+    if (t->n >= SC_GLASSMAX)
+        return fail(r, "%s: '%.24s...' is too long for a glass name", what, t->s);
+    memcpy(name, t->s, t->n);
+    name[t->n] = '\0';
+    int rc = px_glass_index(name, PX_LAMBDA_D, n);
+    if (rc == PX_GLASS_RANGE && (g = px_glass_find(name)))
+        rc = px_glass_index(name, 0.5 * (g->lmin + g->lmax), n);
+    if (rc != PX_OK)
+        return fail(r, "%s: '%s' is neither a number nor a glass of the catalogue (a name "
+                    "such as N-BK7, a model glass ND/VD such as 1.5168/64.17, or a medium "
+                    "such as water)", what, name);
+    if ((g = px_glass_find(name))) strcpy(name, g->name);   /* the catalogue's spelling */
+    return 0;
+}
+
 /* Parse the items from t[first] on as key/value groups allowed by `allowed`
  * (space-separated key names). */
 static int parse_fields(reader *r, int first, const char *dname, const char *allowed,
@@ -435,6 +481,26 @@ static int parse_fields(reader *r, int first, const char *dname, const char *all
             continue;
         }
         snprintf(what, sizeof what, "%s: '%s'", dname, w);
+        if (keys[k].nargs == ARGS_WL) {
+            while (i < r->nt && key_index(&r->t[i]) < 0) {
+                char b[NUMLEN];
+                double um;
+                snprintf(b, sizeof b, "%.*s", (int)(r->t[i].n < NUMLEN - 1 ? r->t[i].n :
+                                                    NUMLEN - 1), r->t[i].s);
+                if (f->count[k] == SC_MAXWL)
+                    return fail(r, "%s: more than %d wavelengths", dname, SC_MAXWL);
+                if (r->t[i].n >= NUMLEN || px_wavelength(b, &um) != PX_OK)
+                    return fail(r, "%s: '%s' is not a wavelength (nm above 100, else um, "
+                                "or F d C e g hene)", what, b);
+                for (int j = 0; j < f->count[k]; j++)   /* (587.5618 is d) */
+                    if (fabs(f->num[k][j] - um) <= 1e-12 * um)
+                        return fail(r, "%s: wavelength '%s' given twice", what, b);
+                f->num[k][f->count[k]++] = um;
+                i++;
+            }
+            if (!f->count[k]) return fail(r, "%s: '%s' needs at least one wavelength", dname, w);
+            continue;
+        }
         if (keys[k].nargs == ARGS_VAR) {
             while (i < r->nt && key_index(&r->t[i]) < 0) {
                 if (f->count[k] == SC_MAXCOEF)
@@ -449,6 +515,10 @@ static int parse_fields(reader *r, int first, const char *dname, const char *all
             if (i == r->nt || key_index(&r->t[i]) >= 0)
                 return fail(r, "%s: '%s' needs %d number%s, found %d", dname, w,
                             keys[k].nargs, keys[k].nargs == 1 ? "" : "s", j);
+            if (is_index_key(k) && !tok_numeric(&r->t[i])) {
+                if (index_glass(r, what, &i, f->glass[k][j], &f->num[k][j])) return -1;
+                continue;
+            }
             if (tok_num(r, &r->t[i], what, &f->num[k][j])) return -1;
         }
         f->count[k] = keys[k].nargs;
@@ -523,8 +593,10 @@ static int surface_kind(reader *r, const fields *f, const char *dname, sc_surfac
         return fail(r, "%s: give exactly one of refract N1 N2, %smirror, absorb, detect",
                     dname, s->shape == SC_MESH ? "media FILE, " : "");
     if (s->kind == SC_REFRACT) {
+        int k = key_index(&(tok){"refract", 7});
         s->n1 = val(f, "refract")[0];
         s->n2 = val(f, "refract")[1];
+        memcpy(s->glass, f->glass[k], sizeof s->glass);
         if (!(s->n1 > 0) || !(s->n2 > 0))
             return fail(r, "%s: refract %g %g: an index of refraction must be positive",
                         dname, s->n1, s->n2);
@@ -690,15 +762,15 @@ mesh_bad:
 static int read_source(reader *r, sc_scene *sc)
 {
     static const struct { const char *name, *allowed, *required; } types[] = {
-        [SC_RAY] = {"ray", "from dir power medium pol", "from dir"},
-        [SC_FAN] = {"fan", "from dir angle up to rays power medium pol", "from rays"},
-        [SC_POINT] = {"point", "from toward radius rings power medium pol",
+        [SC_RAY] = {"ray", "from dir power medium pol lambda", "from dir"},
+        [SC_FAN] = {"fan", "from dir angle up to rays power medium pol lambda", "from rays"},
+        [SC_POINT] = {"point", "from toward radius rings power medium pol lambda",
                       "from toward radius rings"},
-        [SC_CONE] = {"cone", "from dir angle rings power medium pol",
+        [SC_CONE] = {"cone", "from dir angle rings power medium pol lambda",
                      "from dir angle rings"},
-        [SC_COLLIMATED] = {"collimated", "from dir radius grid power medium pol",
+        [SC_COLLIMATED] = {"collimated", "from dir radius grid power medium pol lambda",
                            "from dir radius grid"},
-        [SC_GAUSSIAN] = {"gaussian", "from dir waist wavelength rings trunc power medium pol",
+        [SC_GAUSSIAN] = {"gaussian", "from dir waist wavelength rings trunc power medium pol lambda",
                          "from dir waist wavelength rings"},
     };
     sc_source s;
@@ -730,7 +802,13 @@ static int read_source(reader *r, sc_scene *sc)
         s.power = val(&f, "power")[0];
         if (positive(r, dname, "power", s.power)) return -1;
     }
+    if (has(&f, "lambda")) {
+        int k = key_index(&(tok){"lambda", 6});
+        s.nlambda = f.count[k];
+        memcpy(s.lambda, f.num[k], (size_t)s.nlambda * sizeof *s.lambda);
+    }
     if (has(&f, "medium")) {
+        memcpy(s.glass, f.glass[key_index(&(tok){"medium", 6})][0], sizeof s.glass);
         s.medium = val(&f, "medium")[0];
         if (!(s.medium > 0))
             return fail(r, "%s: medium %g: an index of refraction must be positive", dname,
@@ -1041,6 +1119,23 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
     if (st < 0) goto bad;
     if (!sc->nsurf) { fail(&r, "the scene has no surface"); goto bad; }
     if (!sc->nsource) { fail(&r, "the scene has no source of rays"); goto bad; }
+    {   /* wavelengths: named by some source?  (at most SC_MAXWLS distinct ones) */
+        double seen[SC_MAXWLS];
+        int nseen = 0;
+        for (int i = 0; i < sc->nsource; i++)
+            for (int j = 0; j < sc->source[i].nlambda; j++) {
+                int k = 0;
+                sc->named_wl = 1;
+                while (k < nseen && seen[k] != sc->source[i].lambda[j]) k++;
+                if (k < nseen) continue;
+                if (nseen == SC_MAXWLS) {
+                    snprintf(err, SC_ERRMAX, "%s:%ld: more than %d different wavelengths "
+                             "in one scene", sc->name, sc->source[i].line, SC_MAXWLS);
+                    goto bad;
+                }
+                seen[nseen++] = sc->source[i].lambda[j];
+            }
+    }
     if (axial_pairs(sc, err)) goto bad;
     if (sc_check_coincident(sc, err)) goto bad;     /* with both lines */
     return 0;

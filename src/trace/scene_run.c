@@ -2,8 +2,11 @@
  * into the engine's surfaces, meshes and sources (trace.h), runs it, and writes
  * what the scene asked for: ray segments in the seed's p.l form (two "x y z" lines
  * per segment), detector hits as CSV, a summary; a progress line on stderr for long
- * traces on a terminal.  Also the error-against-run-time table.  Exports the table
- * lm_scene_api() that the dialogue loads. */
+ * traces on a terminal.  A scene whose sources name wavelengths is traced once per
+ * wavelength, each run with the indices and absorption of its glasses at that
+ * wavelength from the catalogue (src/paraxial/glass.c), so every run's indices are
+ * uniform (the engine's fast paths stay as they are).  Also the error-against-run-time
+ * table.  Exports the table lm_scene_api() that the dialogue loads. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -11,6 +14,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "paraxial/paraxial.h"
 #include "scene.h"
 
 #define DEG 0.017453292519943295
@@ -26,14 +30,105 @@ static double now_ms(void)
 
 /* ---- scene -> engine ------------------------------------------------------------ */
 
-static void to_material(const sc_surface *s, trace_material *m)
+/* ---- media at a wavelength ------------------------------------------------------ */
+
+/* The wavelengths a scene traces: those its sources name, in the order first named
+ * (a source naming none is at the d line); one entry 0 when none names any (the scene
+ * traces as it always did: glasses at d, no wavelength column). */
+static int scene_wavelengths(const sc_scene *sc, double *wl)
+{
+    int n = 0;
+    if (!sc->named_wl) { wl[0] = 0; return 1; }
+    for (int i = 0; i < sc->nsource; i++) {
+        const sc_source *s = &sc->source[i];
+        for (int j = 0; j < (s->nlambda ? s->nlambda : 1); j++) {
+            double l = s->nlambda ? s->lambda[j] : PX_LAMBDA_D;
+            int k = 0;
+            while (k < n && wl[k] != l) k++;
+            if (k == n && n < SC_MAXWLS + 1) wl[n++] = l;
+        }
+    }
+    return n;
+}
+
+/* Does source s emit at wavelength l (a run of scene_wavelengths)? */
+static int source_at(const sc_scene *sc, const sc_source *s, double l)
+{
+    if (!sc->named_wl) return 1;
+    if (!s->nlambda) return l == PX_LAMBDA_D;
+    for (int j = 0; j < s->nlambda; j++)
+        if (s->lambda[j] == l) return 1;
+    return 0;
+}
+
+/* The index and absorption coefficient (1/mm: scene lengths are millimetres) of a
+ * medium at l um (0: none named, the d line): a plain number n as it is, transparent;
+ * a glass from the catalogue, absorbing where it has transmittance data.  0, or -1
+ * with "SRC:LINE: why" in err. */
+static int medium_at(const char *glass, double n, double l, const char *src, long line,
+                     double *nout, double *aout, char *err)
+{
+    double um = l > 0 ? l : PX_LAMBDA_D, lo, hi;
+    const px_glass_rec *g;
+    int rc;
+    *nout = n;
+    *aout = 0;
+    if (!glass[0]) return 0;
+    if ((rc = px_glass_index(glass, um, nout)) != PX_OK) {
+        if (rc == PX_GLASS_RANGE && (g = px_glass_find(glass)))
+            snprintf(err, SC_ERRMAX, "%s:%ld: %s has no index at %.10g nm: its formula "
+                     "holds from %.10g to %.10g nm%s", src, line, glass, um * 1e3,
+                     g->lmin * 1e3, g->lmax * 1e3, l > 0 ? "" : " (name the sources' "
+                     "wavelengths: lambda)");
+        else
+            snprintf(err, SC_ERRMAX, "%s:%ld: %s has no index at %.10g nm", src, line,
+                     glass, um * 1e3);
+        return -1;
+    }
+    rc = px_glass_absorption(glass, um, aout);
+    if (rc == PX_NO_TAU) { *aout = 0; return 0; }
+    if (rc == PX_OK) return 0;
+    if (rc == PX_GLASS_RANGE && px_glass_absorption_range(glass, &lo, &hi) == PX_OK)
+        snprintf(err, SC_ERRMAX, "%s:%ld: %s's internal transmittance is known from "
+                 "%.10g to %.10g nm, not at %.10g nm (below, it is nearly opaque)", src, line,
+                 glass, lo * 1e3, hi * 1e3, um * 1e3);
+    else
+        snprintf(err, SC_ERRMAX, "%s:%ld: %s: no transmittance at %.10g nm", src, line,
+                 glass, um * 1e3);
+    return -1;
+}
+
+/* The media of every refracting surface and every source at every wavelength, before
+ * anything is traced or written: 0 or -1 (err). */
+static int check_media(const sc_scene *sc, const double *wl, int nwl, char *err)
+{
+    double n, a;
+    for (int k = 0; k < nwl; k++) {
+        for (int i = 0; i < sc->nsurf; i++) {
+            const sc_surface *s = &sc->surf[i];
+            if (s->kind != SC_REFRACT) continue;
+            if (medium_at(s->glass[0], s->n1, wl[k], s->src, s->line, &n, &a, err) ||
+                medium_at(s->glass[1], s->n2, wl[k], s->src, s->line, &n, &a, err))
+                return -1;
+        }
+        for (int i = 0; i < sc->nsource; i++) {
+            const sc_source *s = &sc->source[i];
+            if (source_at(sc, s, wl[k]) &&
+                medium_at(s->glass, s->medium, wl[k], s->src, s->line, &n, &a, err))
+                return -1;
+        }
+    }
+    return 0;
+}
+
+static void to_material(const sc_surface *s, double n1, double n2, trace_material *m)
 {
     static const int kinds[] = {[SC_REFRACT] = TRACE_REFRACT, [SC_MIRROR] = TRACE_MIRROR,
                                 [SC_ABSORB] = TRACE_ABSORB, [SC_DETECT] = TRACE_DETECT,
                                 [SC_MEDIA] = TRACE_REFRACT};
     m->kind = kinds[s->kind];
-    m->n_front = s->kind == SC_REFRACT ? s->n1 : 1;
-    m->n_back = s->kind == SC_REFRACT ? s->n2 : 1;
+    m->n_front = s->kind == SC_REFRACT ? n1 : 1;
+    m->n_back = s->kind == SC_REFRACT ? n2 : 1;
 }
 
 /* The analytic surface of s (not meshes). */
@@ -79,16 +174,32 @@ static int engine_fail(const trace_api *tr, trace_scene *ts, const char *src, lo
     return -1;
 }
 
+/* Absorption of a surface just added (id) when either medium absorbs. */
+static int set_alpha(const trace_api *tr, trace_scene *ts, int id, double a1, double a2,
+                     const sc_surface *s, char *err)
+{
+    if (id < 0) return engine_fail(tr, ts, s->src, s->line, err);
+    if ((a1 > 0 || a2 > 0) && tr->set_absorption(ts, id, a1, a2) < 0)
+        return engine_fail(tr, ts, s->src, s->line, err);
+    return 0;
+}
+
+/* Surface s with its media at wavelength l (0: none named). */
 static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s,
-                       char *err)
+                       double l, char *err)
 {
     trace_material m;
     trace_surface an;
     trace_mesh mesh;
-    to_material(s, &m);
+    double n1 = s->n1, n2 = s->n2, a1 = 0, a2 = 0;
+    if (s->kind == SC_REFRACT &&
+        (medium_at(s->glass[0], s->n1, l, s->src, s->line, &n1, &a1, err) ||
+         medium_at(s->glass[1], s->n2, l, s->src, s->line, &n2, &a2, err)))
+        return -1;
+    to_material(s, n1, n2, &m);
     if (s->shape != SC_MESH && !s->tessellate) {
         to_surface(s, &an);
-        return tr->add_surface(ts, &an, &m) < 0 ? engine_fail(tr, ts, s->src, s->line, err) : 0;
+        return set_alpha(tr, ts, tr->add_surface(ts, &an, &m), a1, a2, s, err);
     }
     memset(&mesh, 0, sizeof mesh);
     mesh.vertex = s->tri;
@@ -107,10 +218,12 @@ static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s
         mesh.underlying = &an;
         mesh.refine = TRACE_REFINE_FULL;
     }
-    return tr->add_mesh(ts, &mesh, &m) < 0 ? engine_fail(tr, ts, s->src, s->line, err) : 0;
+    return set_alpha(tr, ts, tr->add_mesh(ts, &mesh, &m), a1, a2, s, err);
 }
 
-static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, char *err)
+/* Source s at wavelength l (0: none named). */
+static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, double l,
+                      char *err)
 {
     trace_source t;
     trace_ray *rays = NULL;
@@ -119,7 +232,9 @@ static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, 
     memcpy(t.at, s->from, sizeof t.at);
     memcpy(t.dir, s->dir, sizeof t.dir);
     t.power = s->power;
-    t.n_medium = s->medium;
+    if (medium_at(s->glass, s->medium, l, s->src, s->line, &t.n_medium, &t.alpha_medium, err))
+        return -1;
+    t.lambda = l;
     if (s->polarised) {
         t.pol = TRACE_LINEAR;
         memcpy(t.pol_dir, s->pol, sizeof t.pol_dir);
@@ -194,6 +309,8 @@ typedef struct out {
     void *stop_ctx;
     unsigned records;           /* records written since the last poll */
     int stopped;
+    int wl;                     /* write the wavelength column (the scene names some) */
+    uint64_t ray0;              /* rays of the wavelengths traced before this run */
 } out;
 
 /* Poll the stop callback; 1 (and o->stopped) if the trace must stop. */
@@ -215,22 +332,32 @@ static int w_segment(void *ctx, const trace_segment *s)
 {
     out *o = ctx;
     if (poll_records(o)) return 1;
+    if (o->wl) {
+        double nm = s->lambda * 1e3;
+        return fprintf(o->seg, "%.10g %.10g %.10g %.10g\n%.10g %.10g %.10g %.10g\n",
+                       s->p0[0], s->p0[1], s->p0[2], nm, s->p1[0], s->p1[1], s->p1[2],
+                       nm) < 0;
+    }
     return fprintf(o->seg, "%.10g %.10g %.10g\n%.10g %.10g %.10g\n", s->p0[0], s->p0[1],
                    s->p0[2], s->p1[0], s->p1[1], s->p1[2]) < 0;
 }
 
 static const char hit_header[] =
     "ray,depth,surface,triangle,x,y,z,dx,dy,dz,power_s,power_p,power,length,opl\n";
+static const char hit_header_wl[] =
+    "ray,depth,surface,triangle,x,y,z,dx,dy,dz,power_s,power_p,power,length,opl,lambda_nm\n";
 
 static int w_hit(void *ctx, const trace_hit *h)
 {
     out *o = ctx;
     if (poll_records(o)) return 1;
-    return fprintf(o->hit, "%llu,%d,%d,%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
-                   "%.17g,%.17g,%.17g,%.17g\n", (unsigned long long)h->ray, h->depth,
-                   h->surface, h->prim, h->pos[0], h->pos[1], h->pos[2], h->dir[0],
-                   h->dir[1], h->dir[2], h->power_s, h->power_p, h->power_s + h->power_p,
-                   h->length, h->opl) < 0;
+    if (fprintf(o->hit, "%llu,%d,%d,%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+                "%.17g,%.17g,%.17g,%.17g", (unsigned long long)(h->ray + o->ray0), h->depth,
+                h->surface, h->prim, h->pos[0], h->pos[1], h->pos[2], h->dir[0],
+                h->dir[1], h->dir[2], h->power_s, h->power_p, h->power_s + h->power_p,
+                h->length, h->opl) < 0)
+        return 1;
+    return (o->wl ? fprintf(o->hit, ",%.10g\n", h->lambda * 1e3) : fputs("\n", o->hit)) < 0;
 }
 
 /* A progress line on stderr, only on a terminal and once the trace has run 1 s. */
@@ -239,6 +366,8 @@ static int w_progress(void *ctx, uint64_t done, uint64_t total)
     out *o = ctx;
     double t = now_ms();
     if (stop_now(o)) return 1;
+    done += o->ray0;
+    total += o->ray0;
     if (!o->tty || t - o->t0 < 1000 || (t - o->last < 200 && done < total)) return 0;
     o->last = t;
     o->shown = 1;
@@ -280,7 +409,31 @@ static int finish(FILE *f, const char *part, const char *name, int ok, char *err
     return 0;
 }
 
-static int write_summary(const sc_scene *sc, const trace_summary *s, char *err)
+/* One wavelength's run into the scene's summary (counts and powers add). */
+static void add_summary(trace_summary *a, const trace_summary *b)
+{
+    a->rays += b->rays;
+    a->segments += b->segments;
+    a->interactions += b->interactions;
+    a->tir += b->tir;
+    a->hits += b->hits;
+    a->cut_depth += b->cut_depth;
+    a->cut_power += b->cut_power;
+    a->cut_reflection += b->cut_reflection;
+    a->medium_mismatch += b->medium_mismatch;
+    a->failures += b->failures;
+    if (b->max_depth_seen > a->max_depth_seen) a->max_depth_seen = b->max_depth_seen;
+    a->emitted += b->emitted;
+    a->detected += b->detected;
+    a->absorbed += b->absorbed;
+    a->escaped += b->escaped;
+    a->cutoff += b->cutoff;
+    a->build_ms += b->build_ms;
+    a->trace_ms += b->trace_ms;
+}
+
+static int write_summary(const sc_scene *sc, const trace_summary *s, const double *wl,
+                         const trace_summary *per, int nwl, char *err)
 {
     char *part;
     FILE *f = open_part(sc->out_summary, &part, err);
@@ -297,20 +450,29 @@ static int write_summary(const sc_scene *sc, const trace_summary *s, char *err)
             (unsigned long long)s->failures, (unsigned long long)s->medium_mismatch,
             s->emitted, s->detected, s->absorbed, s->escaped, s->cutoff,
             s->emitted - (s->detected + s->absorbed + s->escaped + s->cutoff));
+    for (int k = 0; sc->named_wl && k < nwl; k++)   /* one line per wavelength */
+        fprintf(f, "wavelength_nm %.10g rays %llu hits %llu emitted %.17g detected %.17g "
+                "absorbed %.17g escaped %.17g cutoff %.17g\n", wl[k] * 1e3,
+                (unsigned long long)per[k].rays, (unsigned long long)per[k].hits,
+                per[k].emitted, per[k].detected, per[k].absorbed, per[k].escaped,
+                per[k].cutoff);
     rc = finish(f, part, sc->out_summary, 1, err);
     free(part);
     return rc;
 }
 
-static int build_scene(const trace_api *tr, const sc_scene *sc, trace_scene **out_ts,
-                       char *err)
+/* The engine's scene at wavelength l (0: none named): every surface with its media at
+ * l, the sources that emit at l. */
+static int build_scene(const trace_api *tr, const sc_scene *sc, double l,
+                       trace_scene **out_ts, char *err)
 {
     trace_scene *ts = tr->scene_new();
     if (!ts) return snprintf(err, SC_ERRMAX, "out of memory"), -1;
     for (int i = 0; i < sc->nsurf; i++)
-        if (add_surface(tr, ts, &sc->surf[i], err)) goto bad;
+        if (add_surface(tr, ts, &sc->surf[i], l, err)) goto bad;
     for (int i = 0; i < sc->nsource; i++)
-        if (add_source(tr, ts, &sc->source[i], err)) goto bad;
+        if (source_at(sc, &sc->source[i], l) && add_source(tr, ts, &sc->source[i], l, err))
+            goto bad;
     *out_ts = ts;
     return 0;
 bad:
@@ -332,16 +494,20 @@ static long stop_batch(int depth)
 static int run(const sc_scene *sc, sc_result *res, char *err)
 {
     const trace_api *tr = engine();
-    trace_scene *ts;
+    trace_scene *ts = NULL;
     trace_options opt;
     trace_sink sink = {0};
     out o = {0};
-    int rc;
+    int rc = TRACE_OK, nwl;
+    double wl[SC_MAXWLS + 1];
+    trace_summary per[SC_MAXWLS + 1];
 
     err[0] = '\0';
     memset(res, 0, sizeof *res);
+    memset(per, 0, sizeof per);
     if (!tr) return snprintf(err, SC_ERRMAX, "the trace engine's ABI does not match"), -1;
-    if (build_scene(tr, sc, &ts, err)) return -1;
+    nwl = scene_wavelengths(sc, wl);
+    if (check_media(sc, wl, nwl, err) || build_scene(tr, sc, wl[0], &ts, err)) return -1;
     tr->options_default(&opt);
     opt.max_depth = sc->depth;
     opt.cutoff = sc->cutoff;
@@ -359,6 +525,7 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     o.stop_ctx = sc->stop_ctx;
     o.tty = isatty(2);
     o.t0 = now_ms();
+    o.wl = sc->named_wl;
     sink.ctx = &o;
     sink.progress = w_progress;
     if (sc->out_segments) {
@@ -367,10 +534,18 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     }
     if (sc->out_hits) {
         if (!(o.hit = open_part(sc->out_hits, &o.hit_part, err))) goto out;
-        fputs(hit_header, o.hit);
+        fputs(o.wl ? hit_header_wl : hit_header, o.hit);
         sink.hit = w_hit;
     }
-    rc = stop_now(&o) ? TRACE_ECANCEL : tr->run(ts, &opt, &sink, &res->sum);
+    /* one run per wavelength, in the order the sources name them; rays are numbered on
+     * from one run to the next */
+    for (int k = 0; k < nwl && rc >= 0; k++) {
+        if (!ts && build_scene(tr, sc, wl[k], &ts, err)) goto out;
+        rc = stop_now(&o) ? TRACE_ECANCEL : tr->run(ts, &opt, &sink, &per[k]);
+        add_summary(&res->sum, &per[k]);
+        o.ray0 += per[k].rays;
+        if (rc >= 0) { tr->scene_free(ts); ts = NULL; }
+    }
     if (o.shown) fputc('\n', stderr);
     res->progress_shown = o.shown;
     res->stopped = o.stopped;
@@ -395,8 +570,8 @@ out:
     if (o.hit) finish(o.hit, o.hit_part, sc->out_hits, !err[0], err);
     free(o.seg_part);
     free(o.hit_part);
-    tr->scene_free(ts);
-    if (!err[0] && sc->out_summary) write_summary(sc, &res->sum, err);
+    if (ts) tr->scene_free(ts);
+    if (!err[0] && sc->out_summary) write_summary(sc, &res->sum, wl, per, nwl, err);
     return err[0] ? -1 : 0;
 }
 

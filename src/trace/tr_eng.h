@@ -17,6 +17,7 @@
 typedef struct tr_surf {
     int id, is_mesh;
     trace_material mat;
+    double alpha_front, alpha_back;   /* absorption of its media (set_absorption) */
     tr_shape shape;            /* analytic surface, or a mesh's underlying one */
     int has_under, refine;
     double *vtx;               /* mesh: nv*3 */
@@ -68,6 +69,8 @@ struct trace_scene {
                                   centre of its box): a scene far from the origin keeps
                                   single precision's digits for its own size */
     int seq_nsurf;             /* the lens hints hold while nsurf == seq_nsurf */
+    int absorbing;             /* some medium absorbs: the packet path is not taken
+                                  (it does not apply Beer-Lambert; see tr_pool.c) */
     int entry[4], nentry;      /* lens: what a forward ray from left of it meets first */
     const tr_shape *entryg[4];
     tr_pk_set entry_pk;
@@ -152,6 +155,8 @@ typedef struct tr_wray {
     int depth, last_surf;
     long last_prim;
     uint32_t hist;
+    double lambda;               /* the source's wavelength, into every record */
+    double alpha;                /* absorption of the medium it travels in (0: none) */
 } tr_wray;
 
 typedef struct tr_buf {
@@ -233,6 +238,7 @@ const char *tr_scene_error(const trace_scene *sc);
 int tr_add_surface(trace_scene *sc, const trace_surface *s, const trace_material *m);
 int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m);
 int tr_add_source(trace_scene *sc, const trace_source *s, uint64_t *first);
+int tr_set_absorption(trace_scene *sc, int id, double alpha_front, double alpha_back);
 int tr_build(trace_scene *sc, double *ms);
 /* ---- a sequential lens inside any scene (tr_seqscan.c): the lens hints ---- */
 void tr_seq_detect(trace_scene *sc);
@@ -258,6 +264,8 @@ void tr_ray_start(tr_wray *r, const tr_ray0 *r0, tr_tally *ty, double *p0);
 void tr_trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int sp,
                    tr_wray *rp, int live, uint64_t ray, double p0);
 void tr_trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty);
+/* A whole batch ray by ray (the general path: every medium, absorption included). */
+void tr_trace_batch_rays(tr_worker *w);
 void tr_fold(tr_worker *w, uint64_t i, const tr_tally *t);
 void tr_scene_ray(const trace_scene *sc, int *k, uint64_t g, tr_ray0 *r);
 

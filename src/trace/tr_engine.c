@@ -37,6 +37,7 @@ static const trace_api api = {
     fresnel,
     tr_add_lens,
     tr_lens_fan,
+    tr_set_absorption,
 };
 
 const trace_api *trace_get_api(int abi)

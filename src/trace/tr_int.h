@@ -263,6 +263,7 @@ typedef struct tr_ray0 {
     double o[3], d[3];
     double power, n;
     tr_pol pol;
+    double lambda, alpha;        /* wavelength (um, 0: none); absorption of the medium */
 } tr_ray0;
 
 int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap);

@@ -1,8 +1,8 @@
 /* tr_lanes.c -- the packet orchestration: eight rays at a time through a sequential
- * lens on the packet step (tr_packet.c), each lane's books and records kept as the
+ * lens on the packet step (tr_pk_kernel.h), each lane's books and records kept as the
  * one-ray code (tr_trace.c) would keep them, a lane that leaves the shortcut finished
  * by the one-ray code; and the choice, per batch, between packets and rays one by one
- * (the same bits either way). */
+ * (the same bits either way; with LENSMAT_ISA=scalar always one by one). */
 #include <math.h>
 #include "tr_eng.h"
 
@@ -140,7 +140,7 @@ static int lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr
 }
 
 /* Rays i0 .. i0+TR_LANES-1 of the worker side by side while each stays on the lens
- * shortcut, step by step in a packet (tr_packet.c); a lane that leaves it (no
+ * shortcut, step by step in a packet (tr_pk_kernel.h); a lane that leaves it (no
  * candidate hit, depth limit, a ray going back, TIR, reflections waiting) is finished
  * alone afterwards by trace_rest from where it left.  Every lane computes exactly what
  * trace_one would; its records wait in the lane's buffers and are passed on in ray
@@ -215,14 +215,6 @@ static void tr_trace_lanes(tr_worker *w, uint64_t i0, int *k)
     }
 }
 
-/* tr_pk_step is compiled for AVX-512: without it rays go one by one (same bits). */
-static int packets_usable(void)
-{
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-           __builtin_cpu_supports("avx512dq");
-}
-
 /* Trace the worker's batch: rays first .. first+count-1, records to w->out in ray
  * order, the powers of each ray to w->power and the counts to w->counts. */
 void tr_trace_batch(tr_worker *w)
@@ -232,7 +224,7 @@ void tr_trace_batch(tr_worker *w)
     int k = 0;
     uint64_t i = 0;
     if (o->sequential && !o->float_hits && sc->seq_nsurf == sc->nsurf && sc->nentry > 0 &&
-        packets_usable())
+        tr_pk_usable())
         for (; i + TR_LANES <= w->count; i += TR_LANES) tr_trace_lanes(w, i, &k);
     for (; i < w->count; i++) {
         tr_ray0 r;

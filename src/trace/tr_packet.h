@@ -1,5 +1,7 @@
 /* tr_packet.h -- private to the trace engine: eight rays side by side through the
- * surfaces a sequential lens names (tr_packet.c), in vector arithmetic that rounds
+ * surfaces a sequential lens names (the candidate sets: tr_packet.c; the step:
+ * tr_pk_kernel.h, one source built per instruction set; the choice: tr_isa.c), in
+ * vector arithmetic that rounds
  * exactly as the one-ray code does (tr_geom.c's fast shapes, tr_optics.c's Fresnel,
  * tr_trace.c's interaction): the same operations in the same order, where a branch
  * becomes a select.  The engine keeps the books (counts, records, stacks); a ray the
@@ -10,26 +12,25 @@
 
 #pragma GCC visibility push(hidden)
 
-/* GCC notes that wide vectors pass differently with and without AVX; they never
- * cross this module's boundary (tr_pk_step takes pointers), so the note is moot. */
-#pragma GCC diagnostic ignored "-Wpsabi"
+/* Lanes: eight rays in hand, the widest packet (one AVX-512 register of doubles).
+ * A narrower instruction set steps them in chunks of its own width (four with AVX2,
+ * two with SSE2 or NEON), lane by lane the same arithmetic, so the same bits. */
+#define TR_PK 8
 
-#define TR_PK 8                  /* lanes: one AVX-512 register of doubles */
-typedef double tr_vd __attribute__((vector_size(8 * TR_PK)));
-typedef long long tr_vm __attribute__((vector_size(8 * TR_PK)));   /* lane masks */
-
-/* The double part of the rays' states (lane l is element l of every member). */
+/* The double part of the rays' states (lane l is element l of every member),
+ * aligned for the widest vector loads. */
 typedef struct tr_pk {
-    tr_vd o[3], d[3];
-    tr_vd n, len, opl;
-    tr_vd e[3], jss, jpp, jre, jim;   /* tr_pol */
-    tr_vd p0;                         /* the source ray's power */
+    double o[3][TR_PK], d[3][TR_PK];
+    double n[TR_PK], len[TR_PK], opl[TR_PK];
+    double e[3][TR_PK], jss[TR_PK], jpp[TR_PK], jre[TR_PK], jim[TR_PK];   /* tr_pol */
+    double p0[TR_PK];                 /* the source ray's power */
     /* the ray's books since it started, kept here while it runs in the packet */
-    tr_vd cut;                        /* reflected power cut off (reflections off) */
-    tr_vm depth, maxd;                /* interactions; the deepest step start */
-    tr_vm nseg, nint, nmis, ncutr;    /* segments, interactions, index mismatches,
+    double cut[TR_PK];                /* reflected power cut off (reflections off) */
+    long long depth[TR_PK], maxd[TR_PK];   /* interactions; the deepest step start */
+    long long nseg[TR_PK], nint[TR_PK], nmis[TR_PK], ncutr[TR_PK];
+                                      /* segments, interactions, index mismatches,
                                          reflections cut */
-} tr_pk;
+} __attribute__((aligned(64))) tr_pk;
 
 /* The trace options a step needs; entry: the rays come from the source (the first
  * surface's candidates), and must start at z < entry_z. */
@@ -72,16 +73,18 @@ enum {
 
 /* The rest of a step's results, for the engine's books. */
 typedef struct tr_pk_aux {
-    tr_vm status, cand;          /* TR_PK_*; the candidate index */
-    tr_vm mismatch;              /* REFRACT: the ray's index was not n1 (-1) */
-    tr_vd t;                     /* distance to the hit */
-    tr_vd p;                     /* power arriving (jss + jpp before the step) */
-    tr_vd nrm[3];                /* front unit normal at the hit */
-    tr_vd jss, jpp, jre, jim;    /* REFRACT: the state in the s/p basis, before T */
-    tr_vd Rs, Rp, rsp;           /* REFRACT with Fresnel: reflection coefficients */
-    tr_vd rd[3], n1;             /* REFRACT with reflections: reflected direction, its
-                                    medium */
-} tr_pk_aux;
+    long long status[TR_PK], cand[TR_PK];   /* TR_PK_*; the candidate index */
+    long long mismatch[TR_PK];        /* REFRACT: the ray's index was not n1 (-1) */
+    double t[TR_PK];                  /* distance to the hit */
+    double p[TR_PK];                  /* power arriving (jss + jpp before the step) */
+    double nrm[3][TR_PK];             /* front unit normal at the hit */
+    double jss[TR_PK], jpp[TR_PK], jre[TR_PK], jim[TR_PK];
+                                      /* REFRACT: the state in the s/p basis, before T */
+    double Rs[TR_PK], Rp[TR_PK], rsp[TR_PK];  /* REFRACT with Fresnel: reflection
+                                                 coefficients */
+    double rd[3][TR_PK], n1[TR_PK];   /* REFRACT with reflections: reflected direction,
+                                         its medium */
+} __attribute__((aligned(64))) tr_pk_aux;
 
 /* One step of the lanes in mask `live` (bit l: lane l) against the candidates of s
  * (nc > 0): the depth limit and direction checks of the one-ray code, the nearest hit
@@ -90,9 +93,23 @@ typedef struct tr_pk_aux {
  * fresnel), the reflected direction (if reflections), the refracted ray and its books
  * (counts, reflected power cut off).  Returns the lanes that refracted and keep enough
  * power to go on; the others' books are the caller's.  in and out must not overlap.
- * Needs AVX-512 (the caller checks). */
+ * Runs the kernel of the instruction set chosen at load (tr_isa.c). */
 unsigned tr_pk_step(const tr_pk *in, tr_pk *out, tr_pk_aux *x, const tr_pk_set *s,
                     unsigned live, const tr_pk_opt *o);
+
+/* The same step, one kernel (tr_pk_kernel.h) compiled per instruction set
+ * (tr_pk_avx512.c, tr_pk_avx2.c, tr_pk_base.c: SSE2 on x86-64, NEON on arm64). */
+typedef unsigned (*tr_pk_step_fn)(const tr_pk *in, tr_pk *out, tr_pk_aux *x,
+                                  const tr_pk_set *s, unsigned live, const tr_pk_opt *o);
+unsigned tr_pk_step_avx512(const tr_pk *, tr_pk *, tr_pk_aux *, const tr_pk_set *,
+                           unsigned, const tr_pk_opt *);
+unsigned tr_pk_step_avx2(const tr_pk *, tr_pk *, tr_pk_aux *, const tr_pk_set *,
+                         unsigned, const tr_pk_opt *);
+unsigned tr_pk_step_base(const tr_pk *, tr_pk *, tr_pk_aux *, const tr_pk_set *,
+                         unsigned, const tr_pk_opt *);
+
+/* 1 if the packets run in this process (0: LENSMAT_ISA=scalar, rays one by one). */
+int tr_pk_usable(void);
 
 #pragma GCC visibility pop
 #endif

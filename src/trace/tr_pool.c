@@ -137,7 +137,12 @@ static void fill(tr_pool *p, tr_worker *w, tr_slot *s, uint64_t b)
     w->out.seg.n = w->out.hit.n = 0;
     w->nomem = 0;
     w->fail.cause = TR_FAIL_NONE;
-    tr_trace_batch(w);
+    /* The packet path (tr_trace_batch's lanes) does not apply Beer-Lambert: a scene
+     * with an absorbing medium goes ray by ray, the general path (same physics
+     * otherwise).  Every other scene takes tr_trace_batch, which picks packets when
+     * its own conditions hold (a sequential lens, AVX-512). */
+    if (p->sc->absorbing) tr_trace_batch_rays(w);
+    else tr_trace_batch(w);
     s->fail = w->fail;
     s->out = w->out;
     s->nomem = w->nomem;

@@ -119,6 +119,18 @@ static int check_material(trace_scene *sc, const trace_material *m)
     return TRACE_OK;
 }
 
+int tr_set_absorption(trace_scene *sc, int id, double af, double ab)
+{
+    if (!sc) return TRACE_EINVAL;
+    if (id < 0 || id >= sc->nsurf) return fail(sc, TRACE_EINVAL, "no such surface");
+    if (!(af >= 0 && isfinite(af) && ab >= 0 && isfinite(ab)))
+        return fail(sc, TRACE_EINVAL, "absorption coefficients must be numbers >= 0");
+    sc->surf[id]->alpha_front = af;
+    sc->surf[id]->alpha_back = ab;
+    if (af > 0 || ab > 0) sc->absorbing = 1;
+    return TRACE_OK;
+}
+
 static tr_surf *new_surf(trace_scene *sc)
 {
     if (sc->nsurf == sc->capsurf) {
@@ -367,6 +379,7 @@ int tr_add_source(trace_scene *sc, const trace_source *s, uint64_t *first)
         return TRACE_EINVAL;
     }
     ts->first = sc->nrays;
+    if (ts->s.alpha_medium > 0) sc->absorbing = 1;
     if (first) *first = ts->first;
     sc->nrays += (uint64_t)ts->nrays;
     sc->nsrc++;

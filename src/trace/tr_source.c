@@ -98,6 +98,11 @@ int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
                    s->n_medium);
         return -1;
     }
+    if (!(s->alpha_medium >= 0 && isfinite(s->alpha_medium)) ||
+        !(s->lambda >= 0 && isfinite(s->lambda))) {
+        tr_set_err(err, cap, "a source's absorption and wavelength must be numbers >= 0");
+        return -1;
+    }
     if (!(ts->s.power >= TR_LEN_MIN && ts->s.power <= TR_LEN_MAX) ||
         !tr_len_ok(s->radius) || !tr_len_ok(s->waist) || !tr_len_ok(s->wavelength)) {
         tr_set_err(err, cap, "source power, radius, waist and wavelength must be 0 (where "
@@ -276,6 +281,8 @@ static void ray_at(const tr_source *ts, long i, long row, tr_ray0 *r)
     v_set(r->o, s->at);
     r->power = each;
     r->n = s->n_medium;
+    r->lambda = s->lambda;
+    r->alpha = s->alpha_medium;
     switch (s->type) {
     case TRACE_SRC_RAYS:
         v_set(r->o, ts->rays[i].o);

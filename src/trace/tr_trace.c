@@ -19,6 +19,7 @@ void tr_emit_segment(tr_worker *w, tr_out *out, const tr_wray *r, uint64_t ray,
     v_set(s->p0, r->o);
     v_set(s->p1, p1);
     s->power = r->pol.jss + r->pol.jpp;
+    s->lambda = r->lambda;
 }
 
 void tr_emit_hit(tr_worker *w, tr_out *out, const tr_wray *r, uint64_t ray,
@@ -41,6 +42,7 @@ void tr_emit_hit(tr_worker *w, tr_out *out, const tr_wray *r, uint64_t ray,
     x->power_p = r->pol.jpp;
     x->length = r->len;
     x->opl = r->opl;
+    x->lambda = r->lambda;
 }
 
 /* s unit vector of the plane of incidence (d x n), or the ray's own e at normal
@@ -78,9 +80,15 @@ static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray
                     const tr_hitrec *h, const tr_surf *f, double p0)
 {
     double n1 = f->mat.n_front, n2 = f->mat.n_back, s[3], m[3];
-    if (f->media && h->prim >= 0) { n1 = f->media[2 * h->prim]; n2 = f->media[2 * h->prim + 1]; }
+    double a2 = f->alpha_back;                          /* absorption of n2's side */
+    if (f->media && h->prim >= 0) {
+        n1 = f->media[2 * h->prim]; n2 = f->media[2 * h->prim + 1]; a2 = 0;
+    }
     double dn = v_dot(r->d, h->n);
-    if (dn > 0) { double x = n1; n1 = n2; n2 = x; }     /* arriving from the back */
+    if (dn > 0) {                                       /* arriving from the back */
+        double x = n1; n1 = n2; n2 = x;
+        a2 = f->media && h->prim >= 0 ? 0 : f->alpha_front;
+    }
     /* m: unit normal pointing back into the incident medium */
     for (int i = 0; i < 3; i++) m[i] = dn > 0 ? -h->n[i] : h->n[i];
     double ci = fabs(dn) < 1.0 ? fabs(dn) : 1.0;   /* fmin(1, |dn|) without the call */
@@ -139,6 +147,7 @@ static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray
     for (int i = 0; i < 3; i++) r->d[i] = eta * r->d[i] + k * m[i];
     v_unit(r->d);
     r->n = n2;
+    r->alpha = a2;
     if (w->o->fresnel) {
         double a = sqrt(fc.Ts * fc.Tp);
         r->pol.jss *= fc.Ts;
@@ -162,6 +171,8 @@ void tr_ray_start(tr_wray *r, const tr_ray0 *r0, tr_tally *ty, double *p0)
     r->last_surf = -1;
     r->last_prim = -1;
     r->hist = 0;
+    r->lambda = r0->lambda;
+    r->alpha = r0->alpha;
     *p0 = r0->pol.jss + r0->pol.jpp;
     ty->emitted = *p0;
 }
@@ -173,6 +184,21 @@ static void ray_failed(tr_tally *ty, int cause, int surf, double p)
     if (!ty->failures) { ty->fail_cause = cause; ty->fail_surf = surf; }
     ty->failures++;
     if (isfinite(p)) ty->cutoff += p;
+}
+
+/* Beer-Lambert along a segment of length t in the ray's medium (alpha > 0): its
+ * state scaled by exp(-alpha t), the loss counted as absorbed; returns the loss.  The
+ * segment's record keeps the power where it starts (emitted before this). */
+static double absorb_along(tr_tally *ty, tr_wray *r, double t)
+{
+    double k = exp(-r->alpha * t), p = r->pol.jss + r->pol.jpp;
+    r->pol.jss *= k;
+    r->pol.jpp *= k;
+    r->pol.jre *= k;
+    r->pol.jim *= k;
+    double lost = p - (r->pol.jss + r->pol.jpp);
+    ty->absorbed += lost;
+    return lost;
 }
 
 /* One step once the hit h of *r is known: the segment to it and what the surface
@@ -192,7 +218,7 @@ static inline int on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack
     r->len += h->t;
     r->opl += r->n * h->t;
     switch (f->mat.kind) {
-    case TRACE_ABSORB:
+    case TRACE_ABSORB:                  /* (what the medium took is absorbed too) */
         ty->absorbed += p;
         tr_emit_segment(w, out, r, ray, q, TRACE_END_ABSORB, h->surf);
         return 0;
@@ -200,14 +226,16 @@ static inline int on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack
         double s[3];
         s_vector(r, h->n, s);
         tr_pol_rotate(&r->pol, r->d, s);
+        tr_emit_segment(w, out, r, ray, q, TRACE_END_DETECT, h->surf);
+        if (r->alpha > 0) p -= absorb_along(ty, r, h->t);
         ty->detected += p;
         ty->hits++;
-        tr_emit_segment(w, out, r, ray, q, TRACE_END_DETECT, h->surf);
         tr_emit_hit(w, out, r, ray, h, q);
         return 0;
     }
     default:
         tr_emit_segment(w, out, r, ray, q, TRACE_END_NONE, h->surf);
+        if (r->alpha > 0) absorb_along(ty, r, h->t);
         v_set(r->o, q);
         return interact(w, ty, stack, sp, r, h, f, p0);
     }
@@ -252,6 +280,17 @@ void tr_trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty)
     double p0;
     tr_ray_start(&r, r0, ty, &p0);
     tr_trace_rest(w, &w->out, ty, w->stack, 0, &r, 1, ray, p0);
+}
+
+void tr_trace_batch_rays(tr_worker *w)
+{
+    int k = 0;
+    for (uint64_t i = 0; i < w->count; i++) {
+        tr_ray0 r;
+        tr_scene_ray(w->sc, &k, w->first + i, &r);
+        tr_trace_one(w, &r, w->first + i, &w->tally[0]);
+        tr_fold(w, i, &w->tally[0]);
+    }
 }
 
 /* A traced ray's tally (ray i of the batch) into the batch's powers and counts. */

@@ -153,6 +153,12 @@ typedef struct trace_source {
     int pol;                   /* enum trace_pol */
     double pol_dir[3];         /* TRACE_LINEAR: E direction (projected _|_ ray) */
     const trace_ray *ray;      /* TRACE_SRC_RAYS: count rays (copied on adding) */
+    double alpha_medium;       /* absorption where the rays start (set_absorption) */
+    double lambda;             /* the rays' vacuum wavelength, um (0: none named), carried
+                                  by every ray into its segments and hits; the indices
+                                  are the materials' (a caller tracing several
+                                  wavelengths gives each its own run with the indices at
+                                  that wavelength, as the scene front end does) */
 } trace_source;
 
 typedef struct trace_options {
@@ -188,7 +194,8 @@ typedef struct trace_segment {
     int end;               /* enum trace_end: what happened at p1 */
     int surface;           /* surface id at p1 (-1: escaped) */
     double p0[3], p1[3];
-    double power;          /* s + p power along the segment */
+    double power;          /* s + p power along the segment (where it starts) */
+    double lambda;         /* the ray's wavelength (trace_source.lambda) */
 } trace_segment;
 
 typedef struct trace_hit {
@@ -202,6 +209,7 @@ typedef struct trace_hit {
     double power_s, power_p;   /* along s_dir and dir x s_dir */
     double length;         /* geometric path length from the source */
     double opl;            /* optical path length (sum n * length) */
+    double lambda;         /* the ray's wavelength (trace_source.lambda) */
 } trace_hit;
 
 /* Every callback returns 0 to go on, non-zero to cancel the trace (TRACE_ECANCEL).
@@ -313,11 +321,30 @@ typedef struct trace_api {
     int (*lens_fan)(const trace_lens *lens, double z_obj, double y_obj,
                     double z_paraxial, int nrays, const double *h,
                     trace_fan_ray *out, char *err, size_t errcap);
+
+    /* Absorption (added after v1): the absorption coefficients (per unit of the scene's
+     * length, >= 0; 0: transparent) of the media on either side of surface `id`
+     * (front/back as n_front/n_back).  Inside a medium with alpha > 0 a ray's power
+     * falls as exp(-alpha L) along every segment (Beer-Lambert), the loss counted as
+     * absorbed; a source starts in alpha_medium.  A scene with any absorbing medium is
+     * traced ray by ray, never on the packet path (which does not apply it; see
+     * tr_pool.c).  Per-triangle media (trace_mesh.media) stay transparent.  TRACE_OK
+     * or TRACE_EINVAL. */
+    int (*set_absorption)(trace_scene *sc, int id, double alpha_front, double alpha_back);
 } trace_api;
 
 typedef const trace_api *(*trace_get_api_fn)(int abi);
 /* Exported by lensmat-trace.so: the table, or NULL if abi != TRACE_ABI. */
 const trace_api *trace_get_api(int abi);
+
+/* Also exported: the instruction sets the lens packets can run on in this build, best
+ * first (x86-64: "avx512", "avx2", "sse2"; arm64: "neon"; then "scalar", rays one by
+ * one): name i, or NULL past the last, *usable (may be NULL) 1 if this processor runs
+ * it.  trace_isa_active(): the one this process uses, chosen when the module loads:
+ * the best usable, or the one the environment variable LENSMAT_ISA names (if this
+ * processor cannot run that one, the best below it).  All give the same bits. */
+const char *trace_isa_name(int i, int *usable);
+const char *trace_isa_active(void);
 
 /* ---- a lens's geometry, checked without the module -------------------------------
  * Inline so that the dialogue can refuse an answer at its question without loading

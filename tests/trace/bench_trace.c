@@ -17,6 +17,9 @@
  *                            through Embree (sequential shortcut off), same results
  *   trace_sum_1e8_{rays,error,balance}: 1e8 rays of total power 1, the summed powers
  *                            against n fl(1/n) and the balance (not in quick runs)
+ * `bench_trace isa` prints one triplet run's Mrays/s (wall clock, and per second of
+ * the tracing thread's CPU time) with the packet kernel of this process (LENSMAT_ISA=<isa>), `bench_trace isas` the kernels this processor runs
+ * (scripts/bench_trace_isa.sh: BENCH trace_triplet_<isa>_mrays_per_s).
  * `bench_trace triplet` prints the triplet figures alone, `bench_trace sum` the sums. */
 #define _DEFAULT_SOURCE 1      /* wait4 */
 #include <embree3/rtcore.h>
@@ -57,6 +60,16 @@ static int spot_hit(void *ctx, const trace_hit *h)
     return 0;
 }
 
+/* The calling thread's CPU time (one thread traces on the caller): a figure that a
+ * busy shared machine does not halve, unlike the wall clock. */
+static double triplet_cpu_s;
+static double cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
 /* Returns rays/s; *rms_um: the power-weighted RMS spot radius about its centroid. */
 static double triplet_run(int threads, long across, int sequential, double *rms_um,
                           uint64_t *nrays)
@@ -82,9 +95,10 @@ static double triplet_run(int threads, long across, int sequential, double *rms_
     trace_sink sink = {&sp, NULL, spot_hit, NULL};
     trace_summary sum;
     tr->build(sc, NULL);
-    double t0 = now();
+    double t0 = now(), c0 = cpu_now();
     if (tr->run(sc, &o, &sink, &sum)) { fprintf(stderr, "%s\n", tr->error(sc)); exit(1); }
     double dt = now() - t0;
+    triplet_cpu_s = cpu_now() - c0;
     double cx = sp.sx / sp.w, cy = sp.sy / sp.w;
     if (rms_um) *rms_um = 1e3 * sqrt(sp.s2 / sp.w - cx * cx - cy * cy);
     if (nrays) *nrays = sum.rays;
@@ -319,6 +333,16 @@ static void triplet_child(void *arg)
 }
 static void mem_fn(void *arg) { (void)arg; mem_child(); }
 
+/* Issue 13: the triplet figure of the packet kernel this process runs (LENSMAT_ISA
+ * forces one; scripts/bench_trace_isa.sh runs this for each instruction set the
+ * processor has, in rounds, and takes the medians): one thread, one run. */
+static void triplet_isa(void)
+{
+    uint64_t n;
+    double r = triplet(1, 1128, NULL, &n);
+    printf("%s %.4f %.4f\n", trace_isa_active(), r / 1e6, n / triplet_cpu_s / 1e6);
+}
+
 /* Issue 9's 1e8-ray row (too long for make check, which runs 1e7 in t_extreme): a
  * collimated grid of about 1e8 rays of total power 1 onto a detector, on all cores:
  * how far the summed powers are from n fl(1/n) (exact, in long double), and the
@@ -366,6 +390,16 @@ int main(int argc, char **argv)
     FILE *f = NULL;
     if (argc > 1 && !strcmp(argv[1], "triplet")) {     /* the triplet figures alone */
         triplet_child(NULL);
+        return 0;
+    }
+    if (argc > 1 && !strcmp(argv[1], "isa")) {         /* this process's kernel */
+        triplet_isa();
+        return 0;
+    }
+    if (argc > 1 && !strcmp(argv[1], "isas")) {        /* those this processor runs */
+        int ok;
+        for (int i = 0; trace_isa_name(i, &ok); i++)
+            if (ok) printf("%s\n", trace_isa_name(i, NULL));
         return 0;
     }
     if (argc > 1 && !strcmp(argv[1], "sum")) {         /* the 1e8-ray sums alone */

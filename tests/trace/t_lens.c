@@ -265,8 +265,9 @@ static int both_seg(void *ctx, const trace_segment *g)
     return push(&((both *)ctx)->s, g, sizeof *g);
 }
 
-/* The lens shortcut (no BVH between consecutive surfaces; on AVX-512 processors eight
- * rays at a time in vector registers, tr_packet.c) changes no bit: hits, segments,
+/* The lens shortcut (no BVH between consecutive surfaces; eight rays at a time in
+ * vector registers, tr_pk_kernel.h; each kernel against the others: t_isa.c) changes
+ * no bit: hits, segments,
  * energy figures and counts equal the BVH trace's, with and without Fresnel and
  * reflected rays, for skew rays some of which the mounts stop. */
 static void sequential_same(const trace_api *tr)
