@@ -99,6 +99,15 @@ EOF
 { cat "$PK/meniscus.body"
   echo "plane absorb at 0 0 2.679491924311227 normal 0 0 1 disc 30 hole 10"
   echo "plane absorb at 0 0 3.5871215252208 normal 0 0 1 disc 30 hole 10"; } > "$PK/meniscus_mounts.body"
+# glasses at three wavelengths (one run each); an absorbing glass (N-BK7 at 334 nm:
+# Beer-Lambert, traced ray by ray, the lens shortcut still choosing the surfaces)
+cat > "$PK/wl.body" <<'EOF'
+cap refract 1 N-SF6 vertex 0 0 0 radius 50 aperture 12
+cap refract N-SF6 1 vertex 0 0 8 radius -50 aperture 12
+plane detect at 0 0 55 normal 0 0 1 disc 40
+source collimated from 0 0 -10 dir 0 0 1 radius 11.9 grid 21 lambda F d C
+EOF
+sed -e 's/N-SF6/N-BK7/g' -e 's/lambda F d C/lambda 334/' "$PK/wl.body" > "$PK/absorbing.body"
 # a mesh vane across the beam between the first and second elements: the lens path
 # starts after it (surfaces 3 to 6, their mounts and the detector)
 { pk_triplet; echo "plane absorb at 0 3 6 normal 0 0 1 rect 20 2 tessellate 2"
@@ -175,6 +184,9 @@ if [ -f "$TOP/build/lib/lensmat-trace.so" ]; then
         pk_modes meniscus 5 "$PK/meniscus.body"
     check "scene lens path: the same with the meniscus mounted: the meniscus alone" \
         pk_modes meniscus_mounts 4 "$PK/meniscus_mounts.body"
+    check "scene lens path: glasses at F, d and C" pk_modes wl 3 "$PK/wl.body"
+    check "scene lens path: an absorbing glass (ray by ray, the shortcut on)" \
+        pk_modes absorbing 3 "$PK/absorbing.body"
     check "scene lens path: singlet, collimated and tilted fan" pk_modes singlet 3 "$PK/singlet.body"
     check "scene lens path: conic singlet" pk_modes conic 3 "$PK/conic.body"
     check "scene lens path: meshes before and after the lens (rays from either side of the plate)" \

@@ -430,6 +430,7 @@ static void add_summary(trace_summary *a, const trace_summary *b)
     a->cutoff += b->cutoff;
     a->build_ms += b->build_ms;
     a->trace_ms += b->trace_ms;
+    if (b->lens_surfaces > a->lens_surfaces) a->lens_surfaces = b->lens_surfaces;
 }
 
 static int write_summary(const sc_scene *sc, const trace_summary *s, const double *wl,

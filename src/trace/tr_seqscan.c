@@ -41,8 +41,13 @@ _Static_assert(sizeof(trace_material) == sizeof(struct tr_seq_known_material),
                "trace_material has a new field: teach tr_seqscan.c whether the lens "
                "path (tr_packet.c) handles it, or refuse such surfaces there");
 
-/* ... and every field of a ray's working state (the packet carries these and no
- * other: a wavelength or an attenuation added to tr_wray would not be updated there). */
+/* ... and every field of a ray's working state.  The packet carries the doubles of
+ * the first seven and nothing else: a lane's other fields stay as they were when it
+ * started (tr_lanes.c's lane_ray copies them into every record).  So lambda is right
+ * (it never changes); alpha, the absorption of the medium, is not updated by the
+ * packet at a refraction, which is why a scene with an absorbing medium goes ray by
+ * ray (tr_pool.c, sc->absorbing) -- the lens shortcut itself (tr_hit.c: which surface
+ * next) is still exact there, Beer-Lambert being applied by the one-ray code. */
 struct tr_seq_known_ray {
     double o[3], d[3];
     double n, len, opl;
@@ -50,6 +55,7 @@ struct tr_seq_known_ray {
     int depth, last_surf;
     long last_prim;
     uint32_t hist;
+    double lambda, alpha;
 };
 _Static_assert(sizeof(tr_wray) == sizeof(struct tr_seq_known_ray),
                "tr_wray has a new field: teach tr_seqscan.c and tr_packet.c about it (or "
