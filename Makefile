@@ -21,8 +21,8 @@ PROMPTS := $(wildcard prompts/*.txt)
 GEN     := $(patsubst prompts/%.txt,build/gen/prompts_%.h,$(PROMPTS))
 # The glass catalogue (data/glass.txt), compiled in like the prompts.
 GEN     += build/gen/glass_data.h
-# The core: the dialogue layer and the paraxial engine (libc, libm, readline only).
-CORE    := $(wildcard src/dialogue/*.c src/paraxial/*.c)
+# The core: the dialogue layer, paraxial engine, lens model (libc, libm, readline only).
+CORE    := $(wildcard src/dialogue/*.c src/paraxial/*.c src/lens/*.c)
 LIBCORE := $(filter-out src/dialogue/main.c,$(CORE))
 OBJ     := $(patsubst src/%.c,build/obj/%.o,$(CORE))
 SANOBJ  := $(patsubst src/%.c,build/asan/%.o,$(CORE))
@@ -80,6 +80,14 @@ build/fuzz_answers: tests/fuzz_answers.c $(LIBCORE) $(GEN) | $(DEPS)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
 	    tests/fuzz_answers.c $(LIBCORE) $(LIBS)
 
+# libFuzzer target for the lens model's readers (src/lens: thickness prescriptions,
+# .zmx), with the paraxial engine they build on.
+LENSFUZZ_SRC := $(wildcard src/lens/*.c src/paraxial/*.c)
+build/fuzz_lens: tests/fuzz_lens.c $(LENSFUZZ_SRC) $(GEN) | $(DEPS)
+	@mkdir -p $(@D)
+	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -o $@ \
+	    tests/fuzz_lens.c $(LENSFUZZ_SRC) -lm
+
 # The transcribed original program, for differential tests (built from ../shared,
 # never copied into this tree).
 ORIG_DIR := ../shared/original-lensmat
@@ -91,6 +99,7 @@ build/original/lensmat: | $(DEPS)
 TEST_BINS := lensmat build/asan/lensmat build/fuzz_answers build/original/lensmat \
              $(patsubst tests/%.c,build/obj/%,$(UNIT)) \
              $(patsubst tests/%.c,build/asan/%,$(UNIT))
+TEST_BINS += build/fuzz_lens
 
 -include $(wildcard src/*/*.mk)
 
@@ -108,10 +117,13 @@ bench: lensmat build/original/lensmat build/bench/benchrun build/bench/baseline 
        $(MODULE_BENCH_BINS)
 	@sh scripts/bench.sh
 
-fuzz: build/fuzz_answers
+fuzz: build/fuzz_answers build/fuzz_lens
 	@mkdir -p build/fuzz-corpus
 	build/fuzz_answers -max_total_time=$${FUZZ_SECONDS:-600} build/fuzz-corpus \
 	    tests/fuzz-corpus
+	@mkdir -p build/fuzz-lens-corpus
+	build/fuzz_lens -max_total_time=$${FUZZ_SECONDS:-600} build/fuzz-lens-corpus \
+	    tests/fuzz-lens
 
 example: lensmat
 	./lensmat --example example.rec

@@ -159,7 +159,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fflush(stdout);
         out = slurp(out_path, &nout);
         rec = slurp(rec_path, &nrec);
-        if (bad_number_word(out, nout) || bad_number_word(rec, nrec)) {
+        /* --to-zmx and --to-thickness write a lens file: its titles and glass names
+         * are the input's own words (fuzz_lens checks its numbers read back) */
+        int lens_file = !strcmp(d->option, "--to-zmx") || !strcmp(d->option, "--to-thickness");
+        if (bad_number_word(out, nout) || (!lens_file && bad_number_word(rec, nrec))) {
             fprintf(stderr, "%s printed nan or inf:\n---- stdout\n%s\n---- record\n%s\n",
                     d->option, out, rec);
             abort();

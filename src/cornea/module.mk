@@ -45,3 +45,10 @@ all: build/lib/lensmat-cornea.so
 MODULE_TEST_BINS  += build/lib/lensmat-cornea.so build/asan/lib/lensmat-cornea.so $(CN_TBIN)
 MODULE_BENCH_BINS += build/lib/lensmat-cornea.so $(CN_BBIN)
 -include $(CN_OBJ:.o=.d) $(CN_SOBJ:.o=.d)
+# The scan bench's plot (scripts/bench_cornea_scan.sh): the imaging engine's plot call.
+build/obj/cornea_tests/scan_plot: tests/cornea/scan_plot.c build/lib/lensmat-imaging.so \
+                                  src/imaging/imaging.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -o $@ $< build/lib/lensmat-imaging.so \
+	    -Wl,-rpath,$(abspath build/lib) -lm
+MODULE_BENCH_BINS += build/obj/cornea_tests/scan_plot

@@ -1,21 +1,34 @@
-/* cornea_scan.c -- the --cornea-scan dialogue (issue 12): a simulated measurement.
- * The example rig geometry scans a synthetic eye the user describes (radius, Q,
- * cylinder and axis, decentration, tilt), spots with centroid noise, the cornea
- * engine fits the chosen model and the report is printed: Sim K, radii, Q, pose,
- * singular values, what is not determined.  Texts in prompts/cornea_scan.txt; the
- * rig and cornea engines are loaded here only. */
+/* cornea_scan.c -- the --cornea-scan dialogue (issue 12): one cornea measurement.
+ * The rig (the example geometry, or a rig file planned only or run on the simulated
+ * chip) scans a synthetic eye the user describes (radius, Q, cylinder and axis,
+ * decentration, tilt) with a pattern (spiral, rings, grid); each exposure's spot is
+ * traced through the eye and made into a full detector frame whose centroid is the
+ * measurement (or, quicker, the traced hit plus Gaussian noise); the cornea engine
+ * fits the chosen model, the fit's model is checked against the tracer, and the report
+ * is printed, recorded and (optionally) written to a report file: Sim K, radii, Q,
+ * pose, singular values, what is not determined, the spots rejected and why.  The
+ * loop itself is cornea_loop.c; texts in prompts/cornea_scan.txt.  The rig, cornea
+ * and trace engines are loaded here; the imaging engine only when frames are used. */
+#include <errno.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include "calcio.h"
+#include "cornea_loop.h"
 #include "dialogues.h"
 #include "engine.h"
-#include "../rig/rig.h"
-#include "../cornea/cornea.h"
+#include "../imaging/imaging.h"
+#include "../trace/trace.h"
 #include "prompts_cornea_scan.h"
 
 #define CS(k) cornea_scan_prompts[CORNEA_SCAN_##k]
 #define DEG (3.14159265358979323846 / 180)
+#define WORD 4096
+#define CHECK_TOL_UM 1e-3       /* tracer against the fit's model: 1 nm */
 
 /* One number in [lo, hi] (whole when integral), asked again on a terminal. */
 static int ranged(calc *c, const char *q, const char *what, const char *range, double lo,
@@ -34,36 +47,242 @@ static int ranged(calc *c, const char *q, const char *what, const char *range, d
 
 static int stop_cb(void *ctx) { (void)ctx; return lm_stop_requested() != 0; }
 
+/* ---- the session's state ---------------------------------------------------------- */
+
+typedef struct cs {
+    calc cc;
+    const rig_api *rg;
+    rg_rig rig;
+    int have_rig;
+    char rigname[WORD], log[WORD], report[WORD], camera[WORD], save[WORD];
+    char *text;                 /* the report as said, for the report file */
+    size_t len, cap;
+} cs;
+
+static const rig_api *volatile hook_api;
+static void laser_off_hook(void *ctx)      /* async-signal-safe: the engine's path */
+{
+    (void)ctx;
+    if (hook_api && hook_api->emergency_off) hook_api->emergency_off();
+}
+
+/* Said on stdout and in the record, and kept for the report file. */
+static void say(cs *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void say(cs *s, const char *fmt, ...)
+{
+    char line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    calc_say(&s->cc, "%s", line);
+    size_t n = strlen(line);
+    if (s->len + n + 1 > s->cap) {
+        size_t cap = (s->cap + n + 1) * 2;
+        char *t = realloc(s->text, cap);
+        if (!t) return;                 /* the report file then says less; never crash */
+        s->text = t;
+        s->cap = cap;
+    }
+    memcpy(s->text + s->len, line, n + 1);
+    s->len += n;
+}
+
+/* The report file: everything the session said about the measurement, written to
+ * NAME.part and renamed when complete (a stopped session leaves nothing under NAME).
+ * The one place the report file is made: the maps and other numbers join here. */
+static int cs_write_report(const char *path, const char *text, size_t len, char *err,
+                           size_t cap)
+{
+    char part[WORD + 8];
+    FILE *f;
+    snprintf(part, sizeof part, "%s.part", path);
+    if (!(f = fopen(part, "w"))) { snprintf(err, cap, "%s", strerror(errno)); return -1; }
+    int ok = fwrite(text, 1, len, f) == len;
+    ok = !fclose(f) && ok;
+    if (!ok || lm_stop_requested() || rename(part, path)) {
+        snprintf(err, cap, "%s", ok ? strerror(errno) : "write error");
+        unlink(part);
+        return -1;
+    }
+    return 0;
+}
+
+/* ---- answers checked as they come ----------------------------------------------- */
+
+static int check_rig(void *ctx, const char *word, char *msg, size_t cap)
+{
+    cs *s = ctx;
+    s->have_rig = 0;
+    if (!strcmp(word, "-")) return 0;
+    if (s->rg->rig_load(word, &s->rig, msg, cap)) return -1;
+    s->have_rig = 1;
+    return 0;
+}
+
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return !stat(a, &sa) && !stat(b, &sb) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+static int check_log(void *ctx, const char *word, char *msg, size_t cap)
+{
+    cs *s = ctx;
+    static const char *const ext[] = {"", ".part"};
+    char name[WORD + 16];
+    if (!strcmp(word, "-")) return 0;
+    for (int i = 0; i < 2; i++) {
+        snprintf(name, sizeof name, "%s%s", word, ext[i]);
+        if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
+        if (same_file(name, s->rig.path)) { snprintf(msg, cap, CS(LOG_IS_RIG), name); return -1; }
+    }
+    return 0;
+}
+
+static int check_report(void *ctx, const char *word, char *msg, size_t cap)
+{
+    cs *s = ctx;
+    char name[WORD + 16];
+    if (!strcmp(word, "-")) return 0;
+    for (int i = 0; i < 2; i++) {
+        snprintf(name, sizeof name, "%s%s", word, i ? ".part" : "");
+        if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
+        if (s->have_rig && same_file(name, s->rig.path)) {
+            snprintf(msg, cap, CS(REPORT_IS_RIG), name);
+            return -1;
+        }
+        if (s->log[0] && strcmp(s->log, "-") && !strcmp(word, s->log)) {
+            snprintf(msg, cap, CS(REPORT_IS_LOG), name);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* A pattern for saved frames: one %d (flags 0, width up to 2 digits), no other
+ * conversion, a picture extension the writer knows; the first name not an input. */
+static int check_save(void *ctx, const char *word, char *msg, size_t cap)
+{
+    cs *s = ctx;
+    int conv = 0;
+    const char *dot = strrchr(word, '.');
+    if (!strcmp(word, "-")) return 0;
+    for (const char *p = word; *p; p++) {
+        if (*p != '%') continue;
+        if (p[1] == '%') { p++; continue; }
+        p++;
+        if (*p == '0') p++;
+        for (int k = 0; k < 2 && *p >= '0' && *p <= '9'; k++) p++;
+        if (*p != 'd') { conv = -1; break; }
+        conv++;
+    }
+    if (conv != 1 || !dot || (strcmp(dot, ".png") && strcmp(dot, ".tif") && strcmp(dot, ".raw"))) {
+        snprintf(msg, cap, CS(SAVE_BAD), word);
+        return -1;
+    }
+    char name[WORD + 16];
+    snprintf(name, sizeof name, word, 1);
+    return lm_check_output(s->cc.io, name, msg, cap);
+}
+
+static int threads_wanted(void)
+{
+    const char *e = getenv("LENSMAT_THREADS");
+    long n = e && *e ? strtol(e, NULL, 10) : sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 16 ? 16 : (int)n;
+}
+
+/* The check's tolerance (um): LENSMAT_CORNEA_CHECK_TOL_UM overrides it (tests make
+ * the check fail with 0). */
+static double check_tol_um(void)
+{
+    const char *e = getenv("LENSMAT_CORNEA_CHECK_TOL_UM");
+    return e && *e ? strtod(e, NULL) : CHECK_TOL_UM;
+}
+
+/* ---- the dialogue ----------------------------------------------------------------- */
+
+static int run(cs *s, cl_run *r, rg_machine **m);
+
 int lm_cornea_scan(lm_io *io)
 {
     static const char *const models[] = {"sphere", "conic", "biconic", NULL};
-    calc cc = {io, PX_MM, "mm"}, *c = &cc;
+    static const char *const chips[] = {"none", "sim", "gpiod", NULL};
+    static const char *const patterns[] = {"spiral", "rings", "grid", NULL};
+    static const char *const sources[] = {"frames", "model", "camera", NULL};
+    cs *s = calloc(1, sizeof *s);
+    cl_run *r = calloc(1, sizeof *r);
+    rg_machine *m = NULL;
+    int rc = LM_FAIL;
+    if (!s || !r) { free(s); free(r); fprintf(stderr, "lensmat: out of memory\n"); return LM_FAIL; }
+    s->cc = (calc){io, PX_MM, "mm"};
+    calc *c = &s->cc;
     rig_get_api_fn rget;
     cornea_get_api_fn cget;
     *(void **)&rget = lm_engine_symbol("rig", RIG_API_SYMBOL);
     *(void **)&cget = lm_engine_symbol("cornea", CORNEA_API_SYMBOL);
     const rig_api *rg = rget ? rget(RIG_ABI) : NULL;
     const cornea_api *cn = cget ? cget(CORNEA_ABI) : NULL;
-    if (!rg || !cn) return calc_fail(c, CS(NO_ENGINE));
-    int model, rc;
-    double np, zone, R, Q, cyl, axis, dx, dy, tx, ty, noise, pitch, seed;
+    if (!rg || !cn) { rc = calc_fail(c, CS(NO_ENGINE)); goto out; }
+    s->rg = rg;
+    int model, chip = 0, pattern, source;
+    double np, zone, R = 7.8, Q = 0, cyl = 0, axis = 0, dx = 0, dy = 0, tx = 0, ty = 0,
+           noise = 0, pitch, seed = 0, w = 0, h = 0, ms = 0;
     if ((rc = calc_choice(c, CS(MODEL), CS(MODEL_WHAT), models, &model)) ||
+        (rc = lm_ask_word(io, CS(RIG_FILE), CS(RIG_FILE), CS(RIG_FILE_WHAT), check_rig, s,
+                          s->rigname, sizeof s->rigname)))
+        goto out;
+    if (s->have_rig) {
+        if ((rc = calc_choice(c, CS(CHIP), CS(CHIP_WHAT), chips, &chip))) goto out;
+        if ((chip == 1 &&
+             (rc = lm_ask_word(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
+                               s->log, sizeof s->log))) ||
+            (chip >= 1 &&
+             (rc = ranged(c, CS(EXPOSE), CS(EXPOSE_WHAT), CS(EXPOSE_RANGE),
+                          0.01, s->rig.max_on_ms, 0, &ms))))
+            goto out;
+    }
+    if ((rc = calc_choice(c, CS(PATTERN), CS(PATTERN_WHAT), patterns, &pattern)) ||
         (rc = ranged(c, CS(POINTS), CS(POINTS_WHAT), CS(POINTS_RANGE), 10, 10000, 1, &np)) ||
         (rc = ranged(c, CS(ZONE), CS(ZONE_WHAT), CS(ZONE_RANGE), 0.5, 12, 0, &zone)) ||
-        (rc = ranged(c, CS(R), CS(R_WHAT), CS(R_RANGE), 5, 12, 0, &R)) ||
+        (rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source)))
+        goto out;
+    if (source == CL_SRC_CAMERA &&
+        (rc = lm_ask_word(io, CS(CAMERA), CS(CAMERA), CS(CAMERA_WHAT), NULL, NULL, s->camera,
+                          sizeof s->camera)))
+        goto out;
+    if (source != CL_SRC_CAMERA &&      /* a real eye is what the camera sees */
+        ((rc = ranged(c, CS(R), CS(R_WHAT), CS(R_RANGE), 5, 12, 0, &R)) ||
         (rc = ranged(c, CS(Q), CS(Q_WHAT), CS(Q_RANGE), -1, 1, 0, &Q)) ||
         (rc = ranged(c, CS(CYL), CS(CYL_WHAT), CS(CYL_RANGE), 0, 8, 0, &cyl)) ||
         (rc = ranged(c, CS(AXIS), CS(AXIS_WHAT), CS(AXIS_RANGE), -360, 360, 0, &axis)) ||
         (rc = ranged(c, CS(DX), CS(DX_WHAT), CS(DEC_RANGE), -1, 1, 0, &dx)) ||
         (rc = ranged(c, CS(DY), CS(DY_WHAT), CS(DEC_RANGE), -1, 1, 0, &dy)) ||
         (rc = ranged(c, CS(TX), CS(TX_WHAT), CS(TILT_RANGE), -10, 10, 0, &tx)) ||
-        (rc = ranged(c, CS(TY), CS(TY_WHAT), CS(TILT_RANGE), -10, 10, 0, &ty)) ||
-        (rc = ranged(c, CS(NOISE), CS(NOISE_WHAT), CS(NOISE_RANGE), 0, 10, 0, &noise)) ||
-        (rc = ranged(c, CS(PITCH), CS(PITCH_WHAT), CS(PITCH_RANGE), 0.1, 100, 0, &pitch)) ||
-        (rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)))
-        return rc;
-    rg_geometry g;
-    rg->geometry_default(&g);
+        (rc = ranged(c, CS(TY), CS(TY_WHAT), CS(TILT_RANGE), -10, 10, 0, &ty))))
+        goto out;
+    if (source == CL_SRC_MODEL &&
+        (rc = ranged(c, CS(NOISE), CS(NOISE_WHAT), CS(NOISE_RANGE), 0, 10, 0, &noise)))
+        goto out;
+    if ((rc = ranged(c, CS(PITCH), CS(PITCH_WHAT), CS(PITCH_RANGE), 0.1, 100, 0, &pitch)))
+        goto out;
+    if (source == CL_SRC_FRAMES &&
+        ((rc = ranged(c, CS(WIDTH), CS(WIDTH_WHAT), CS(PX_RANGE), 16, 4096, 1, &w)) ||
+         (rc = ranged(c, CS(HEIGHT), CS(HEIGHT_WHAT), CS(PX_RANGE), 16, 4096, 1, &h)) ||
+         (rc = lm_ask_word(io, CS(SAVE), CS(SAVE), CS(SAVE_WHAT), check_save, s, s->save,
+                           sizeof s->save))))
+        goto out;
+    if ((source != CL_SRC_CAMERA &&
+         (rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed))) ||
+        (rc = lm_ask_word(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), check_report, s,
+                          s->report, sizeof s->report)))
+        goto out;
+
+    /* the rig's geometry: the rig file's, or the example */
+    static rg_geometry g;
+    if (s->have_rig) g = s->rig.geom;
+    else rg->geometry_default(&g);
     rg_cornea eye = g.cornea;
     double km = 337.5 / R;
     eye.model = RG_BICONIC;
@@ -74,40 +293,167 @@ int lm_cornea_scan(lm_io *io)
     eye.zone = 0;
     double at[3] = {g.cornea.trans[0] + dx, g.cornea.trans[1] + dy, g.cornea.trans[2]};
     rg->eye_pose(&eye, tx * DEG, ty * DEG, 0, at);
-    int n = (int)np;
-    cn_spot *sp = malloc(sizeof *sp * n);
-    if (!sp) return calc_fail(c, CS(NO_ENGINE));
-    double sigma = noise * pitch * 1e-3;
-    cn_scan_opts so = {.npoints = n, .theta_max = zone * DEG, .sigma = sigma,
-                       .seed = (unsigned long long)seed, .quantise = 1};
+
+    r->rg = rg;
+    r->cn = cn;
+    r->g = &g;
+    r->truth = eye;
+    r->have_truth = source != CL_SRC_CAMERA;
+    r->camera = source == CL_SRC_CAMERA ? s->camera : NULL;
+    r->save = source == CL_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
+    r->pattern = pattern;
+    r->npoints = (int)np;
+    r->zone = zone * DEG;
+    r->source = source;
+    r->sigma = noise * pitch * 1e-3;
+    r->cam = (cl_camera){(int)w, (int)h, pitch * 1e-3, 3, 1000, 100, 50};
+    r->seed = (uint64_t)seed;
+    r->threads = threads_wanted();
+    r->expose_ms = ms;
+    r->stop = stop_cb;
+    r->model = model;
+    r->check_tol = check_tol_um() * 1e-3;
+    r->rig = &s->rig;
+    if (!(r->pt = calloc((size_t)r->npoints, sizeof *r->pt))) {
+        rc = calc_fail(c, CS(NO_MEMORY));
+        goto out;
+    }
+    if (s->have_rig) say(s, CS(RIG_LOADED), s->rig.path, g.cornea.R);
+    {
+        trace_get_api_fn tget =
+            (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
+        r->tr = tget ? tget(TRACE_ABI) : NULL;
+        if (!r->tr) say(s, "%s", CS(NO_TRACER));
+    }
+    if (source != CL_SRC_MODEL) {
+        imaging_get_api_fn iget =
+            (imaging_get_api_fn)lm_engine_symbol("imaging", IMAGING_API_SYMBOL);
+        r->im = iget ? iget(IMAGING_ABI) : NULL;
+        if (!r->im || !r->im->frame) { rc = calc_fail(c, CS(NO_IMAGING)); goto out; }
+        if (source == CL_SRC_CAMERA)
+            say(s, CS(CAMERA_ON), s->camera, pitch);
+        else
+            say(s, CS(FRAMES_ON), r->cam.width, r->cam.height, pitch, r->cam.spot_w,
+                r->cam.peak, r->cam.bias, r->cam.read_noise);
+    } else {
+        say(s, CS(MODEL_ON), noise, r->sigma * 1e3);
+    }
+    if (chip >= 1) {
+        rg_open_opts o = {RG_BACKEND_SIM, NULL, strcmp(s->log, "-") ? s->log : NULL, NULL, 0};
+        if (chip == 2) o = (rg_open_opts){RG_BACKEND_GPIOD, NULL, NULL, NULL, 1};
+        char err[RG_ERRMAX];
+        rg_pose p;
+        hook_api = rg;
+        lm_on_stop(laser_off_hook, NULL);
+        if (rg->open(&s->rig, &o, &m, err, sizeof err) ||
+            rg->home(m, stop_cb, NULL, err, sizeof err)) {
+            say(s, CS(MACHINE_FAILED), err);
+            rc = LM_FAIL;
+            goto out;
+        }
+        rg->position(m, NULL, &p);
+        char buf[256];
+        snprintf(buf, sizeof buf, "m1a %.4g deg, m1b %.4g deg, u %.4g mm, v %.4g mm, "
+                 "m2a %.4g deg, m2b %.4g deg", p.j[0] / DEG, p.j[1] / DEG, p.j[2], p.j[3],
+                 p.j[4] / DEG, p.j[5] / DEG);
+        say(s, CS(OPENED), chip == 2 ? s->rig.chip : "the simulator", buf);
+        lm_say(io, LM_OUT, "%s\n", rg->sched_note(m));   /* varies: not recorded */
+        r->m = m;
+    }
+    rc = run(s, r, &m);
+    if (rc == LM_GO && r->save) say(s, CS(SAVED), r->save, r->nplanned);
+    if (rc == LM_GO && r->have_truth) {
+        cn_params t;
+        cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
+        say(s, CS(TRUTH), eye.R, eye.R2, km, cyl);
+        say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km,
+            model == CN_BICONIC ? remainder(r->res.k.K1_axis - fmod(axis + 360, 180), 180.0)
+                                : 0.0);
+    }
+    if (rc == LM_GO) {
+        if (r->check_max > r->check_tol) {
+            fprintf(stderr, "lensmat: ");
+            fprintf(stderr, CS(CHECK_FAILED), r->check_max * 1e3, r->check_tol * 1e3);
+            rc = LM_FAIL;
+        }
+    }
+    if (m) { rg->close(m); m = NULL; }       /* laser off, then drivers disabled */
+    if (rc == LM_GO && strcmp(s->report, "-")) {
+        char err[256];
+        if (cs_write_report(s->report, s->text ? s->text : "", s->len, err, sizeof err)) {
+            if (lm_stop_requested()) rc = LM_FAIL;
+            else rc = calc_fail(c, CS(NO_REPORT));
+            fprintf(stderr, "lensmat: ");
+            fprintf(stderr, CS(REPORT_FAILED), s->report, err);
+        } else {
+            lm_say(io, LM_OUT, CS(REPORT_WRITTEN), s->report);
+        }
+    }
+    if (rc == LM_GO) rc = calc_done(c);
+out:
+    if (m) rg->close(m);
+    if (hook_api) { lm_on_stop_remove(laser_off_hook, NULL); hook_api = NULL; }
+    free(r->pt);
+    free(r);
+    free(s->text);
+    free(s);
+    return rc;
+}
+
+/* The measurement and its report. */
+static int run(cs *s, cl_run *r, rg_machine **m)
+{
+    static const char *const pname[] = {"spiral", "rings", "grid"};
+    calc *c = &s->cc;
+    const cornea_api *cn = r->cn;
     char err[256];
-    static char buf[4096];
-    int got = cn->simulate(rg, &g, &eye, &so, sp, n, err, sizeof err);
-    int ok = 0;
-    for (int i = 0; i < got; i++) ok += sp[i].status == CN_S_OK;
-    calc_say(c, CS(SCANNED), n, ok, sigma * 1e3);
-    cn_fit_opts fo = {.model = model, .stop = stop_cb};
-    cn_result r;
-    if (got < 0 || cn->fit(&g, sp, got, NULL, &fo, &r, err, sizeof err)) {
-        free(sp);
-        if (lm_stop_requested()) return LM_FAIL;
-        calc_say(c, CS(FAILED), got < 0 ? "no scan" : err);
+    static char buf[8192];
+    int rc = cl_measure(r, err, sizeof err);
+    int counts[6];
+    cl_counts(r, counts);
+    if (rc == CN_ESTOP || lm_stop_requested()) return LM_FAIL;
+    if (rc == CN_EINVAL || rc == CN_ENOMEM) {   /* the machine, the camera or saving */
+        if (*m) { r->rg->close(*m); *m = NULL; }
+        say(s, CS(MACHINE_FAILED), err);
+        fprintf(stderr, "lensmat: %s\n", err);
         return LM_FAIL;
     }
-    free(sp);
-    cn->report(&r, buf, sizeof buf);
+    say(s, CS(PLANNED), pname[r->pattern], r->npoints, r->zone / DEG, r->nplanned, r->nexposed);
+    double ssum = 0;
+    int sn = 0;
+    for (int k = 0; k < r->npoints; k++)
+        if (r->pt[k].planned && isfinite(r->pt[k].spot.u)) { ssum += r->pt[k].spot.sigma; sn++; }
+    say(s, CS(SCANNED), r->nplanned, sn, (r->source == CL_SRC_MODEL || !sn ? r->sigma
+                                           : ssum / sn) * 1e3);
+    if (rc) {
+        calc_say(c, CS(FAILED), err);
+        return LM_FAIL;
+    }
+    cn->report(&r->res, buf, sizeof buf);
     for (char *l = buf, *e; *l; l = e + 1) {     /* line by line into the record */
         e = strchr(l, '\n');
-        if (!e) { calc_say(c, CS(LINE), l); break; }
+        if (!e) { say(s, CS(LINE), l); break; }
         *e = 0;
-        calc_say(c, CS(LINE), l);
+        say(s, CS(LINE), l);
     }
-    cn_params t;
-    cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
-    calc_say(c, CS(TRUTH), eye.R, eye.R2, km, cyl);
-    calc_say(c, CS(ERRORS), (r.k.R - t.p[CN_R]) * 1e3, r.k.Km - km,
-             model == CN_BICONIC ? remainder(r.k.K1_axis - fmod(axis + 360, 180), 180.0)
-                                 : 0.0);
-    return calc_done(c);
+    say(s, CS(SPOTS), counts[CN_S_OK],
+        counts[CN_S_NONE] + counts[CN_S_SEVERAL] + counts[CN_S_OUTLIER] + counts[CN_S_MISS],
+        counts[CN_S_NONE], counts[CN_S_SEVERAL], counts[CN_S_OUTLIER], counts[CN_S_MISS],
+        counts[5]);
+    for (int k = 0; k < r->npoints; k++) {
+        const cl_point *q = &r->pt[k];
+        if (q->planned && q->spot.status == CN_S_OK) continue;
+        say(s, CS(REJECTED), k + 1, q->t.a / DEG, q->t.b / DEG, q->why);
+    }
+    if (r->tr)
+        say(s, CS(CHECK), r->check_n, r->check_max * 1e3, r->check_tol * 1e3,
+            r->check_max <= r->check_tol ? CS(CHECK_OK) : CS(CHECK_BAD));
+    else
+        say(s, "%s", CS(CHECK_NONE));
+    /* times vary from run to run: stdout only, never in the record or the report */
+    lm_say(c->io, LM_OUT, CS(TIMES), r->threads, r->tm.plan, r->tm.machine, r->tm.frames,
+           r->tm.fit, r->tm.check, r->tm.total, r->tm.cpu);
+    return LM_GO;
 }
+
 const char *lm_cornea_scan_example(void) { return CS(EXAMPLE); }

@@ -31,6 +31,7 @@ int lm_prescription(lm_io *io);    const char *lm_prescription_example(void);
 int lm_to_prescription(lm_io *io); const char *lm_to_prescription_example(void);
 int lm_spot(lm_io *io);        const char *lm_spot_example(void);   /* spot.c: --spot */
 int lm_colour(lm_io *io);       const char *lm_colour_example(void);   /* colour.c */
+int lm_pupil(lm_io *io);        const char *lm_pupil_example(void);    /* pupil.c */
 
 /* A lens read from a file (prescription.c): a classic record, its grep'd or plain
  * answers, or a prescription file.  lm_read_lens: LM_GO, or LM_FAIL with
@@ -45,5 +46,19 @@ typedef struct lm_lens_file {
 } lm_lens_file;
 int  lm_read_lens(const char *path, lm_lens_file *lf, char *err, size_t cap);
 void lm_lens_file_free(lm_lens_file *lf);
+/* The same from a text in memory (len bytes; s is cut up). */
+int  lm_lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, char *err,
+                     size_t cap);
+
+/* Lens files of the lens model (lensfile.c): a thickness prescription or a .zmx?
+ * lm_model_answers: its classic dialogue answers (malloc'd text in *out, *outlen
+ * bytes); unless quiet, the reader's notes and what the classic cannot take go to
+ * stderr.  LM_GO, or LM_FAIL with "FILE:LINE: why" in err.  --to-zmx and
+ * --to-thickness convert any lens file. */
+int lm_is_model_file(const char *s, size_t len);
+int lm_model_answers(const char *src, const char *s, size_t len, char **out, size_t *outlen,
+                     int quiet, char *err, size_t cap);
+int lm_to_zmx(lm_io *io);       const char *lm_to_zmx_example(void);
+int lm_to_thickness(lm_io *io); const char *lm_to_thickness_example(void);
 
 #endif

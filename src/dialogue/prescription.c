@@ -5,7 +5,8 @@
  * dialogue's answers and runs lm_classic, so its record is an ordinary classic record
  * (grep input: replays it).  --to-prescription reads a classic record or answer file
  * and writes the prescription file.  lm_read_lens reads any of the three into
- * surfaces (for --trace's record choice).  Texts in prompts/prescription.txt. */
+ * surfaces (for --trace's record choice).  Thickness prescriptions and .zmx files
+ * go through the lens model (lensfile.c).  Texts in prompts/prescription.txt. */
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -35,9 +36,22 @@ static void put(text *t, const char *a, const char *b)
     t->len += (size_t)sprintf(t->s + t->len, "%s%s\n", a, b);
 }
 
-/* All of `in` as one NUL-terminated string (NUL bytes in it end the text early).
- * NULL with err set if it is too long or cannot be read. */
-static char *slurp(FILE *in, const char *src, char *err, size_t cap)
+/* A NUL byte in s (len bytes) is refused with its line: 0, or -1 with err set. */
+static int nul_check(const char *s, size_t len, const char *src, char *err, size_t cap)
+{
+    const char *t = memchr(s, '\0', len);
+    long line = 1;
+    if (!t) return 0;
+    for (const char *p = s; p < t; p++) line += *p == '\n';
+    snprintf(err, cap, PS(NUL_BYTE), src, line);
+    return -1;
+}
+
+/* All of `in` as one NUL-terminated string of *lenp bytes (lenp may be NULL); NUL
+ * bytes are refused unless allow_nul (a UTF-16 .zmx holds them).  NULL with err set
+ * if it is too long, cannot be read, or holds a NUL. */
+static char *slurp_n(FILE *in, const char *src, char *err, size_t cap, size_t *lenp,
+                     int allow_nul)
 {
     char *s = NULL, *t;
     size_t len = 0, room = 0, n;
@@ -66,15 +80,14 @@ static char *slurp(FILE *in, const char *src, char *err, size_t cap)
         len -= 3;
         memmove(s, s + 3, len + 1);
     }
-    if ((t = memchr(s, '\0', len))) {   /* every string function would cut there */
-        long line = 1;
-        for (const char *p = s; p < t; p++) line += *p == '\n';
-        snprintf(err, cap, PS(NUL_BYTE), src, line);
+    if (!allow_nul && nul_check(s, len, src, err, cap)) {  /* string functions cut there */
         free(s);
         return NULL;
     }
+    if (lenp) *lenp = len;
     return s;
 }
+
 
 /* ---- prescription files -> the classic dialogue's answers ------------------------ */
 
@@ -251,12 +264,16 @@ int lm_prescription(lm_io *io)
     rx r;
     FILE *answers;
     char src[600], err[1200], *s;
+    size_t len;
     int rc;
     memset(&r, 0, sizeof r);
     r.src = io->src;
     r.err = err;
     r.errcap = sizeof err;
-    if (!(s = slurp(io->in, io->src, err, sizeof err))) rc = LM_FAIL;
+    if (!(s = slurp_n(io->in, io->src, err, sizeof err, &len, 1))) rc = LM_FAIL;
+    else if (lm_is_model_file(s, len))     /* by thickness, or a .zmx: lensfile.c */
+        rc = lm_model_answers(io->src, s, len, &r.ans.s, &r.ans.len, 0, err, sizeof err);
+    else if (nul_check(s, len, io->src, err, sizeof err)) rc = LM_FAIL;
     else rc = read_prescription(&r, s);
     free(s);
     if (rc) { say_error(err); free(r.ans.s); return rc; }
@@ -419,13 +436,26 @@ static void keep_input_lines(char *s)
 
 /* The lens in text s (a prescription, a classic record or its answers; s is cut up).
  * LM_GO, or LM_FAIL with "FILE:LINE: why" in err. */
-static int lens_of_text(const char *src, char *s, lm_lens_file *lf, char *err, size_t cap)
+static int lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, char *err,
+                        size_t cap)
 {
     cursor c = {src, s, "", 0, err, cap};
-    char asrc[600];
+    char asrc[600], *ans;
+    size_t alen;
     rx r;
     int rc;
     memset(lf, 0, sizeof *lf);
+    if (lm_is_model_file(s, len)) {         /* by thickness, or a .zmx: lensfile.c */
+        if (lm_model_answers(src, s, len, &ans, &alen, 1, err, cap)) return LM_FAIL;
+        snprintf(asrc, sizeof asrc, "%s (as classic answers)", src);
+        c.src = asrc;
+        c.next = ans;
+        rc = read_answers(&c, lf);
+        free(ans);
+        if (rc) lm_lens_file_free(lf);
+        return rc;
+    }
+    if (nul_check(s, len, src, err, cap)) return LM_FAIL;
     keep_input_lines(s);
     if (!is_prescription(s)) {
         rc = read_answers(&c, lf);
@@ -450,6 +480,7 @@ int lm_read_lens(const char *path, lm_lens_file *lf, char *err, size_t cap)
     struct stat st;
     FILE *f;
     char *s;
+    size_t len;
     int rc;
     memset(lf, 0, sizeof *lf);
     if (stat(path, &st) || !(f = fopen(path, "r"))) {
@@ -461,12 +492,18 @@ int lm_read_lens(const char *path, lm_lens_file *lf, char *err, size_t cap)
         snprintf(err, cap, PS(NOT_REGULAR), path);
         return LM_FAIL;
     }
-    s = slurp(f, path, err, cap);
+    s = slurp_n(f, path, err, cap, &len, 1);
     fclose(f);
     if (!s) return LM_FAIL;
-    rc = lens_of_text(path, s, lf, err, cap);
+    rc = lens_of_text(path, s, len, lf, err, cap);
     free(s);
     return rc;
+}
+
+int lm_lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, char *err,
+                    size_t cap)
+{
+    return lens_of_text(src, s, len, lf, err, cap);
 }
 
 void lm_lens_file_free(lm_lens_file *lf)
@@ -508,8 +545,9 @@ static void write_prescription(lm_io *out, const lm_lens_file *lf)
 int lm_to_prescription(lm_io *io)
 {
     lm_lens_file lf;
-    char err[1200], *s = slurp(io->in, io->src, err, sizeof err);
-    if (!s || lens_of_text(io->src, s, &lf, err, sizeof err)) {
+    size_t len;
+    char err[1200], *s = slurp_n(io->in, io->src, err, sizeof err, &len, 1);
+    if (!s || lens_of_text(io->src, s, len, &lf, err, sizeof err)) {
         free(s);
         say_error(err);
         return LM_FAIL;

@@ -31,7 +31,7 @@ const lm_dialogue lm_dialogues[] = {
      lm_vision_example, NULL, 0},
     {"--cornea", "corneal radius <-> power, measuring accuracy (section 37)", lm_cornea,
      lm_cornea_example, NULL, 0},
-    {"--cornea-scan", "simulated cornea measurement: rig scan, fit, Sim K (issue 12)", lm_cornea_scan, lm_cornea_scan_example, "cornea", 0},
+    {"--cornea-scan", "cornea measurement: rig scan, traced spots, frames, centroids, fit, Sim K (issue 12)", lm_cornea_scan, lm_cornea_scan_example, "cornea", 0},
     {"--fit", "lens matrix from measurements (lsq), cardinal or nodal points (14, 24, 26)",
      lm_fit, lm_fit_example, "fit", 0},
     {"--spot", "laser-spot centroids in a detector frame: file, raw, synthetic or a stream (36, 46)",
@@ -42,6 +42,12 @@ const lm_dialogue lm_dialogues[] = {
      lm_to_prescription, lm_to_prescription_example, NULL, 0},
     {"--colour", "per wavelength: glasses by name, focal lengths, colour, Abbe numbers",
      lm_colour, lm_colour_example, NULL, 0},
+    {"--to-zmx", "write any lens file (-i FILE: .zmx, prescription, record) as OpticStudio .zmx",
+     lm_to_zmx, lm_to_zmx_example, NULL, 0},
+    {"--to-thickness", "write any lens file (-i FILE) as a prescription by thickness",
+     lm_to_thickness, lm_to_thickness_example, NULL, 0},
+    {"--pupil", "a lens file's pupils, chief rays, spots and fans of rays aimed at the stop",
+     lm_pupil, lm_pupil_example, "trace", 0},
 };
 const size_t lm_ndialogues = sizeof lm_dialogues / sizeof lm_dialogues[0];
 

@@ -407,4 +407,61 @@ int px_seidel_run(const px_csurf *s, int nsurf, const char *obj_glass, double y1
 int px_seidel_run_stop(const px_csurf *s, int nsurf, const char *obj_glass, double y1,
                        double ubar1, int stop, px_seidel *out);
 
+/* ---- first-order pupils (pupil.c) -----------------------------------------------
+ * A prescription by thickness (px_csurf, surface 1 at z = 0) at one wavelength, its
+ * aperture stop (0-based surface index), an aperture and an object.  Two paraxial
+ * rays are traced (y-nu: height y and n u at every surface; u = dy/dz after the
+ * surface): the marginal ray (from the object's axial point to the rim of the stop)
+ * and the chief ray (from the edge of the field through the centre of the stop).
+ * Aperture, as in lens design programs:
+ *   PX_AP_EPD   entrance pupil diameter;
+ *   PX_AP_FNUM  image-space f-number efl/EPD (the EPD follows; needs a focal system);
+ *   PX_AP_NA    object-space numerical aperture n u of the paraxial marginal ray
+ *               (finite objects only);
+ *   PX_AP_STOP  the stop's semi-diameter itself.
+ * Object: obj_dist = distance from the object to surface 1 (INFINITY: at infinity,
+ * field = angle in degrees, |angle| < 90); finite: field = object height.  Results:
+ * pupils (z of the vertex-plane crossing, surface 1 at 0; semi-diameters), the
+ * paraxial image plane and the image height of the field, f-numbers, NAs and the
+ * Lagrange invariant H = n (ubar y - u ybar).  A pupil at infinity (telecentric
+ * side) has z = +-INFINITY, its semi-diameter INFINITY.  Refusals (out->why says
+ * which): PX_BAD (inputs), PX_AT_INFINITY (afocal: no image, no f-number; refused),
+ * PX_NO_PUPIL (the stop is conjugate to the object: the marginal ray cannot reach
+ * its rim, or the chief ray is undefined). */
+enum { PX_AP_EPD = 0, PX_AP_FNUM = 1, PX_AP_NA = 2, PX_AP_STOP = 3 };
+enum { PX_NO_PUPIL = 6 };
+#define PX_PUPIL_MAXSURF 64
+typedef struct px_pupil_in {
+    const px_csurf *s;
+    int nsurf, stop;           /* stop: 0-based */
+    const char *obj_glass;
+    double lambda;             /* um */
+    int aperture;              /* PX_AP_* */
+    double ap_value;
+    double obj_dist;           /* INFINITY, or the object's distance left of surface 1 */
+    double field;              /* degrees (object at infinity) or object height */
+} px_pupil_in;
+typedef struct px_pupil {
+    int nsurf, stop;
+    double n[PX_PUPIL_MAXSURF + 1];       /* n[0] object space, n[k+1] right of k */
+    double z[PX_PUPIL_MAXSURF];           /* vertices, surface 1 at 0 */
+    /* the two rays: height at surface k, slope right of it; [0] of u, ub: object */
+    double y[PX_PUPIL_MAXSURF], u[PX_PUPIL_MAXSURF + 1];
+    double yb[PX_PUPIL_MAXSURF], ub[PX_PUPIL_MAXSURF + 1];
+    double efl;                           /* effective focal length -1/C (px_first) */
+    double z_ep, r_ep;                    /* entrance pupil */
+    double z_xp, r_xp;                    /* exit pupil */
+    double r_stop;                        /* the stop's semi-diameter */
+    double z_img;                         /* paraxial image plane (inf: at infinity) */
+    double h_img;                         /* paraxial image height of the field */
+    double fnum;                          /* efl/EPD (image-space f-number) */
+    double work_fnum;                     /* 1/(2 n' |u'|): working f-number */
+    double na_obj, na_img;                /* n |u| of the marginal ray in object and
+                                             image space (0 with the object at inf) */
+    double mag;                           /* lateral magnification (finite object) */
+    double lagrange;                      /* H */
+    const char *why;                      /* a refusal's reason, or "" */
+} px_pupil;
+int px_pupil_run(const px_pupil_in *in, px_pupil *out);
+
 #endif

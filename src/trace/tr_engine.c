@@ -1,6 +1,6 @@
 /* tr_engine.c -- the function table the trace module exports (trace_get_api): the
  * scene (tr_scene.c), the run (tr_pool.c, tr_lanes.c, tr_trace.c), optics
- * (tr_optics.c) and lenses (tr_lens.c) behind one ABI-checked table. */
+ * (tr_optics.c), lenses (tr_lens.c) and aimed rays (tr_aim.c) behind one ABI-checked table. */
 #include "tr_eng.h"
 
 /* ---------------- the table ---------------- */
@@ -38,6 +38,8 @@ static const trace_api api = {
     tr_add_lens,
     tr_lens_fan,
     tr_set_absorption,
+    tr_rx_trace,
+    tr_rx_aim,
 };
 
 const trace_api *trace_get_api(int abi)

@@ -277,6 +277,12 @@ int tr_add_lens(trace_scene *sc, const trace_lens *lens);
 int tr_lens_fan(const trace_lens *lens, double z_obj, double y_obj, double z_paraxial,
                 int nrays, const double *h, trace_fan_ray *out, char *err, size_t cap);
 
+/* ---- real rays aimed at the stop (tr_aim.c), the table's rx_trace and rx_aim ---- */
+int tr_rx_trace(const trace_rx *rx, const double o[3], const double d[3], double *pts,
+                trace_aim_ray *out, char *err, size_t cap);
+int tr_rx_aim(const trace_rx *rx, const trace_aim_req *rq, trace_aim_ray *out, char *err,
+              size_t cap);
+
 /* Lens hints (tr_scene.c): after refraction at surface id a forward ray can only
  * meet cand[0..n-1] (-1 entries skipped); valid until another surface is added. */
 void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n);

@@ -280,6 +280,65 @@ typedef struct trace_fresnel_coef {
     int tir;
 } trace_fresnel_coef;
 
+/* ---- real rays aimed at the stop (tr_aim.c) ----------------------------------
+ * A sequential prescription with conics and aspheres: surfaces left to right, each
+ * an axial surface of the z axis (vertex z, radius: 0 or inf plane, > 0 centre to
+ * the right; conic and even-asphere terms as trace_surface), the index to its right
+ * (one wavelength: the caller's), its clear semi-diameter (0: none).  No Embree: a
+ * ray meets the surfaces in order, in double, with the engine's own intersections
+ * and Snell law.  Clear apertures do not bound the surfaces while a ray is aimed; a
+ * converged ray that passes outside one is reported vignetted there. */
+typedef struct trace_rx_surface {
+    double z, radius, conic;
+    double asph[TRACE_MAXASPH];
+    int nasph;
+    double n_right;
+    double semi_diameter;
+} trace_rx_surface;
+typedef struct trace_rx {
+    double n_object;
+    int nsurf;
+    const trace_rx_surface *surf;
+    int stop;                  /* the aperture stop, 0-based */
+    double stop_radius;        /* what px, py = 1 means at the stop */
+    double z_image;            /* the image plane rays are carried to (NaN: none) */
+} trace_rx;
+enum trace_aim_status {
+    TRACE_AIM_OK,              /* crosses the stop at its target */
+    TRACE_AIM_VIGNETTED,       /* aimed, but outside a clear semi-diameter (surface) */
+    TRACE_AIM_MISSED,          /* misses a surface (surface) */
+    TRACE_AIM_TIR,             /* totally reflected at a surface (surface) */
+    TRACE_AIM_NOCONV           /* Newton did not bring it to the target */
+};
+/* What to aim: from the object point obj (finite: z left of surface 1), or a beam
+ * from infinity along dir; to the stop point (px, py) * stop_radius (local x, y of
+ * the stop's vertex).  The unknowns start at the caller's paraxial guess: for a
+ * finite object the ray's slopes dx/dz, dy/dz; for infinity the point (x, y) where it
+ * crosses the plane z = z_ref.  tol: stop residual accepted (0: 1e-10 * max(1,
+ * stop_radius)); max_iter 0: 40. */
+typedef struct trace_aim_req {
+    int infinite;
+    double obj[3], dir[3];
+    double px, py;
+    double guess[2];
+    double z_ref;
+    double tol;
+    int max_iter;
+} trace_aim_req;
+typedef struct trace_aim_ray {
+    int status;                /* enum trace_aim_status */
+    int surface;               /* where it failed (0-based), or -1 */
+    int iterations;            /* Newton steps taken (0: the guess was on target) */
+    int traces;                /* rays traced to get there */
+    double residual;           /* |stop crossing - target| */
+    double v[2];               /* the unknowns found (slopes, or x, y at z_ref) */
+    double o[3], d[3];         /* the ray in object space (o: the object point, or
+                                  its crossing of z_ref) */
+    double stop[3];            /* its stop crossing */
+    double img[3], img_dir[3]; /* at z_image (NaN if none) */
+    double opl;                /* optical path from o to the image plane */
+} trace_aim_ray;
+
 typedef struct trace_scene trace_scene;
 
 typedef struct trace_api {
@@ -331,6 +390,18 @@ typedef struct trace_api {
      * tr_pool.c).  Per-triangle media (trace_mesh.media) stay transparent.  TRACE_OK
      * or TRACE_EINVAL. */
     int (*set_absorption)(trace_scene *sc, int id, double alpha_front, double alpha_back);
+
+    /* Real rays aimed at the stop (ABI 1 additions).  rx_trace: the ray o, d (unit,
+     * in the object medium) through rx in order to z_image; out->status and
+     * out->surface as above (clear apertures checked), pts (NULL or 3*nsurf
+     * doubles): the surface crossings.  rx_aim: Newton on the stop crossing from the
+     * guess (a damped step when a trial ray fails), then the converged ray traced to
+     * z_image.  Both: TRACE_OK with the ray's status in out, or TRACE_EINVAL (bad
+     * rx or request: err says why). */
+    int (*rx_trace)(const trace_rx *rx, const double o[3], const double d[3],
+                    double *pts, trace_aim_ray *out, char *err, size_t errcap);
+    int (*rx_aim)(const trace_rx *rx, const trace_aim_req *rq, trace_aim_ray *out,
+                  char *err, size_t errcap);
 } trace_api;
 
 typedef const trace_api *(*trace_get_api_fn)(int abi);

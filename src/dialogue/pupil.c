@@ -1,0 +1,663 @@
+/* pupil.c -- the --pupil dialogue: a lens file (a thickness prescription or a Zemax
+ * .zmx, read by src/lens) with its stop, aperture, fields and wavelengths (asked when
+ * the file has none); per wavelength the first-order pupil data and the paraxial
+ * marginal and chief rays (src/paraxial/pupil.c), then per field the real chief ray,
+ * the spot of real rays aimed at the stop (grid or hexapolar pupil sampling; RMS
+ * about the chief ray and about the centroid) and, if asked, ray fans (the trace
+ * module's rx_aim, loaded on first use).  Texts in prompts/pupil.txt. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "calcio.h"
+#include "dialogues.h"
+#include "engine.h"
+#include "../lens/lens.h"
+#include "../paraxial/paraxial.h"
+#include "../trace/trace.h"
+#include "prompts_pupil.h"
+
+#define P(k) pupil_prompts[PUPIL_##k]
+#define CL(v) lm_clean(d->io, snap(d, (v)))
+#define WORD 4096
+#define MAXFIELD 16
+#define MAXSAMPLE 4096
+#define FILE_MAX (16 << 20)
+#define DEG (3.14159265358979323846 / 180)
+
+typedef struct pdlg {
+    lm_io *io;
+    calc c;
+    ln_lens lens;
+    int have;                  /* lens holds the accepted file */
+    ln_notes notes;
+    const trace_api *tr;
+    int sampling, nsamp_arg, fans, fan_rays;
+    int nsamp;
+    double spx[MAXSAMPLE], spy[MAXSAMPLE];
+    double scale;              /* the lens's size: below 1e-13 of it a result is 0 */
+} pdlg;
+
+/* A centroid or a height that is zero but for rounding (1e-17 on the axis) prints as
+ * 0: the same on every build and in every replay. */
+static double snap(const pdlg *d, double v)
+{
+    return fabs(v) <= 1e-13 * d->scale ? 0.0 : v;
+}
+
+/* ---- the lens file ---------------------------------------------------------------- */
+
+static char *slurp(const char *path, size_t *len, char *msg, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    size_t n = 0, got;
+    if (!f) { snprintf(msg, cap, "%s: cannot be read", path); return NULL; }
+    buf = malloc(FILE_MAX + 1);
+    if (!buf) { fclose(f); snprintf(msg, cap, "out of memory"); return NULL; }
+    while ((got = fread(buf + n, 1, FILE_MAX + 1 - n, f)) > 0) n += got;
+    fclose(f);
+    if (n > FILE_MAX) {
+        free(buf);
+        snprintf(msg, cap, "%s: larger than 16 MiB: not a lens file", path);
+        return NULL;
+    }
+    buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+static int check_file(void *ctx, const char *word, char *msg, size_t cap)
+{
+    pdlg *d = ctx;
+    size_t len;
+    char err[LN_ERR_MAX];
+    char *text = slurp(word, &len, msg, cap);
+    ln_lens l;
+    ln_notes notes = {0};
+    int r, read_ok;
+    if (!text) return 1;
+    if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
+    else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
+    free(text);
+    read_ok = r == LN_OK;
+    if (r == LN_OK && ln_check(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
+    if (r == LN_OK && isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_HEIGHT) {
+        snprintf(err, sizeof err, "%s: object heights as fields need a finite object "
+                 "(the object is at infinity: give field angles)", word);
+        r = LN_BAD;
+    }
+    if (r == LN_OK && !isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_ANGLE) {
+        snprintf(err, sizeof err, "%s: field angles with a finite object: give the "
+                 "fields as object heights", word);
+        r = LN_BAD;
+    }
+    if (r == LN_OK && !isinf(l.object) && !(l.object > 0)) {
+        snprintf(err, sizeof err, "%s: the object lies %s surface 1 (a virtual object): "
+                 "rays are aimed only from a real object left of it, or from infinity",
+                 word, l.object == 0 ? "on" : "right of");
+        r = LN_BAD;
+    }
+    if (r == LN_OK && l.nsurf > PX_PUPIL_MAXSURF) {
+        snprintf(err, sizeof err, "%s: %d surfaces: at most %d", word, l.nsurf,
+                 PX_PUPIL_MAXSURF);
+        r = LN_BAD;
+    }
+    if (r != LN_OK) {
+        if (read_ok) ln_free(&l);
+        ln_notes_free(&notes);
+        snprintf(msg, cap, "%s", err);
+        return 1;
+    }
+    if (d->have) ln_free(&d->lens);
+    ln_notes_free(&d->notes);
+    d->lens = l;
+    d->notes = notes;
+    d->have = 1;
+    return 0;
+}
+
+/* ---- small questions -------------------------------------------------------------- */
+
+typedef struct count_ctx { int lo, hi, value; const char *bad; } count_ctx;
+static int check_count(void *ctx, const char *w, char *msg, size_t cap)
+{
+    count_ctx *k = ctx;
+    char *end;
+    long v = strtol(w, &end, 10);
+    if (end == w || *end || v < k->lo || v > k->hi) {
+        snprintf(msg, cap, k->bad, w, k->lo, k->hi);
+        return 1;
+    }
+    k->value = (int)v;
+    return 0;
+}
+
+static int ask_count(pdlg *d, const char *q, const char *bad, int lo, int hi, int *v)
+{
+    char buf[32];
+    count_ctx k = {lo, hi, 0, bad};
+    int rc = lm_ask_word(d->io, q, q, P(COUNT_WHAT), check_count, &k, buf, sizeof buf);
+    *v = k.value;
+    return rc;
+}
+
+static int check_stop(void *ctx, const char *w, char *msg, size_t cap)
+{
+    count_ctx *k = ctx;
+    char *end;
+    long v = strtol(w, &end, 10);
+    if (end == w || *end || v < 1 || v > k->hi) {
+        snprintf(msg, cap, P(STOP_BAD), w, k->hi);
+        return 1;
+    }
+    k->value = (int)v;
+    return 0;
+}
+
+/* Whatever the file leaves out: the stop, the aperture, the fields. */
+static int ask_missing(pdlg *d)
+{
+    ln_lens *l = &d->lens;
+    char q[256], buf[32];
+    int rc;
+    if (l->stop < 0) {
+        count_ctx k = {1, l->nsurf, 0, NULL};
+        snprintf(q, sizeof q, P(STOP), l->nsurf);
+        if ((rc = lm_ask_word(d->io, q, q, P(STOP_WHAT), check_stop, &k, buf, sizeof buf)))
+            return rc;
+        l->stop = k.value - 1;
+    }
+    if (l->ap_kind == LN_AP_NONE) {
+        static const char *const kinds[] = {"epd", "fnum", "na", NULL};
+        int i = 0;
+        double v;
+        if ((rc = calc_choice(&d->c, P(AP_KIND), P(AP_KIND_WHAT), kinds, &i)) ||
+            (rc = calc_num(&d->c, P(AP_VALUE), P(AP_VALUE_WHAT), LM_POSITIVE, &v)))
+            return rc;
+        l->ap_kind = i == 0 ? LN_AP_EPD : i == 1 ? LN_AP_FNUM : LN_AP_NA;
+        l->ap_value = v;
+    }
+    if (l->nfield == 0) {
+        int n, inf = isinf(l->object);
+        if ((rc = ask_count(d, P(NFIELD), P(NFIELD_BAD), 1, MAXFIELD, &n))) return rc;
+        l->field_kind = inf ? LN_FIELD_ANGLE : LN_FIELD_HEIGHT;
+        for (int i = 0; i < n; i++) {
+            double v;
+            for (;;) {
+                lm_mark m;
+                snprintf(q, sizeof q, inf ? P(FIELD_ANGLE) : P(FIELD_HEIGHT), i + 1);
+                calc_mark(&d->c, &m);
+                if ((rc = calc_num(&d->c, q, P(FIELD_WHAT), 0, &v))) return rc;
+                if (!inf || fabs(v) < 90) break;
+                if ((rc = calc_reject(&d->c, &m, P(FIELD_WHAT), q, P(AGAIN_FIELD), "%s",
+                                      P(FIELD_BAD))))
+                    return rc;
+            }
+            l->field[i].x = 0;
+            l->field[i].y = v;
+            l->field[i].weight = 1;
+        }
+        l->nfield = n;
+    }
+    return LM_GO;
+}
+
+/* Grid: cell centres of n x n across [-1, 1]^2 inside the unit circle; hexapolar: the
+ * centre and rings k = 1..n of 6k points at radius k/n. */
+static void make_samples(pdlg *d)
+{
+    int n = d->nsamp_arg;
+    d->nsamp = 0;
+    if (d->sampling == 0) {
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double x = -1 + (2.0 * j + 1) / n, y = -1 + (2.0 * i + 1) / n;
+                if (x * x + y * y > 1) continue;
+                d->spx[d->nsamp] = x;
+                d->spy[d->nsamp++] = y;
+            }
+    } else {
+        d->spx[0] = d->spy[0] = 0;
+        d->nsamp = 1;
+        for (int k = 1; k <= n; k++)
+            for (int j = 0; j < 6 * k; j++) {
+                double a = 2 * 3.14159265358979323846 * j / (6 * k), r = (double)k / n;
+                d->spx[d->nsamp] = r * sin(a);
+                d->spy[d->nsamp++] = r * cos(a);
+            }
+    }
+}
+
+static int ask_sampling(pdlg *d)
+{
+    static const char *const kinds[] = {"grid", "hex", NULL};
+    int rc;
+    if ((rc = calc_choice(&d->c, P(SAMPLING), P(SAMPLING_WHAT), kinds, &d->sampling)))
+        return rc;
+    if (d->sampling == 0) rc = ask_count(d, P(GRID), P(COUNT_BAD), 2, 64, &d->nsamp_arg);
+    else rc = ask_count(d, P(HEX), P(COUNT_BAD), 1, 32, &d->nsamp_arg);
+    if (rc) return rc;
+    if ((rc = calc_yn(&d->c, P(FANS_Q), P(FANS_Q_WHAT), &d->fans))) return rc;
+    if (d->fans && (rc = ask_count(d, P(FAN_RAYS), P(COUNT_BAD), 3, 101, &d->fan_rays)))
+        return rc;
+    make_samples(d);
+    return LM_GO;
+}
+
+/* ---- computing --------------------------------------------------------------------- */
+
+/* A length that may be at infinity (a telecentric pupil): the word, never "inf". */
+static const char *fmt_len(char *buf, size_t cap, double v)
+{
+    if (isinf(v)) snprintf(buf, cap, "%s", v > 0 ? "infinity" : "-infinity");
+    else if (isnan(v)) snprintf(buf, cap, "-");
+    else snprintf(buf, cap, "%.6g", v == 0 ? 0.0 : v);
+    return buf;
+}
+
+/* A ratio that may be undefined (the f-number of an entrance pupil at infinity). */
+static const char *fmt_num(char *buf, size_t cap, double v)
+{
+    if (!isfinite(v)) snprintf(buf, cap, "-");
+    else snprintf(buf, cap, "%.4g", v == 0 ? 0.0 : v);
+    return buf;
+}
+
+static const char *status_word(int st)
+{
+    switch (st) {
+    case TRACE_AIM_VIGNETTED: return "vignetted";
+    case TRACE_AIM_MISSED: return "misses a surface";
+    case TRACE_AIM_TIR: return "totally reflected";
+    case TRACE_AIM_NOCONV: return "Newton did not converge";
+    default: return "ok";
+    }
+}
+
+typedef struct wl_ctx {
+    px_pupil p;                /* unit field: 45 degrees (tan 1) or height 1 */
+    trace_rx rx;
+    trace_rx_surface surf[PX_PUPIL_MAXSURF];
+    double s;                  /* marginal-ray scale: primary stop size / this one */
+} wl_ctx;
+
+static int pupil_at(pdlg *d, const px_csurf *cs, const char *obj, double lambda, px_pupil *p,
+                    char *why, size_t cap)
+{
+    const ln_lens *l = &d->lens;
+    px_pupil_in in = {cs, l->nsurf, l->stop, obj, lambda, PX_AP_EPD, l->ap_value,
+                      isinf(l->object) ? INFINITY : l->object, isinf(l->object) ? 45 : 1};
+    in.aperture = l->ap_kind == LN_AP_FNUM ? PX_AP_FNUM : l->ap_kind == LN_AP_NA ? PX_AP_NA
+                                                                              : PX_AP_EPD;
+    if (px_pupil_run(&in, p) != PX_OK) {
+        snprintf(why, cap, "%s", p->why);
+        return -1;
+    }
+    return 0;
+}
+
+static int build_rx(pdlg *d, wl_ctx *w, double lambda, double r_stop, double z_image,
+                    char *why, size_t cap)
+{
+    const ln_lens *l = &d->lens;
+    double z = 0;
+    memset(w->surf, 0, sizeof w->surf);
+    if (ln_index(l, -1, lambda, &w->rx.n_object, NULL, why, cap) != LN_OK) return -1;
+    for (int i = 0; i < l->nsurf; i++) {
+        const ln_surface *s = &l->surf[i];
+        trace_rx_surface *t = &w->surf[i];
+        t->z = z;
+        t->radius = isfinite(s->r) ? s->r : 0;
+        t->conic = s->conic;
+        t->nasph = s->nasph < TRACE_MAXASPH ? s->nasph : TRACE_MAXASPH;
+        for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
+        t->semi_diameter = s->semi;
+        if (ln_index(l, i, lambda, &t->n_right, NULL, why, cap) != LN_OK) return -1;
+        z += s->t;
+    }
+    w->rx.nsurf = l->nsurf;
+    w->rx.surf = w->surf;
+    w->rx.stop = l->stop;
+    w->rx.stop_radius = r_stop;
+    w->rx.z_image = z_image;
+    return 0;
+}
+
+/* The request for pupil point (px, py) of field f. */
+static void request(const pdlg *d, const wl_ctx *w, const ln_field *f, double px, double py,
+                    trace_aim_req *rq)
+{
+    const px_pupil *p = &w->p;
+    memset(rq, 0, sizeof *rq);
+    rq->px = px;
+    rq->py = py;
+    if (isinf(d->lens.object)) {
+        double tx = tan(f->x * DEG), ty = tan(f->y * DEG), n = sqrt(tx * tx + ty * ty + 1);
+        rq->infinite = 1;
+        rq->dir[0] = tx / n; rq->dir[1] = ty / n; rq->dir[2] = 1 / n;
+        rq->z_ref = 0;
+        rq->guess[0] = tx * p->yb[0] + px * p->y[0] * w->s;
+        rq->guess[1] = ty * p->yb[0] + py * p->y[0] * w->s;
+    } else {
+        rq->obj[0] = f->x; rq->obj[1] = f->y; rq->obj[2] = -d->lens.object;
+        rq->guess[0] = f->x * p->ub[0] + px * p->u[0] * w->s;
+        rq->guess[1] = f->y * p->ub[0] + py * p->u[0] * w->s;
+    }
+}
+
+typedef struct aim_tally { int maxit; double maxres; } aim_tally;
+
+static int aim(pdlg *d, const wl_ctx *w, const ln_field *f, double px, double py,
+               trace_aim_ray *out, aim_tally *t)
+{
+    trace_aim_req rq;
+    char err[256];
+    request(d, w, f, px, py, &rq);
+    if (d->tr->rx_aim(&w->rx, &rq, out, err, sizeof err) != TRACE_OK) {
+        calc_say(&d->c, P(FAIL_TRACE), err);
+        return -1;
+    }
+    if (out->status == TRACE_AIM_OK || out->status == TRACE_AIM_VIGNETTED) {
+        if (out->iterations > t->maxit) t->maxit = out->iterations;
+        if (out->residual > t->maxres) t->maxres = out->residual;
+    }
+    return 0;
+}
+
+static void fan_cell(char *buf, size_t cap, const trace_aim_ray *r, double v)
+{
+    if (r->status == TRACE_AIM_OK) snprintf(buf, cap, "%.6g", v == 0 ? 0.0 : v);
+    else snprintf(buf, cap, "%s@%d", r->status == TRACE_AIM_VIGNETTED ? "vign" : "fail",
+                  r->surface + 1);
+}
+
+/* The wave aberration of an aimed ray (Welford's W): the chief ray's optical path to
+ * the reference sphere minus the ray's, positive where the wavefront leads the
+ * sphere.  The sphere is centred on the chief ray's image point and passes through
+ * the chief ray's crossing of the paraxial exit pupil's plane; paths count from the
+ * object point, or (object at infinity) from the incoming plane wavefront through
+ * the origin (rx_aim's paths start on the plane z = 0: the ray's o . d added). */
+typedef struct wavefront {
+    int ok, inf;
+    double c[3], R, sign, n0, ni, w0, lambda;   /* lambda: in the lens's unit */
+} wavefront;
+
+static double ray_path(const wavefront *wf, const trace_aim_ray *r)
+{
+    double o = r->opl, pc[3], b, cc, disc;
+    if (wf->inf) o += wf->n0 * (r->o[0] * r->d[0] + r->o[1] * r->d[1] + r->o[2] * r->d[2]);
+    for (int k = 0; k < 3; k++) pc[k] = r->img[k] - wf->c[k];
+    b = r->img_dir[0] * pc[0] + r->img_dir[1] * pc[1] + r->img_dir[2] * pc[2];
+    cc = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2] - wf->R * wf->R;
+    disc = b * b - cc;
+    if (disc < 0) return NAN;
+    return o - wf->ni * (b + wf->sign * sqrt(disc));
+}
+
+/* W of ray r in waves (NaN: no sphere, or the ray misses it). */
+static double wave(const wavefront *wf, const trace_aim_ray *r)
+{
+    if (!wf->ok || r->status != TRACE_AIM_OK) return NAN;
+    return (wf->w0 - ray_path(wf, r)) / wf->lambda;
+}
+
+static double unit_mm(const char *u)
+{
+    return !strcmp(u, "cm") ? 10 : !strcmp(u, "m") ? 1000 : !strcmp(u, "in") ? 25.4 : 1;
+}
+
+static void wavefront_init(const pdlg *d, const wl_ctx *w, const trace_aim_ray *chief,
+                           double lambda_um, wavefront *wf)
+{
+    const px_pupil *p = &w->p;
+    memset(wf, 0, sizeof *wf);
+    if (!isfinite(p->z_xp) || !(chief->img_dir[2] > 0)) return;
+    double t = (p->z_xp - chief->img[2]) / chief->img_dir[2];
+    if (!(fabs(t) > 0)) return;
+    wf->inf = isinf(d->lens.object);
+    memcpy(wf->c, chief->img, sizeof wf->c);
+    wf->R = fabs(t);
+    wf->sign = t < 0 ? 1 : -1;
+    wf->n0 = w->rx.n_object;
+    wf->ni = w->surf[w->rx.nsurf - 1].n_right;
+    wf->lambda = lambda_um * 1e-3 / unit_mm(d->c.uname);
+    wf->ok = 1;
+    wf->w0 = ray_path(wf, chief);
+    if (!isfinite(wf->w0)) wf->ok = 0;
+}
+
+static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
+{
+    const ln_lens *l = &d->lens;
+    const ln_field *f = &l->field[fi];
+    const px_pupil *p = &w->p;
+    trace_aim_ray chief, r;
+    aim_tally t = {0, 0};
+    int N = l->nsurf - 1, inf = isinf(l->object), nok = 0, nvig = 0;
+    double sx = 0, sy = 0, sc = 0;
+    double fx = inf ? tan(f->x * DEG) : f->x, fy = inf ? tan(f->y * DEG) : f->y;
+    char dist[32], hp[64], hi[64], hr[64];
+    if (f->x == 0) {
+        if (inf) calc_say(&d->c, P(FIELD_HEAD_ANGLE), fi + 1, f->y);
+        else calc_say(&d->c, P(FIELD_HEAD_HEIGHT), fi + 1, f->y);
+    } else {
+        if (inf) calc_say(&d->c, P(FIELD_HEAD_ANGLE_XY), fi + 1, f->x, f->y);
+        else calc_say(&d->c, P(FIELD_HEAD_HEIGHT_XY), fi + 1, f->x, f->y);
+    }
+    if (aim(d, w, f, 0, 0, &chief, &t)) return LM_FAIL;
+    if (chief.status != TRACE_AIM_OK) {
+        calc_say(&d->c, P(CHIEF_BAD), status_word(chief.status), chief.surface + 1);
+        return LM_GO;
+    }
+    /* paraxial chief-ray heights: at the paraxial image, and at the image plane the
+     * real rays are carried to (the distortion compares the real one with this,
+     * radially); x and y are separate paraxial rays, both the unit chief ray scaled */
+    {
+        double unit = p->yb[N] + p->ub[N + 1] * (w->rx.z_image - p->z[N]);
+        double px_ = fx * unit, py_ = fy * unit, rp = hypot(px_, py_);
+        double rr = hypot(chief.img[0], chief.img[1]);
+        if (snap(d, rp) != 0) snprintf(dist, sizeof dist, "%.4g %%", CL(100 * (rr - rp) / rp));
+        else snprintf(dist, sizeof dist, "-");
+        if (f->x == 0) {
+            snprintf(hp, sizeof hp, "%.6g", CL(fy * p->h_img));
+            snprintf(hi, sizeof hi, "%.6g", CL(py_));
+            snprintf(hr, sizeof hr, "%.6g", CL(chief.img[1]));
+        } else {
+            snprintf(hp, sizeof hp, "(%.6g, %.6g)", CL(fx * p->h_img), CL(fy * p->h_img));
+            snprintf(hi, sizeof hi, "(%.6g, %.6g)", CL(px_), CL(py_));
+            snprintf(hr, sizeof hr, "(%.6g, %.6g)", CL(chief.img[0]), CL(chief.img[1]));
+        }
+    }
+    calc_say(&d->c, P(CHIEF), hp, hi, hr, dist, chief.residual, chief.iterations);
+    /* the spot and the wavefront */
+    wavefront wf;
+    int nw = 0;
+    double ws = 0, ws2 = 0, wmin = INFINITY, wmax = -INFINITY;
+    wavefront_init(d, w, &chief, lambda, &wf);
+    double *xs = malloc(sizeof(double) * 2 * (size_t)d->nsamp);
+    if (!xs) return LM_FAIL;
+    for (int i = 0; i < d->nsamp; i++) {
+        if (lm_stop_requested()) { free(xs); return LM_FAIL; }
+        if (aim(d, w, f, d->spx[i], d->spy[i], &r, &t)) { free(xs); return LM_FAIL; }
+        if (r.status != TRACE_AIM_OK) { nvig++; continue; }
+        xs[2 * nok] = r.img[0];
+        xs[2 * nok + 1] = r.img[1];
+        double wv = wave(&wf, &r);
+        if (isfinite(wv)) {
+            nw++;
+            ws += wv;
+            ws2 += wv * wv;
+            wmin = fmin(wmin, wv);
+            wmax = fmax(wmax, wv);
+        }
+        sx += r.img[0];
+        sy += r.img[1];
+        nok++;
+    }
+    if (nok) {
+        double cx = sx / nok, cy = sy / nok, rc2 = 0, rm2 = 0;
+        for (int i = 0; i < nok; i++) {
+            double ex = xs[2 * i] - chief.img[0], ey = xs[2 * i + 1] - chief.img[1];
+            double mx = xs[2 * i] - cx, my = xs[2 * i + 1] - cy;
+            rc2 += ex * ex + ey * ey;
+            rm2 += mx * mx + my * my;
+        }
+        sc = sqrt(rc2 / nok);
+        calc_say(&d->c, P(SPOT), nok, nvig, CL(sc), CL(sqrt(rm2 / nok)), CL(cx), CL(cy));
+    } else {
+        calc_say(&d->c, P(SPOT_NONE), nvig);
+    }
+    free(xs);
+    if (nw) {
+        double m = ws / nw, var = ws2 / nw - m * m;
+        calc_say(&d->c, P(WAVE), CL(wf.R), CL(p->r_xp * w->s), CL(sqrt(var > 0 ? var : 0)),
+                 CL(wmax - wmin));
+    } else {
+        calc_say(&d->c, "%s", P(WAVE_NONE));
+    }
+    if (d->fans) {
+        calc_say(&d->c, "%s", P(FAN_HEAD));
+        for (int i = 0; i < d->fan_rays; i++) {
+            double q = -1 + 2.0 * i / (d->fan_rays - 1);
+            trace_aim_ray rt, rs;
+            char a[32], b[32], c[32];
+            if (lm_stop_requested()) return LM_FAIL;
+            if (aim(d, w, f, 0, q, &rt, &t) || aim(d, w, f, q, 0, &rs, &t)) return LM_FAIL;
+            fan_cell(a, sizeof a, &rt, rt.img[1] - chief.img[1]);
+            fan_cell(b, sizeof b, &rs, rs.img[0] - chief.img[0]);
+            double wt = wave(&wf, &rt);
+            if (isfinite(wt)) snprintf(c, sizeof c, "%.6g", CL(wt));
+            else snprintf(c, sizeof c, "-");
+            calc_say(&d->c, P(FAN_ROW), q, a, c, b);
+        }
+    }
+    calc_say(&d->c, P(AIM_STATS), t.maxit, t.maxres, d->c.uname);
+    return LM_GO;
+}
+
+static void report_pupil(pdlg *d, const wl_ctx *w, double fbig)
+{
+    const px_pupil *p = &w->p;
+    const ln_lens *l = &d->lens;
+    int inf = isinf(l->object), N = l->nsurf - 1;
+    double k = inf ? tan(fbig * DEG) : fbig;
+    char a[32], b[32], c[32], e[32];
+    calc_say(&d->c, P(FIRST), CL(p->efl), fmt_num(a, sizeof a, p->fnum),
+             fmt_num(b, sizeof b, p->work_fnum), CL(p->na_obj), CL(p->na_img));
+    calc_say(&d->c, P(PUPILS), fmt_len(a, sizeof a, p->z_ep),
+             fmt_len(b, sizeof b, 2 * p->r_ep * w->s), fmt_len(c, sizeof c, p->z_xp),
+             fmt_len(e, sizeof e, 2 * p->r_xp * w->s), CL(p->r_stop * w->s));
+    if (inf || !isfinite(p->mag)) snprintf(b, sizeof b, "-");
+    else snprintf(b, sizeof b, "%.6g", CL(p->mag));
+    calc_say(&d->c, P(IMAGE), fmt_len(a, sizeof a, p->z_img), b, CL(p->lagrange * w->s * k));
+    calc_say(&d->c, P(RAYS_HEAD), fbig);
+    snprintf(a, sizeof a, "-");
+    calc_say(&d->c, P(RAYS_OBJ), a, CL(p->u[0] * w->s), a, CL(p->ub[0] * k));
+    for (int i = 0; i <= N; i++)
+        calc_say(&d->c, P(RAYS_ROW), i + 1, CL(p->y[i] * w->s), CL(p->u[i + 1] * w->s),
+                 CL(p->yb[i] * k), CL(p->ub[i + 1] * k));
+}
+
+static int need_engine(pdlg *d)
+{
+    trace_get_api_fn get;
+    if (d->tr) return 0;
+    get = (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
+    if (get) d->tr = get(TRACE_ABI);
+    if (!d->tr) {
+        if (get) fprintf(stderr, "lensmat: the trace module's interface does not match\n");
+        return -1;
+    }
+    return 0;
+}
+
+static int refuse(pdlg *d, const char *why)
+{
+    lm_say(d->io, LM_BOTH, P(REFUSED), why);
+    fprintf(stderr, "lensmat: %s: %s\n", d->io->src, why);
+    return LM_FAIL;
+}
+
+static int compute(pdlg *d)
+{
+    const ln_lens *l = &d->lens;
+    px_csurf cs[PX_PUPIL_MAXSURF];
+    char names[PX_PUPIL_MAXSURF + 1][LN_NAME_MAX], why[LN_ERR_MAX], ob[64];
+    const char *obj;
+    wl_ctx *w;
+    px_pupil prim;
+    double lp = ln_primary(l), z_image, zl = 0, fbig = 0;
+    int nwl = l->nwl ? l->nwl : 1, rc = LM_GO;
+    if (ln_to_csurf(l, cs, names, &obj, why, sizeof why) != LN_OK) return refuse(d, why);
+    if (pupil_at(d, cs, obj, lp, &prim, why, sizeof why)) return refuse(d, why);
+    d->scale = fmax(fabs(prim.efl), prim.r_stop);
+    for (int i = 0; i + 1 < l->nsurf; i++) zl += l->surf[i].t;
+    for (int i = 0; i < l->nfield; i++)
+        if (fabs(l->field[i].y) > fabs(fbig)) fbig = l->field[i].y;
+    if (isinf(l->object)) snprintf(ob, sizeof ob, "%s", P(OBJ_INF));
+    else snprintf(ob, sizeof ob, P(OBJ_AT), l->object, d->c.uname);
+    calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
+             l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
+             l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
+    if (l->surf[l->nsurf - 1].t > 0) {
+        z_image = zl + l->surf[l->nsurf - 1].t;
+        calc_say(&d->c, P(IMAGE_FILE), z_image, d->c.uname);
+    } else {
+        if (!isfinite(prim.z_img)) return refuse(d, P(NO_IMAGE));
+        z_image = prim.z_img;
+        calc_say(&d->c, P(IMAGE_PARAXIAL), CL(z_image), d->c.uname, lp * 1000);
+    }
+    calc_say(&d->c, P(SAMPLING_ECHO), d->sampling ? "hexapolar" : "grid", d->nsamp);
+    if (need_engine(d)) return LM_FAIL;
+    if (!(w = malloc(sizeof *w))) return LM_FAIL;
+    for (int k = 0; k < nwl && rc == LM_GO; k++) {
+        double lambda = l->nwl ? l->wl[k] : lp;
+        if (pupil_at(d, cs, obj, lambda, &w->p, why, sizeof why) ||
+            build_rx(d, w, lambda, prim.r_stop, z_image, why, sizeof why)) {
+            rc = refuse(d, why);
+            break;
+        }
+        w->s = prim.r_stop / w->p.r_stop;
+        calc_say(&d->c, P(WL_HEAD), lambda * 1000);
+        report_pupil(d, w, fbig);
+        for (int f = 0; f < l->nfield && rc == LM_GO; f++) rc = one_field(d, w, f, lambda);
+    }
+    free(w);
+    return rc;
+}
+
+int lm_pupil(lm_io *io)
+{
+    pdlg dd, *d = &dd;
+    char name[WORD];
+    int rc;
+    memset(d, 0, sizeof *d);
+    d->io = io;
+    d->c.io = io;
+    d->c.unit = PX_MM;
+    d->c.uname = "mm";
+    rc = lm_ask_word(io, P(FILE), P(FILE), P(FILE_WHAT), check_file, d, name, sizeof name);
+    if (rc == LM_GO) {
+        if (d->notes.s && d->notes.len) {
+            char *s = d->notes.s, *e;
+            while (*s) {
+                e = strchr(s, '\n');
+                if (e) *e = '\0';
+                calc_say(&d->c, P(NOTE), s);
+                if (!e) break;
+                s = e + 1;
+            }
+        }
+        d->c.uname = d->lens.unit[0] ? d->lens.unit : "mm";
+        if ((rc = ask_missing(d)) == LM_GO && (rc = ask_sampling(d)) == LM_GO) {
+            if (lm_stop_requested()) rc = LM_FAIL;
+            else rc = compute(d);
+        }
+    }
+    if (rc == LM_GO) rc = calc_done(&d->c);
+    if (d->have) ln_free(&d->lens);
+    ln_notes_free(&d->notes);
+    return rc;
+}
+const char *lm_pupil_example(void) { return P(EXAMPLE); }

@@ -1,0 +1,78 @@
+/* lens_paraxial.c -- the bridge from the lens model to the paraxial engine: the
+ * lens as px_csurf surfaces (for px_colour_run, px_seidel_run) and as a px_system
+ * at one wavelength.  Paraxial optics sees only the vertex curvature (plus an
+ * asphere's r^2 term); semi-diameters, conics and higher terms are for the tracer. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include "lens.h"
+#include "paraxial/paraxial.h"
+
+/* The glass string px_glass_index takes for medium i (-1: object): the lens's own,
+ * "AIR" for air, or the file's nd/vd as a model (or constant) glass in buf. */
+static const char *glass_name(const ln_lens *l, int i, char *buf)
+{
+    const char *g = i < 0 ? l->obj_glass : l->surf[i].glass;
+    double nd = i < 0 ? l->obj_nd : l->surf[i].nd, vd = i < 0 ? l->obj_vd : l->surf[i].vd;
+    double n;
+    if (!g[0]) return "AIR";
+    if (nd > 1 && px_glass_index(g, PX_LAMBDA_D, &n) == PX_NO_GLASS) {
+        char a[32], b[32];
+        ln_format(nd, a, sizeof a);
+        ln_format(vd, b, sizeof b);
+        if (vd == 0 || isinf(vd)) snprintf(buf, LN_NAME_MAX, "%s", a);
+        else snprintf(buf, LN_NAME_MAX, "%s/%s", a, b);
+        return buf;
+    }
+    return g;
+}
+
+static double paraxial_radius(const ln_surface *s)
+{
+    double c = ln_paraxial_curvature(s);
+    return c == 0 ? INFINITY : 1 / c;
+}
+
+int ln_to_csurf(const ln_lens *l, struct px_csurf *out, char (*names)[LN_NAME_MAX],
+                const char **obj_glass, char *err, size_t cap)
+{
+    if (l->nsurf < 1) { snprintf(err, cap, "no surface"); return LN_BAD; }
+    for (int i = 0; i < l->nsurf; i++) {
+        out[i].r = paraxial_radius(&l->surf[i]);
+        out[i].t = l->surf[i].t;
+        out[i].glass = glass_name(l, i, names[i]);
+    }
+    *obj_glass = glass_name(l, -1, names[l->nsurf]);
+    return LN_OK;
+}
+
+int ln_paraxial(const ln_lens *l, double lambda, struct px_system *s, char *err,
+                size_t cap)
+{
+    double n;
+    char why[LN_ERR_MAX];
+    int r;
+    if (l->nsurf < 1) { snprintf(err, cap, "no surface"); return LN_BAD; }
+    if (ln_index(l, -1, lambda, &n, NULL, why, sizeof why)) {
+        snprintf(err, cap, "the object medium: %s", why);
+        return LN_BAD;
+    }
+    px_system_init(s, n);
+    for (int i = 0; i < l->nsurf; i++) {
+        if (ln_index(l, i, lambda, &n, NULL, why, sizeof why)) {
+            snprintf(err, cap, "surface %d: %s", i + 1, why);
+            return LN_BAD;
+        }
+        if (i > 0 && (r = px_system_gap(s, l->surf[i - 1].t)) != PX_OK) {
+            snprintf(err, cap, "surface %d: thickness %g %s", i, l->surf[i - 1].t,
+                     r == PX_NOMEM ? "(out of memory)" : "is negative or not finite");
+            return r == PX_NOMEM ? LN_NOMEM : LN_BAD;
+        }
+        if ((r = px_system_surface(s, paraxial_radius(&l->surf[i]), n)) != PX_OK) {
+            snprintf(err, cap, "surface %d: %s", i + 1,
+                     r == PX_NOMEM ? "out of memory" : "not a surface");
+            return r == PX_NOMEM ? LN_NOMEM : LN_BAD;
+        }
+    }
+    return LN_OK;
+}
