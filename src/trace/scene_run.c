@@ -430,6 +430,7 @@ static void add_summary(trace_summary *a, const trace_summary *b)
     a->cutoff += b->cutoff;
     a->build_ms += b->build_ms;
     a->trace_ms += b->trace_ms;
+    if (b->lens_surfaces > a->lens_surfaces) a->lens_surfaces = b->lens_surfaces;
 }
 
 static int write_summary(const sc_scene *sc, const trace_summary *s, const double *wl,
@@ -516,6 +517,10 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     opt.threads = sc->threads;
     opt.escape_length = sc->escape;
     opt.batch = stop_batch(sc->depth);
+    /* LENSMAT_TRACE_BVH=1: every segment by Embree, the lens path (tr_seqscan.c) off --
+     * to check that it changes no bit of any output */
+    const char *bvh = getenv("LENSMAT_TRACE_BVH");
+    if (bvh && *bvh && strcmp(bvh, "0") != 0) opt.sequential = 0;
     o.err = err;
     o.stop = sc->stop;
     o.stop_ctx = sc->stop_ctx;

@@ -75,6 +75,8 @@ struct trace_scene {
     const tr_shape *entryg[4];
     tr_pk_set entry_pk;
     double entry_z;            /* ... if it starts at z < entry_z */
+    double entry_zmin;         /* ... and z > entry_zmin (what lies left of the lens:
+                                  -inf for none, tr_seqscan.c) */
 };
 
 /* tr_wt.c: adjacency and the watertight test in double (see there). */
@@ -238,6 +240,8 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
 int tr_add_source(trace_scene *sc, const trace_source *s, uint64_t *first);
 int tr_set_absorption(trace_scene *sc, int id, double alpha_front, double alpha_back);
 int tr_build(trace_scene *sc, double *ms);
+/* ---- a sequential lens inside any scene (tr_seqscan.c): the lens hints ---- */
+void tr_seq_detect(trace_scene *sc);
 /* ---- the next hit (tr_hit.c) ---- */
 /* Embree's callbacks (tr_build attaches them). */
 void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a);

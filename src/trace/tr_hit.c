@@ -51,7 +51,9 @@ void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
     if (x->float_hits) ok = tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n);
     else if ((ok = tr_shape_hit_t(&f->shape, x->o, x->d, leaving, &t, p)))
         tr_shape_hit_normal(&f->shape, p, n);
-    if (!ok || !(t < x->best_t)) return;
+    /* at a tie the lower surface id, whatever order Embree visits them in: the lens
+     * shortcut's candidates (seq_hit) are in id order and take the first */
+    if (!ok || !(t < x->best_t || (t == x->best_t && f->id < x->best_surf))) return;
     float tf = (float)(t - x->ta);
     if (tf > rh->ray.tfar) return;          /* a triangle is clearly nearer */
     rh->ray.tfar = tf;
@@ -366,7 +368,8 @@ static inline int seq_cands(const trace_scene *sc, const trace_options *o,
         *cg = f->seqg;
         *nc = f->nseq;
     } else {
-        if (!(sc->nentry > 0 && org[2] < sc->entry_z)) return 0;
+        if (!(sc->nentry > 0 && org[2] < sc->entry_z && org[2] > sc->entry_zmin))
+            return 0;
         *cand = sc->entry;
         *cg = sc->entryg;
         *nc = sc->nentry;

@@ -171,6 +171,10 @@ static void tr_trace_lanes(tr_worker *w, uint64_t i0, int *k)
         L->sp = 0;
         L->live = 1;
         L->state = LANE_RUN;
+        if (!(L->r.o[2] > sc->entry_zmin)) {     /* something lies between it and the */
+            run &= ~(1u << l);                   /* lens: Embree from its start */
+            L->state = LANE_SLOW;
+        }
     }
     while (run) {
         const tr_pk *in = &pk[cur];

@@ -314,6 +314,22 @@ static tr_worker *new_worker(const trace_scene *sc, const trace_options *o, int 
     return w;
 }
 
+/* How many surfaces the lens shortcut names (when tr_hit.c's seq_cands may use it). */
+static int lens_surfaces(const trace_scene *sc, const trace_options *o)
+{
+    if (!o->sequential || o->float_hits || sc->seq_nsurf != sc->nsurf || sc->nentry <= 0)
+        return 0;
+    char *in = calloc((size_t)sc->nsurf, 1);
+    int n = 0;
+    if (!in) return 0;
+    for (int k = 0; k < sc->nentry; k++) in[sc->entry[k]] = 1;
+    for (int i = 0; i < sc->nsurf; i++)
+        for (int k = 0; k < sc->surf[i]->nseq; k++) in[sc->surf[i]->seq[k]] = 1;
+    for (int i = 0; i < sc->nsurf; i++) n += in[i];
+    free(in);
+    return n;
+}
+
 int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
                trace_summary *sum)
 {
@@ -373,6 +389,7 @@ int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
         for (int i = 0; i < nstarted; i++) pthread_join(tid[i], NULL);
     }
     s.trace_ms = tr_now_ms() - t0;
+    s.lens_surfaces = lens_surfaces(sc, &o);
     if (rc == TRACE_OK) rc = numeric_check(sc, &s, &p.fail);
     if (mu) pthread_mutex_destroy(&p.mu);
     if (more) pthread_cond_destroy(&p.more);

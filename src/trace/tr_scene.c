@@ -45,6 +45,7 @@ void tr_scene_set_entry(trace_scene *sc, const int *cand, int n, double z)
             tr_pk_set_add(&sc->entry_pk, cand[i], &f->shape, &f->mat, 0, NULL);
         }
     sc->entry_z = z;
+    sc->entry_zmin = -INFINITY;
 }
 
 void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
@@ -67,7 +68,9 @@ void tr_scene_set_seq(trace_scene *sc, int id, const int *cand, int n)
 
 trace_scene *tr_scene_new(void)
 {
-    return calloc(1, sizeof(trace_scene));
+    trace_scene *sc = calloc(1, sizeof(trace_scene));
+    if (sc) sc->entry_zmin = -INFINITY;
+    return sc;
 }
 
 static void drop_embree(trace_scene *sc)
@@ -576,6 +579,7 @@ int tr_build(trace_scene *sc, double *ms)
     }
     embree_box(sc);
     group_coincident(sc);
+    if (sc->seq_nsurf != sc->nsurf && !sc->ngroup) tr_seq_detect(sc);
     for (int i = 0; i < sc->nsurf; i++) {
         tr_surf *f = sc->surf[i];
         if (!f->is_mesh && !in_range(f)) { sc->far[sc->nfar++] = i; continue; }

@@ -236,6 +236,9 @@ typedef struct trace_summary {
     /* Power: emitted = detected + absorbed + escaped + cutoff (to ~1e-15 relative) */
     double emitted, detected, absorbed, escaped, cutoff;
     double build_ms, trace_ms;
+    int lens_surfaces;         /* surfaces of the sequential lens the run took the lens
+                                  shortcut through (add_lens's, or one found inside the
+                                  scene: tr_seqscan.c); 0: every segment by Embree */
 } trace_summary;
 
 /* A sequential lens as the classic dialogue enters it: surfaces left to right with
