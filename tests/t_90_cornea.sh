@@ -1,8 +1,9 @@
 # t_90_cornea.sh -- the cornea analysis engine (src/cornea/): the fit against synthetic
 # truth from the rig geometry's forward model (t_fit), the stiff and degenerate scans
-# (t_stiff), the final parameters traced through the trace engine (t_trace); normal
+# (t_stiff), the final parameters traced through the trace engine (t_trace), the asphere,
+# 3 mm-zone Sim K, cone, maps and report (t_models); normal
 # and sanitizer builds.
-for b in t_fit t_stiff t_trace; do
+for b in t_fit t_stiff t_trace t_models; do
     unit "$TOP/build/obj/cornea_tests/$b"
     unit "$TOP/build/asan/cornea_tests/$b"
 done
