@@ -13,6 +13,7 @@
 #include "../rig/rig.h"
 #include "../cornea/cornea.h"
 #include "prompts_cornea_scan.h"
+#include "cornea_out.h"
 
 #define CS(k) cornea_scan_prompts[CORNEA_SCAN_##k]
 #define DEG (3.14159265358979323846 / 180)
@@ -34,9 +35,54 @@ static int ranged(calc *c, const char *q, const char *what, const char *range, d
 
 static int stop_cb(void *ctx) { (void)ctx; return lm_stop_requested() != 0; }
 
+static void say_line(void *ctx, const char *line) { calc_say(ctx, CS(LINE), line); }
+
+/* The report file (scan settings, truth and errors beside the engine's numbers) and,
+ * when asked, the maps. */
+static int cs_files(calc *c, const cornea_api *cn, const rg_geometry *g, const char *name,
+                    int maps, const cn_result *r, const cn_spot *sp, int n,
+                    const rg_cornea *eye, const cn_params *t, double km, double cyl,
+                    double axis_err, double np, double zone, double noise, double pitch,
+                    double seed)
+{
+    char msg[512];
+    const cn_clinical *k = &r->k;
+    const cs_row rows[] = {
+        {"scan_points", np, NAN, ""}, {"scan_zone", zone, NAN, "deg"},
+        {"scan_noise", noise, NAN, "px"}, {"scan_pitch", pitch, NAN, "um"},
+        {"scan_seed", seed, NAN, ""},
+        {"true_R", t->p[CN_R], NAN, "mm"}, {"true_R_flat", eye->R, NAN, "mm"},
+        {"true_R_steep", eye->R2, NAN, "mm"}, {"true_Q", eye->Q, NAN, ""},
+        {"true_Km", km, NAN, "D"}, {"true_cyl", cyl, NAN, "D"},
+        {"true_dx", t->p[CN_DX], NAN, "mm"}, {"true_dy", t->p[CN_DY], NAN, "mm"},
+        {"true_tilt_x", t->p[CN_TX] / DEG, NAN, "deg"},
+        {"true_tilt_y", t->p[CN_TY] / DEG, NAN, "deg"},
+        {"err_R", (k->R - t->p[CN_R]) * 1e3, k->sd_R * 1e3, "um"},
+        {"err_R_flat", (k->R_flat - eye->R) * 1e3, k->sd_R_flat * 1e3, "um"},
+        {"err_R_steep", (k->R_steep - eye->R2) * 1e3, k->sd_R_steep * 1e3, "um"},
+        {"err_Q", k->Q - eye->Q, k->sd_Q, ""},
+        {"err_Km", k->Km - km, k->sd_Km, "D"},
+        {"err_cyl", r->model == CN_BICONIC ? k->cyl - cyl : NAN, k->sd_cyl, "D"},
+        {"err_axis", r->model == CN_BICONIC && cyl > 0 ? axis_err : NAN, k->sd_axis, "deg"},
+        {"err_dx", (k->dx - t->p[CN_DX]) * 1e3, k->sd_dx * 1e3, "um"},
+        {"err_dy", (k->dy - t->p[CN_DY]) * 1e3, k->sd_dy * 1e3, "um"},
+        {"err_tilt_x", k->tx - t->p[CN_TX] / DEG, k->sd_tx, "deg"},
+        {"err_tilt_y", k->ty - t->p[CN_TY] / DEG, k->sd_ty, "deg"},
+    };
+    if (cs_write_report(cn, name, r, sp, n, rows, (int)(sizeof rows / sizeof *rows), msg,
+                        sizeof msg))
+        return calc_fail(c, msg);
+    calc_say(c, CS(WROTE), name, name);
+    if (maps && cs_write_maps(cn, g, name, r, sp, n, stop_cb, say_line, c, msg, sizeof msg)) {
+        if (lm_stop_requested()) return LM_FAIL;
+        return calc_fail(c, msg);
+    }
+    return LM_GO;
+}
+
 int lm_cornea_scan(lm_io *io)
 {
-    static const char *const models[] = {"sphere", "conic", "biconic", NULL};
+    static const char *const models[] = {"sphere", "conic", "biconic", "asphere", NULL};
     calc cc = {io, PX_MM, "mm"}, *c = &cc;
     rig_get_api_fn rget;
     cornea_get_api_fn cget;
@@ -62,6 +108,12 @@ int lm_cornea_scan(lm_io *io)
         (rc = ranged(c, CS(PITCH), CS(PITCH_WHAT), CS(PITCH_RANGE), 0.1, 100, 0, &pitch)) ||
         (rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)))
         return rc;
+    char name[1024];
+    int maps = 0;
+    if ((rc = lm_ask_word(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), cs_check_name, io,
+                          name, sizeof name)))
+        return rc;
+    if (strcmp(name, "none") && (rc = calc_yn(c, CS(MAPS), CS(MAPS_WHAT), &maps))) return rc;
     rg_geometry g;
     rg->geometry_default(&g);
     rg_cornea eye = g.cornea;
@@ -94,7 +146,6 @@ int lm_cornea_scan(lm_io *io)
         calc_say(c, CS(FAILED), got < 0 ? "no scan" : err);
         return LM_FAIL;
     }
-    free(sp);
     cn->report(&r, buf, sizeof buf);
     for (char *l = buf, *e; *l; l = e + 1) {     /* line by line into the record */
         e = strchr(l, '\n');
@@ -105,9 +156,15 @@ int lm_cornea_scan(lm_io *io)
     cn_params t;
     cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
     calc_say(c, CS(TRUTH), eye.R, eye.R2, km, cyl);
-    calc_say(c, CS(ERRORS), (r.k.R - t.p[CN_R]) * 1e3, r.k.Km - km,
-             model == CN_BICONIC ? remainder(r.k.K1_axis - fmod(axis + 360, 180), 180.0)
-                                 : 0.0);
+    double axis_err = model == CN_BICONIC ? remainder(r.k.K1_axis - fmod(axis + 360, 180), 180.0)
+                                          : 0.0;
+    calc_say(c, CS(ERRORS), (r.k.R - t.p[CN_R]) * 1e3, r.k.Km - km, axis_err);
+    if (strcmp(name, "none")) {
+        rc = cs_files(c, cn, &g, name, maps, &r, sp, got, &eye, &t, km, cyl, axis_err, np,
+                      zone, noise, pitch, seed);
+        if (rc) { free(sp); return rc; }
+    }
+    free(sp);
     return calc_done(c);
 }
 const char *lm_cornea_scan_example(void) { return CS(EXAMPLE); }
