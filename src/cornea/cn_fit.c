@@ -85,6 +85,56 @@ static double cn_resid_corr(const double *rx, int n)
     return den > 0 ? num / den : 0;
 }
 
+static int solve(fctx *c, cn_params *p, int max_iter, int (*stop)(void *), void *sctx);
+
+static double chi2_of(const fctx *c, const cn_params *p)
+{
+    double s = 0;
+    for (int i = 0; i < c->n; i++) {
+        const cn_spot *sp = &c->s[c->use[i]];
+        double u, v;
+        if (cn_forward(c->model, p, c->apex0, c->pl, &sp->ray, &u, &v, NULL, NULL))
+            return INFINITY;
+        s += ((u - sp->u) * (u - sp->u) + (v - sp->v) * (v - sp->v)) / (sp->sigma * sp->sigma);
+    }
+    return s;
+}
+
+/* Shifting the eye across and tilting it about its centre of curvature look alike
+ * (the dy / tilt_x valley of a nearly spherical cornea), and a fit can stop in the
+ * valley away from the truth.  When the first solution is poor (chi^2 more than 4 sd
+ * above its dof), solve again from starts turned about the start's centre of
+ * curvature by +-3 deg about x and about y, and keep the lowest chi^2.  Returns the
+ * iterations spent or CN_ESTOP. */
+static int valley_restarts(fctx *c, const cn_params *start, cn_params *best, int max_iter,
+                           int (*stop)(void *), void *sctx)
+{
+    int dof = 2 * c->n - c->nf, iters = 0;
+    double cb = chi2_of(c, best);
+    if (dof <= 0 || !((cb - dof) / sqrt(2.0 * dof) > 4)) return 0;
+    const double a = 3 * M_PI / 180;
+    const double turns[4][2] = {{a, 0}, {-a, 0}, {0, a}, {0, -a}};
+    double R = start->p[CN_R];
+    for (int t = 0; t < 4; t++) {
+        cn_params q = *start;
+        double tx0 = q.p[CN_TX], ty0 = q.p[CN_TY];
+        double tx = tx0 + turns[t][0], ty = ty0 + turns[t][1];
+        /* centre of curvature T + R Rot(tx, ty) z: kept where the start has it */
+        double c0[3] = {sin(ty0) * cos(tx0), -sin(tx0), cos(ty0) * cos(tx0)};
+        double c1[3] = {sin(ty) * cos(tx), -sin(tx), cos(ty) * cos(tx)};
+        for (int i = 0; i < 3; i++) q.p[CN_DX + i] += R * (c0[i] - c1[i]);
+        q.p[CN_TX] = tx;
+        q.p[CN_TY] = ty;
+        int rc = solve(c, &q, max_iter, stop, sctx);
+        if (rc == CN_ESTOP) return rc;
+        if (rc < 0) continue;
+        iters += rc;
+        double cq = chi2_of(c, &q);
+        if (cq < cb) { cb = cq; *best = q; }
+    }
+    return iters;
+}
+
 static int cmpd(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -175,10 +225,16 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
             rc = CN_EFIT;
             goto out;
         }
+        cn_params p0 = p;
         rc = solve(&c, &p, max_iter, o->stop, o->stop_ctx);
         if (rc < 0) { snprintf(err, errcap, rc == CN_ESTOP ? "stopped" : "fit failed"); goto out; }
         iters += rc;
         rc = 0;
+        if (round == 0 && res->free[CN_TX] && res->free[CN_TY]) {
+            int more = valley_restarts(&c, &p0, &p, max_iter, o->stop, o->stop_ctx);
+            if (more < 0) { snprintf(err, errcap, "stopped"); rc = more; goto out; }
+            iters += more;
+        }
         /* normalised residuals; robust scale from their median (Rayleigh: 1.1774) */
         int m = 0;
         for (int i = 0; i < c.n; i++) {

@@ -45,3 +45,12 @@ all: build/lib/lensmat-cornea.so
 MODULE_TEST_BINS  += build/lib/lensmat-cornea.so build/asan/lib/lensmat-cornea.so $(CN_TBIN)
 MODULE_BENCH_BINS += build/lib/lensmat-cornea.so $(CN_BBIN)
 -include $(CN_OBJ:.o=.d) $(CN_SOBJ:.o=.d)
+
+# the many-eyes study's plot (scripts/cornea-study.sh), on the imaging engine
+build/obj/cornea_tools/study_plot: tests/cornea/study_plot.c build/lib/lensmat-imaging.so \
+                                   src/imaging/imaging.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -o $@ $< -L$(abspath build/lib) -l:lensmat-imaging.so \
+	    -Wl,-rpath,$(abspath build/lib) -lm
+all: build/obj/cornea_tools/study_plot
+MODULE_TEST_BINS += build/obj/cornea_tools/study_plot
