@@ -1,6 +1,7 @@
 /* study_plot.c -- the many-eyes study's plot (scripts/cornea-study.sh): from the
  * study table (tab-separated, a header row naming err_X and sd_X columns), the
- * cumulative distribution over the eyes of |err_X| / sd_X for each parameter X, beside
+ * cumulative distribution over the eyes of |err_X| / sd_X for R, Q, Km, cyl, axis, dy and
+ * tilt_x, beside
  * the half-normal distribution they follow when every reported uncertainty is honest;
  * drawn by the imaging engine (PNG written through a .part file).
  *     study_plot study.tsv plot.png */
@@ -31,13 +32,19 @@ int main(int argc, char **argv)
     for (char *t = strtok(line, "\t\n"); t && nc < MAXC; t = strtok(NULL, "\t\n"))
         name[nc++] = strdup(t);
     int err_col[MAXC], sd_col[MAXC], np = 0;
-    for (int i = 0; i < nc; i++)
-        if (!strncmp(name[i], "err_", 4))
+    /* seven parameters and the reference: the palette's eight colours */
+    static const char *const shown[] = {"err_R", "err_Q", "err_Km", "err_cyl", "err_axis",
+                                        "err_dy", "err_tilt_x", NULL};
+    for (int i = 0; i < nc; i++) {
+        int want = 0;
+        for (int k = 0; shown[k]; k++) want |= !strcmp(name[i], shown[k]);
+        if (want)
             for (int j = 0; j < nc; j++)
                 if (!strncmp(name[j], "sd_", 3) && !strcmp(name[j] + 3, name[i] + 4)) {
                     err_col[np] = i;
                     sd_col[np++] = j;
                 }
+    }
     static double z[MAXC][MAXE], y[MAXC][MAXE];
     int nz[MAXC] = {0}, ne = 0;
     while (fgets(line, sizeof line, f) && ne < MAXE) {
