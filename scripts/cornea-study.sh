@@ -61,7 +61,7 @@ BEGIN {
         tx = clip(1.5 * gauss(), -5, 5); ty = clip(1.5 * gauss(), -5, 5)
         noise = 0.02 + 0.06 * rand()
         f = sprintf("eye-%04d.in", i)
-        printf "%s\n%d\n12\n%.4f\n%.4f\n%.4f\n%.2f\n%.4f\n%.4f\n%.3f\n%.3f\n%.4f\n5\n%d\neye-%04d\nn\n",
+        printf "%s\n%d\n12\n%.4f\n%.4f\n%.4f\n%.2f\n%.4f\n%.4f\n%.3f\n%.3f\n%.4f\n5\n%d\n0\neye-%04d\nn\n",
                model, pts, R, Q, cyl, ax, dx, dy, tx, ty, noise, seed * 100000 + i, i > f
         close(f)
     }

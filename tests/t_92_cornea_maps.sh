@@ -4,7 +4,7 @@
 # outputs that would overwrite an input refused, the compare script, and the
 # many-eyes study under GNU parallel (skipped with a message when it is missing).
 cm_in() {   # model points name maps(y/n) [seed] -> answers
-    printf '%s\n%s\n12\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n%s\n%s\n%s\n' \
+    printf '%s\n%s\n12\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n%s\n0\n%s\n%s\n' \
         "$1" "$2" "${5:-1}" "$3" "$4"
 }
 mkdir -p "$WORK/cm"
@@ -48,11 +48,11 @@ cm_refuse() {
     cd "$WORK/cm" && cm_in conic 100 a n > a.csv.in && cp a.csv.in a.csv &&
     if "$TOP/lensmat" --cornea-scan b.rec < a.csv > b.out 2> b.err; then
         echo "accepted a report over its answers file"; return 1; fi
-    cmp -s a.csv a.csv.in && grep -q '<stdin>:15: .*a.csv is the file the answers are read from' b.err || { cat b.err; return 1; }
+    cmp -s a.csv a.csv.in && grep -q '<stdin>:16: .*a.csv is the file the answers are read from' b.err || { cat b.err; return 1; }
     cm_in conic 100 b n > b.in &&
     if "$TOP/lensmat" --cornea-scan b.csv < b.in > b.out 2> b.err; then
         echo "accepted a report over the record"; return 1; fi
-    grep -q '<stdin>:15: .*b.csv' b.err || { cat b.err; return 1; }
+    grep -q '<stdin>:16: .*b.csv' b.err || { cat b.err; return 1; }
 }
 check "a report name whose files would overwrite the answers or the record is refused in a replay (FILE:LINE)" cm_refuse
 cm_asphere() {
@@ -67,13 +67,28 @@ cm_compare() {
     "$TOP/lensmat" --cornea-scan d.rec < d.in > d.out 2>&1 &&
     "$TOP/scripts/cornea-compare.sh" eye.csv s2.csv > cmp1.out || { cat cmp1.out; return 1; }
     grep -q '^Km ' cmp1.out && ! grep -q DIFFERS cmp1.out &&
-    printf 'biconic\n300\n12\n7.83\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n3\ns3\nn\n' > e.in &&
+    printf 'biconic\n300\n12\n7.83\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n3\n0\ns3\nn\n' > e.in &&
     "$TOP/lensmat" --cornea-scan e.rec < e.in > e.out 2>&1 &&
     if "$TOP/scripts/cornea-compare.sh" eye.csv s3.csv > cmp2.out; then
         echo "a 30 um radius change not flagged"; cat cmp2.out; return 1; fi
     grep -q '^R .*DIFFERS' cmp2.out && grep -q '^Km .*DIFFERS' cmp2.out
 }
 check "cornea-compare.sh: two seeds of one eye agree, an eye 30 um flatter DIFFERS (exit 1)" cm_compare
+cm_cone() {
+    cd "$WORK/cm" &&
+    printf 'biconic\n500\n12\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n10\n0.8\n0.4\n-0.7\ncone\ny\n' > f.in &&
+    "$TOP/lensmat" --cornea-scan f.rec < f.in > f.out 2>&1 || { cat f.out; return 1; }
+    grep -q '^POOR FIT' f.out && grep -q '^SYSTEMATIC RESIDUALS: neighbour correlation 0\.[5-9]' f.out &&
+    grep -q '^mean K .* +- inf D' f.out && grep -q '^poor_fit,1,' cone.csv &&
+    grep -q '^undetermined,R,' cone.csv && grep -q '^true_cone_h,10,' cone.csv &&
+    awk -F, '$1 == "resid_corr" { exit !($2 > 0.5) }' cone.csv && [ -s cone-residual.png ] ||
+        { cat f.out; return 1; }
+    # the same eye without the cone: a good fit, residuals uncorrelated
+    sed '15s/.*/0/; 16,18d; s/^cone$/nocone/' f.in > g.in &&
+    "$TOP/lensmat" --cornea-scan g.rec < g.in > g.out 2>&1 && ! grep -q 'POOR FIT' g.out &&
+    awk -F, '$1 == "resid_corr" { exit !($2 < 0.2 && $2 > -0.2) }' nocone.csv
+}
+check "a keratoconus-like cone: the fit claims no confidence (POOR, systematic residuals, K +- inf); without it a good fit" cm_cone
 if command -v parallel >/dev/null 2>&1 && parallel --version 2>/dev/null | grep -q 'GNU parallel'; then
     cm_study() {
         d="$WORK/cm/study"

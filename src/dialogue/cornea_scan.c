@@ -41,7 +41,8 @@ static void say_line(void *ctx, const char *line) { calc_say(ctx, CS(LINE), line
  * when asked, the maps. */
 static int cs_files(calc *c, const cornea_api *cn, const rg_geometry *g, const char *name,
                     int maps, const cn_result *r, const cn_spot *sp, int n,
-                    const rg_cornea *eye, const cn_params *t, double km, double cyl,
+                    const rg_cornea *eye, const cn_params *t, const cn_bump *cone,
+                    double km, double cyl,
                     double axis_err, double np, double zone, double noise, double pitch,
                     double seed)
 {
@@ -57,6 +58,8 @@ static int cs_files(calc *c, const cornea_api *cn, const rg_geometry *g, const c
         {"true_dx", t->p[CN_DX], NAN, "mm"}, {"true_dy", t->p[CN_DY], NAN, "mm"},
         {"true_tilt_x", t->p[CN_TX] / DEG, NAN, "deg"},
         {"true_tilt_y", t->p[CN_TY] / DEG, NAN, "deg"},
+        {"true_cone_h", cone->h * 1e3, NAN, "um"}, {"true_cone_w", cone->w, NAN, "mm"},
+        {"true_cone_x", cone->x0, NAN, "mm"}, {"true_cone_y", cone->y0, NAN, "mm"},
         {"err_R", (k->R - t->p[CN_R]) * 1e3, k->sd_R * 1e3, "um"},
         {"err_R_flat", (k->R_flat - eye->R) * 1e3, k->sd_R_flat * 1e3, "um"},
         {"err_R_steep", (k->R_steep - eye->R2) * 1e3, k->sd_R_steep * 1e3, "um"},
@@ -108,6 +111,15 @@ int lm_cornea_scan(lm_io *io)
         (rc = ranged(c, CS(PITCH), CS(PITCH_WHAT), CS(PITCH_RANGE), 0.1, 100, 0, &pitch)) ||
         (rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)))
         return rc;
+    cn_bump cone = {0, 0, 0, 0};
+    if ((rc = ranged(c, CS(CONE), CS(CONE_WHAT), CS(CONE_RANGE), 0, 50, 0, &cone.h)))
+        return rc;
+    if (cone.h > 0 &&
+        ((rc = ranged(c, CS(CONE_W), CS(CONE_W_WHAT), CS(CONE_W_RANGE), 0.2, 3, 0, &cone.w)) ||
+         (rc = ranged(c, CS(CONE_X), CS(CONE_X_WHAT), CS(CONE_XY_RANGE), -2, 2, 0, &cone.x0)) ||
+         (rc = ranged(c, CS(CONE_Y), CS(CONE_Y_WHAT), CS(CONE_XY_RANGE), -2, 2, 0, &cone.y0))))
+        return rc;
+    cone.h *= 1e-3;                    /* um -> mm */
     char name[1024];
     int maps = 0;
     if ((rc = lm_ask_word(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), cs_check_name, io,
@@ -135,6 +147,11 @@ int lm_cornea_scan(lm_io *io)
     char err[256];
     static char buf[4096];
     int got = cn->simulate(rg, &g, &eye, &so, sp, n, err, sizeof err);
+    cn_params t;
+    cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
+    if (got > 0 && cone.h > 0)         /* the cone: the planned scan re-imaged through the
+                                          true eye with the bump (analytic model) */
+        cn->reimage(&g, CN_BICONIC, &t, &cone, sigma, (unsigned long long)seed, sp, got);
     int ok = 0;
     for (int i = 0; i < got; i++) ok += sp[i].status == CN_S_OK;
     calc_say(c, CS(SCANNED), n, ok, sigma * 1e3);
@@ -153,15 +170,13 @@ int lm_cornea_scan(lm_io *io)
         *e = 0;
         calc_say(c, CS(LINE), l);
     }
-    cn_params t;
-    cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
     calc_say(c, CS(TRUTH), eye.R, eye.R2, km, cyl);
     double axis_err = model == CN_BICONIC ? remainder(r.k.K1_axis - fmod(axis + 360, 180), 180.0)
                                           : 0.0;
     calc_say(c, CS(ERRORS), (r.k.R - t.p[CN_R]) * 1e3, r.k.Km - km, axis_err);
     if (strcmp(name, "none")) {
-        rc = cs_files(c, cn, &g, name, maps, &r, sp, got, &eye, &t, km, cyl, axis_err, np,
-                      zone, noise, pitch, seed);
+        rc = cs_files(c, cn, &g, name, maps, &r, sp, got, &eye, &t, &cone, km, cyl, axis_err,
+                      np, zone, noise, pitch, seed);
         if (rc) { free(sp); return rc; }
     }
     free(sp);
