@@ -1,8 +1,10 @@
 /* cornea.h -- public face of the cornea analysis engine (issue 12): fit a cornea model
- * (sphere, conic, biconic/toric) and the eye's pose to laser-spot positions on the
- * rig's detector, report what clinicians read (apex radius, Q, Sim K, cylinder, power)
- * with uncertainties, say which parameters a scan does not determine (SVD of the
- * weighted Jacobian), and predict the accuracy of a rig and scan before building it.
+ * (sphere, conic, biconic/toric, even asphere) and the eye's pose to laser-spot
+ * positions on the rig's detector, report what clinicians read (apex radius, Q, Sim K
+ * at the apex and over the 3 mm zone, cylinder, power) with uncertainties, say which
+ * parameters a scan does not determine (SVD of the weighted Jacobian) and when the
+ * residuals are systematic (a cone), predict the accuracy of a rig and scan before
+ * building it; and give what maps and reports need (map grids, CSV and JSON).
  * Lives in build/lib/lensmat-cornea.so:
  *     cornea_get_api_fn get = (cornea_get_api_fn)lm_engine_symbol("cornea",
  *                                                                 CORNEA_API_SYMBOL);

@@ -86,6 +86,11 @@ int main(void)
                          fabs(r.par.p[CN_QF] - t.p[CN_QF]) < 4 * sqrt(r.cov[CN_QF * (CN_NPARAM + 1)])),
              "small zone: Q %.3f +- %.3f: flagged (mask %#x) or within 4 sd of the truth",
              r.par.p[CN_QF], sqrt(r.cov[CN_QF * (CN_NPARAM + 1)]), r.undetermined);
+    ct_check(rc == 0 && (r.undetermined & BIT(CN_QF)) && strstr(r.why, "Q_flat") &&
+             r.hmax < 0.3 && strstr(cn->report(&r, buf, sizeof buf), "(extrapolated: data to") &&
+             !isfinite(r.k.sd_zKm),
+             "small zone: Q named as not determined, the 3 mm zone's Sim K said to be an "
+             "extrapolation (data to %.3f mm) with sd inf", r.hmax);
     cn_fit_opts fo = {.model = CN_CONIC, .fix_tilt = 1};
     cn_result r2;
     cn->fit(&g, sp, 200, NULL, &fo, &r2, err, sizeof err);
