@@ -8,6 +8,18 @@ cm_in() {   # model points name maps(y/n) [seed] -> answers
         "$1" "$2" "${5:-1}" "$3" "$4"
 }
 mkdir -p "$WORK/cm"
+# the imaging engine's map drawing (tests/imaging/t_map.c), normal and sanitizer builds
+for kind in obj asan; do
+    lib=$TOP/build/lib; [ "$kind" = asan ] && lib=$TOP/build/asan/lib
+    bin=$TOP/build/$kind/imaging_tests/t_map
+    if [ ! -x "$bin" ]; then fail "$bin (not built)"; continue; fi
+    d=$(mktemp -d "$WORK/map.XXXXXX")
+    (cd "$TOP" && IM_LIBDIR=$lib LSAN_OPTIONS="suppressions=$TOP/tests/imaging/lsan.supp:fast_unwind_on_malloc=0:print_suppressions=0" "$bin" "$d") > "$WORK/unit.out" 2>&1; rc=$?
+    p=$(grep -c '^PASS' "$WORK/unit.out"); f=$(grep -c '^FAIL' "$WORK/unit.out")
+    PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
+    grep '^FAIL' "$WORK/unit.out" | sed "s|^|$kind/t_map: |"
+    if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then fail "$kind/t_map exited $rc"; tail -20 "$WORK/unit.out"; fi
+done
 cm_maps() {
     cd "$WORK/cm" && rm -f eye* && cm_in biconic 300 eye y > a.in &&
     "$TOP/lensmat" --cornea-scan a.rec < a.in > a.out 2> a.err || { cat a.err; return 1; }
@@ -44,6 +56,14 @@ cm_replay() {
     cmp eye-axial.png re/eye-axial.png && cmp eye-residual.png re/eye-residual.png
 }
 check "the record replays to the same report, record and maps, byte for byte" cm_replay
+cm_asan() {
+    cd "$WORK/cm" && mkdir -p asan && cd asan && cp ../a.in . &&
+    LSAN_OPTIONS="suppressions=$TOP/tests/imaging/lsan.supp:fast_unwind_on_malloc=0:print_suppressions=0" \
+        "$TOP/build/asan/lensmat" --cornea-scan a.rec < a.in > a.out 2> a.err || { cat a.err; return 1; }
+    cmp ../eye.csv eye.csv && cmp ../eye.json eye.json && cmp ../eye-axial.png eye-axial.png &&
+    cmp ../eye-residual.png eye-residual.png && ! grep -q 'Sanitizer' a.err
+}
+check "the sanitizer build writes the same report and maps (ASan/UBSan clean)" cm_asan
 cm_refuse() {
     cd "$WORK/cm" && cm_in conic 100 a n > a.csv.in && cp a.csv.in a.csv &&
     if "$TOP/lensmat" --cornea-scan b.rec < a.csv > b.out 2> b.err; then

@@ -53,8 +53,10 @@ static int draw_map(const im_map *m, const im_out *out, im_map_info *info, char 
     double step = m->step;
     if (!(step > 0)) {
         step = 0;
-        for (int i = 0; i < m->nsteps && m->steps; i++)      /* the smallest that fits */
-            if (m->steps[i] > 0 && (hi - lo) / m->steps[i] <= maxb - 1) { step = m->steps[i]; break; }
+        for (int i = 0; i < m->nsteps && m->steps; i++) {    /* the smallest that fits */
+            double s = m->steps[i];
+            if (s > 0 && ceil(hi / s - 1e-9) - floor(lo / s + 1e-9) <= maxb) { step = s; break; }
+        }
         if (!(step > 0)) step = nice_step(fmax(hi - lo, 1e-12), maxb / 2);
     }
     if (m->symmetric) {          /* bands centred on 0: 0 in the middle of one */
