@@ -407,7 +407,10 @@ const char *cn_report(const cn_result *r, char *buf, size_t cap)
     OUT("model %s: %d spots fitted, %d left out, %d iterations, residual RMS %.3g um, "
         "chi2/dof %.3g\n", mn[r->model], r->nused, r->nrejected, r->iterations,
         r->rms * 1000, r->chi2_dof);
-    OUT("apex radius R %.5f +- %.5f mm   Q %.4f +- %.4f\n", k->R, k->sd_R, k->Q, k->sd_Q);
+    if (r->free[CN_QF] || r->model == CN_SPHERE)
+        OUT("apex radius R %.5f +- %.5f mm   Q %.4f +- %.4f\n", k->R, k->sd_R, k->Q, k->sd_Q);
+    else
+        OUT("apex radius R %.5f +- %.5f mm   Q %.4f (held)\n", k->R, k->sd_R, k->Q);
     if (r->model == CN_ASPHERE)
         OUT("asphere A4 %.5g +- %.2g mm^-3   A6 %.5g +- %.2g mm^-5%s\n", r->par.p[CN_A4],
             sqrt(r->cov[CN_A4 * (CN_NPARAM + 1)]), r->par.p[CN_A6],

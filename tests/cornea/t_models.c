@@ -2,7 +2,8 @@
  * asphere (forward model against rig_api.forward, recovery, its Q/A4 degeneracy
  * named), Sim K over the 3 mm zone against the closed forms of a conic, the
  * keratoconus-like bump (cn_bump) flagged by the chi^2 test and located by the
- * residuals, the maps' values, an eye at the edge of the dialogue's range, and the
+ * residuals, the maps' values, an eye at the edge of the dialogue's range and at the
+ * edge of a joint's travel, a study eye once stuck in the dy/tilt_x valley, and the
  * CSV/JSON report's rows. */
 #include "ct.h"
 
@@ -283,6 +284,44 @@ static void test_valley(void)
              r.chi2_dof);
 }
 
+/* The edge of travel: m1's outer angle limited to the median of the scan's values,
+ * so the targets beyond it are unreachable (solve: RG_ETRAVEL) and the scan covers
+ * one side of a decentred, tilted eye.  The fit uses what it has, says how much
+ * less it knows (larger sd than the full scan), and what it reports holds. */
+static void test_travel(void)
+{
+    rg_cornea e = ct_eye(rg, &g, 7.8, -0.26, 0.75, 0, 0.3, -0.2, 3 * CT_DEG, -2 * CT_DEG);
+    cn_params t;
+    cn->params_from_cornea(&e, g.cornea.trans, 3 * CT_DEG, -2 * CT_DEG, &t);
+    static double a[1000];
+    int na = 0;
+    char err[256];
+    for (int k = 0; k < 600; k++) {
+        rg_target tg = {RG_T_ANGLES, 12 * CT_DEG * sqrt((k + 0.5) / 600), fmod(k * 2.399963229728653, 2 * CT_PI)};
+        rg_solution s;
+        if (!rg->solve(&g, &tg, NULL, &s, err, sizeof err)) a[na++] = s.pose.j[RG_J_M1A];
+    }
+    double lo = a[0], hi = a[0];
+    for (int i = 0; i < na; i++) { lo = fmin(lo, a[i]); hi = fmax(hi, a[i]); }
+    cn_result full, r;
+    int nf = scan(&e, 600, 12 * CT_DEG, 13);
+    fit(nf, CN_BICONIC, 0, &full);
+    rg_geometry keep = g;
+    g.joint[RG_J_M1A].hi = (lo + hi) / 2;       /* half the zone beyond m1's travel */
+    int n = scan(&e, 600, 12 * CT_DEG, 13);
+    int rc = fit(n, CN_BICONIC, 0, &r);
+    g = keep;
+    int within = 1;
+    for (int k = 0; k < CN_NPARAM; k++)
+        if (r.free[k] && !(r.undetermined & BIT(k)))
+            within &= fabs(r.par.p[k] - t.p[k]) < 4 * sd(&r, k);
+    ct_check(rc == 0 && n < 0.7 * nf && n > 0.3 * nf && within && r.k.sd_R > 1.2 * full.k.sd_R,
+             "edge of travel: m1a limited to %.2f deg, %d of 600 targets reachable (full "
+             "scan %d); determined parameters within 4 sd (mask %#x), sd R %.2f um against "
+             "%.2f for the full scan", (lo + hi) / 2 / CT_DEG, n,
+             nf, r.undetermined, r.k.sd_R * 1e3, full.k.sd_R * 1e3);
+}
+
 static int count_rows(const char *csv, const char *prefix)
 {
     int c = 0;
@@ -337,6 +376,7 @@ int main(int argc, char **argv)
     if (!*only || strstr(only, "bump")) test_bump();
     if (!*only || strstr(only, "edge")) test_edge();
     if (!*only || strstr(only, "valley")) test_valley();
+    if (!*only || strstr(only, "travel")) test_travel();
     if (!*only || strstr(only, "report")) test_report();
     return ct_fails != 0;
 }
