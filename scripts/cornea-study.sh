@@ -73,7 +73,9 @@ set -- --jobs "${JOBS:-0}" --halt never --joblog joblog.txt
 if [ -n "$SSH" ]; then
     set -- "$@" --sshlogin "$SSH" --trc '{.}.rec' --trc '{.}.csv' --trc '{.}.json' --trc '{.}.out'
 fi
+t0=$(date +%s.%N)
 ls eye-*.in | parallel "$@" "'$LENSMAT' --cornea-scan {.}.rec < {} > {.}.out 2>&1" || true
+t1=$(date +%s.%N)
 failed=$(awk 'NR > 1 && $7 != 0' joblog.txt | wc -l)
 
 # 3. one table: the truth, the errors and the reported uncertainties of every eye
@@ -122,6 +124,9 @@ END {
     }
 }' study.tsv > percentiles.tsv.part && mv percentiles.tsv.part percentiles.tsv
 
+cpu=$(sed -n 's/^model name[^:]*: //p' /proc/cpuinfo 2>/dev/null | head -1)
+awk -v t0="$t0" -v t1="$t1" -v cpu="${cpu:-unknown}" -v n="$(nproc 2>/dev/null || echo ?)" \
+    'NR > 1 { s += $4; k++ } END { printf "# wall %.2f s for %d eyes, %.3f s per eye and job (joblog); here: %s, %s cores\n", t1 - t0, k, k ? s / k : 0, cpu, n }' joblog.txt
 echo "# $neyes eyes reported, $failed failed (joblog: $DIR/joblog.txt); |error| percentiles;"
 echo "# z_p95: the 95th percentile of |error| / reported sd (1.96 when the sd is honest)"
 column -t -s "$(printf '\t')" percentiles.tsv 2>/dev/null || cat percentiles.tsv
