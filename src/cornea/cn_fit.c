@@ -213,7 +213,9 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
             spots[i].status = CN_S_NONE;
     }
     double k_rej = o->reject_k > 0 ? o->reject_k : 5;
-    int rounds = o->reject_rounds == 0 ? 3 : o->reject_rounds < 0 ? 0 : o->reject_rounds;
+    /* rejection rounds until none is new (at most 12): a local shape the model lacks
+     * is carved out step by step, each refit lowering the robust scale */
+    int rounds = o->reject_rounds == 0 ? 12 : o->reject_rounds < 0 ? 0 : o->reject_rounds;
     int max_iter = o->max_iter > 0 ? o->max_iter : 1000;
     int rc = 0, iters = 0;
     for (int round = 0;; round++) {
@@ -305,6 +307,21 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     res->cond = a.cond;
     res->undetermined = a.undetermined;
     memcpy(res->why, a.why, sizeof res->why);
+    /* many outliers: the robust test carved a region out of the scan (a cone, a
+     * scar), or the scan is bad; the numbers describe the surface without it */
+    int nout = 0, nin = 0;
+    for (int i = 0; i < n; i++) {
+        nout += spots[i].status == CN_S_OUTLIER;
+        nin += spots[i].status == CN_S_OK || spots[i].status == CN_S_OUTLIER;
+    }
+    if (nin > 0 && nout > 0.1 * nin) {
+        size_t l = strlen(res->why);
+        if (l + 230 < sizeof res->why)
+            snprintf(res->why + l, sizeof res->why - l, "MANY OUTLIERS: %d of %d spots "
+                     "(%.0f %%) rejected by the robust test: a local shape the model lacks "
+                     "(a cone?) or a bad scan; the numbers describe the surface without "
+                     "them (see the residual map)\n", nout, nin, 100.0 * nout / nin);
+    }
     /* chi^2 test: a fit far above its noise is a local minimum, the wrong model or
      * a sigma too small; what its weakest direction mixes is then not trustworthy */
     int dof = M - c.nf;
@@ -443,7 +460,7 @@ const char *cn_report(const cn_result *r, char *buf, size_t cap)
     OUT("singular values (scaled columns):");
     for (int i = 0; i < r->nfree; i++) OUT(" %.3g", r->sv[i]);
     OUT("   condition %.3g\n", r->cond);
-    if (r->undetermined || r->poor) OUT("%s", r->why);
+    if (r->why[0]) OUT("%s", r->why);
 #undef OUT
     return buf;
 }

@@ -66,7 +66,8 @@ typedef struct cn_fit_opts {
     int model;                     /* enum cn_model */
     int fix_tilt;                  /* 1: tilt held at the start value (sphere: always) */
     double reject_k;               /* outlier: |r|/sigma > k * robust scale (0: 5) */
-    int reject_rounds;             /* refits after rejection (0: 3; -1: none) */
+    int reject_rounds;             /* refits after rejection, until none is new
+                                      (0: at most 12; -1: none) */
     double rcond;                  /* singular value / largest below it: not
                                       determined (0: 1e-9) */
     int max_iter;                  /* trust-region iterations (0: 100) */
