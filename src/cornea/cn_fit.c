@@ -64,11 +64,13 @@ static int f_jac(const gsl_vector *x, void *data, gsl_matrix *J)
 /* The residual map's test: the mean correlation of each spot's normalised residual
  * vector with its nearest neighbour's on the cornea (rx: x, y, ru, rv per spot).
  * Noise gives ~0 (sd about 1/sqrt(n)); a shape the model lacks (a cone) gives
- * neighbours that miss alike, near 1.  O(n^2): 10 000 spots take ~50 ms. */
-static double cn_resid_corr(const double *rx, int n)
+ * neighbours that miss alike, near 1.  O(n^2) (10 000 spots: 1e8 distances), so the
+ * stop callback is polled every 256 spots: NaN when it asks to stop. */
+static double cn_resid_corr(const double *rx, int n, int (*stop)(void *), void *sctx)
 {
     double num = 0, den = 0;
     for (int i = 0; i < n; i++) {
+        if ((i & 255) == 0 && stop && stop(sctx)) return NAN;
         const double *a = &rx[4 * i];
         double best = INFINITY;
         int bj = -1;
@@ -297,8 +299,9 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     res->chi2_dof = M > c.nf ? chi2 / (M - c.nf) : NAN;
     res->par = p;
     res->hmax = hmax;
-    res->resid_corr = cn_resid_corr(rx, c.n);
+    res->resid_corr = cn_resid_corr(rx, c.n, o->stop, o->stop_ctx);
     free(rx);
+    if (isnan(res->resid_corr)) { snprintf(err, errcap, "stopped"); rc = CN_ESTOP; goto out; }
     res->nfree = c.nf;
     memcpy(res->idx, c.idx, sizeof res->idx);
     memcpy(res->sv, a.sv, sizeof a.sv);
