@@ -109,6 +109,18 @@ cm_cone() {
     awk -F, '$1 == "resid_corr" { exit !($2 < 0.2 && $2 > -0.2) }' nocone.csv
 }
 check "a keratoconus-like cone: the fit claims no confidence (POOR, systematic residuals, K +- inf); without it a good fit" cm_cone
+cm_stop() {
+    cd "$WORK/cm" && cm_in biconic 10000 stopped y > s.in &&
+    (exec "$TOP/lensmat" --cornea-scan s.rec < s.in > s.out 2> s.err) &
+    p=$!
+    sleep 0.4
+    kill -INT "$p"
+    wait "$p"
+    rc=$?
+    [ "$rc" -eq 130 ] || { echo "exit $rc"; cat "$WORK/cm/s.err"; return 1; }
+    ! ls "$WORK/cm" | grep -q '^stopped' || { ls "$WORK/cm"; return 1; }
+}
+check "SIGINT mid-fit with a report asked: exit 130, no report, map or .part file" cm_stop
 if command -v parallel >/dev/null 2>&1 && parallel --version 2>/dev/null | grep -q 'GNU parallel'; then
     cm_study() {
         d="$WORK/cm/study"
