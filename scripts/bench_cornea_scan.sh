@@ -16,10 +16,11 @@ O=build/bench/cornea_scan
 mkdir -p "$O"
 cpu=$(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //')
 echo "# bench_cornea_scan on: $cpu, $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
-answers() {     # answers N SOURCE SEED REPORT
+answers() {     # answers N SOURCE SEED REPORT: no cone; REPORT a name (no maps) or -
     if [ "$2" = frames ]; then src='frames\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-'
     else src='model\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n14'; fi
-    printf "biconic\n-\nspiral\n%s\n12\n$src\n%s\n%s\n" "$1" "$3" "$4"
+    printf "biconic\n-\nspiral\n%s\n12\n$src\n%s\n0\n%s\n" "$1" "$3" "$4"
+    [ "$4" = - ] || echo n
 }
 scan() {        # scan NAME N SOURCE SEED [REPORT]: the Times line's numbers
     answers "$2" "$3" "$4" "${5:--}" > "$O/$1.in"
@@ -51,10 +52,12 @@ echo "BENCH cornea_scan1000_command_s $8 s"
 echo "BENCH cornea_scan1000_model_s $mmed s"
 echo "BENCH cornea_scan1000_frames_vs_model $(awk -v a="$6" -v b="$mmed" 'BEGIN { printf "%.2f", a / b }') x"
 # ---- the same record and report whatever the thread count ----
-LENSMAT_THREADS=1 scan th1 1000 frames 1 th1.rep && mv th1.rep "$O/th1.rep"
-LENSMAT_THREADS=2 scan th2 1000 frames 1 th1.rep && mv th1.rep "$O/th2.rep"
+LENSMAT_THREADS=1 scan th1 1000 frames 1 th1 && mv th1.txt "$O/th1.rep" && mv th1.csv "$O/th1.csv"
+LENSMAT_THREADS=2 scan th2 1000 frames 1 th1 && mv th1.txt "$O/th2.rep" && mv th1.csv "$O/th2.csv"
+rm -f th1.json
 same=0
-cmp -s "$O/th1.rec" "$O/th2.rec" && cmp -s "$O/th1.rep" "$O/th2.rep" && same=1
+cmp -s "$O/th1.rec" "$O/th2.rec" && cmp -s "$O/th1.rep" "$O/th2.rep" &&
+    cmp -s "$O/th1.csv" "$O/th2.csv" && same=1
 set -- $(tline th1)
 echo "# 1 thread: measurement $6 s (frames $3 s); record and report identical to 2 threads: $same"
 echo "BENCH cornea_scan1000_1thread_s $6 s"

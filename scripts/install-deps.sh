@@ -7,6 +7,7 @@ PKGS="gcc g++ make libreadline-dev libgsl-dev libembree-dev libgpiod-dev
       libopencv-dev clang libclang-rt-14-dev python3"
 PKGS="$PKGS pkg-config zlib1g-dev"   # the imaging module: OpenCV flags, PNG data checks
 PKGS="$PKGS gcc-aarch64-linux-gnu libc6-dev-arm64-cross"   # make check: arm64 compile
+PKGS="$PKGS parallel"   # scripts/cornea-study.sh: GNU parallel fans the eyes out
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||

@@ -1,8 +1,9 @@
 # t_90_cornea.sh -- the cornea analysis engine (src/cornea/): the fit against synthetic
 # truth from the rig geometry's forward model (t_fit), the stiff and degenerate scans
-# (t_stiff), the final parameters traced through the trace engine (t_trace); normal
+# (t_stiff), the final parameters traced through the trace engine (t_trace), the asphere,
+# 3 mm-zone Sim K, cone, maps and report (t_models); normal
 # and sanitizer builds.
-for b in t_fit t_stiff t_trace; do
+for b in t_fit t_stiff t_trace t_models; do
     unit "$TOP/build/obj/cornea_tests/$b"
     unit "$TOP/build/asan/cornea_tests/$b"
 done
@@ -11,7 +12,7 @@ check "lensmat-cornea.so exports cornea_get_api alone" sh -c \
 # the --cornea-scan dialogue: a simulated scan of the issue-12 eye fitted and reported,
 # replayed exactly from its grep'd record, a bad answer refused in a replay
 cs_run() {
-    printf 'biconic\n-\nspiral\n%s\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n-\n' "$2" \
+    printf 'biconic\n-\nspiral\n%s\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n0\n-\n' "$2" \
         > "$WORK/cs.in"
     (cd "$WORK" && "$1" --cornea-scan cs.rec < cs.in > cs.out 2> cs.err)
 }
@@ -36,7 +37,7 @@ for bin in "$TOP/lensmat" "$TOP/build/asan/lensmat"; do
 done
 # SIGINT during a 10 000-point fit: the fit polls the stop flag, lensmat exits 130
 cs_stop() {
-    printf 'biconic\n-\nspiral\n10000\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n-\n' \
+    printf 'biconic\n-\nspiral\n10000\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n0\n-\n' \
         > "$WORK/cs4.in"
     (cd "$WORK" && exec "$TOP/lensmat" --cornea-scan cs4.rec < cs4.in > cs4.out 2> cs4.err) &
     p=$!

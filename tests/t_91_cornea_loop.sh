@@ -7,9 +7,11 @@
 CL=$WORK/cnloop
 mkdir -p "$CL"
 RIGGOLD=$TOP/golden/rig/example.rig
-cl_frames() {   # cl_frames FILE N PITCH WIDTH HEIGHT REPORT [PATTERN [SAVE]]
-    printf 'biconic\n-\n%s\n%s\n12\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n%s\n%s\n%s\n%s\n1\n%s\n' \
+cl_frames() {   # cl_frames FILE N PITCH WIDTH HEIGHT REPORT [PATTERN [SAVE]]: seed 1, no
+                # cone, a report NAME (NAME.txt, .csv, .json; no maps) or -
+    printf 'biconic\n-\n%s\n%s\n12\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n%s\n%s\n%s\n%s\n1\n0\n%s\n' \
         "${7:-spiral}" "$2" "$3" "$4" "$5" "${8:--}" "$6" > "$1"
+    [ "$6" = - ] || echo n >> "$1"
 }
 cl_run() {      # cl_run BIN IN REC [env...]: in $CL, stdout to REC.out
     bin=$1; in=$2; rec=$3; shift 3
@@ -32,7 +34,7 @@ cl_example() {
 check "cornea loop: the example (300 frames) fitted, all spots used, tracer check agrees" cl_example
 # 2. the same record and report for 1 and 2 threads (and a replay of the record)
 cl_threads() {
-    cl_frames "$CL/t.in" 300 14 640 480 rep.txt
+    cl_frames "$CL/t.in" 300 14 640 480 rep
     cl_run "$BIN" t.in t1.rec LENSMAT_THREADS=1 || return 1
     mv "$CL/rep.txt" "$CL/rep1.txt"
     cl_run "$BIN" t.in t2.rec LENSMAT_THREADS=2 || return 1
@@ -42,7 +44,7 @@ cl_threads() {
 }
 check "cornea loop: record and report byte-identical with 1 and 2 threads" cl_threads
 cl_replay() {
-    grep '^input:' "$CL/t1.rec" | sed 's/^input: //; s/^rep.txt$/rep3.txt/' > "$CL/t3.in" &&
+    grep '^input:' "$CL/t1.rec" | sed 's/^input: //; s/^rep$/rep3/' > "$CL/t3.in" &&
         cl_run "$BIN" t3.in t3.rec && cmp "$CL/rep1.txt" "$CL/rep3.txt" &&
         [ "$(grep -v '^input' "$CL/t1.rec")" = "$(grep -v '^input' "$CL/t3.rec")" ]
 }
@@ -62,9 +64,9 @@ check "cornea loop: spots off or cut by a smaller sensor rejected and listed wit
 # every spot off the sensor (5 um pixels: the frame is 3.2 x 2.4 mm, the eye's spots
 # land 2.3-3.1 mm away): the fit has nothing, a replay fails with a message
 cl_allout() {
-    cl_frames "$CL/a.in" 30 5 640 480 arep.txt
+    cl_frames "$CL/a.in" 30 5 640 480 arep
     ! cl_run "$BIN" a.in a.rec && grep -q '^Spots from' "$CL/a.rec" &&
-        grep -q '^The fit failed' "$CL/a.rec" && [ ! -e "$CL/arep.txt" ]
+        grep -q '^The fit failed' "$CL/a.rec" && [ ! -e "$CL/arep.txt" ] && [ ! -e "$CL/arep.csv" ]
 }
 check "cornea loop: every spot off the sensor: the fit fails, exit non-zero, no report" cl_allout
 # 4. patterns: rings and grid give the points asked for
@@ -80,15 +82,15 @@ check "cornea loop: rings and grid patterns, 100 points each, fitted" cl_pattern
 # 5. the check of the fit's analytic model against the tracer: a tolerance it cannot
 # meet (0 um) fails the session, says so, writes no report
 cl_checkfail() {
-    cl_frames "$CL/c.in" 100 14 640 480 crep.txt
+    cl_frames "$CL/c.in" 100 14 640 480 crep
     ! cl_run "$BIN" c.in c.rec LENSMAT_CORNEA_CHECK_TOL_UM=0 &&
         grep -q '^Tracer check: .*(tolerance 0 um): DISAGREES' "$CL/c.rec" &&
-        grep -q 'disagrees with the tracer by' "$CL/c.rec.err" && [ ! -e "$CL/crep.txt" ]
+        grep -q 'disagrees with the tracer by' "$CL/c.rec.err" && [ ! -e "$CL/crep.txt" ] && [ ! -e "$CL/crep.json" ]
 }
 check "cornea loop: the tracer check failing its tolerance is an error (exit 2, no report)" cl_checkfail
 # 6. the quick model source: no OpenCV mapped; frames map it (LD_DEBUG=files)
 cl_maps() {
-    printf 'biconic\n-\nspiral\n30\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n-\n' > "$CL/m.in"
+    printf 'biconic\n-\nspiral\n30\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n0\n-\n' > "$CL/m.in"
     cl_run "$BIN" m.in m.rec LD_DEBUG=files || return 1
     grep -q '^Spots: the traced hit plus Gaussian noise' "$CL/m.rec" &&
         grep -q 'lensmat-trace' "$CL/m.rec.err" && ! grep -q -E 'opencv|lensmat-imaging' "$CL/m.rec.err" || return 1
@@ -98,7 +100,7 @@ cl_maps() {
 check "cornea loop: the model source maps no OpenCV, frames do" cl_maps
 # 7. on the simulated chip: move, expose, frame per point; the log ends laser off
 cl_sim() {
-    printf 'biconic\n%s\nsim\nsim.log\n2\nspiral\n30\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-\n1\nsrep.txt\n' \
+    printf 'biconic\n%s\nsim\nsim.log\n2\nspiral\n30\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-\n1\n0\nsrep\nn\n' \
         "$RIGGOLD" > "$CL/s.in"
     cl_run "$BIN" s.in s.rec || { cat "$CL/s.rec.err"; return 1; }
     grep -q '^Pattern spiral: 30 targets to 4 deg, 30 planned, 30 exposed' "$CL/s.rec" &&
@@ -110,7 +112,7 @@ check "cornea loop: a 30-point scan on the simulated chip (30 exposures, laser o
 # 8. SIGTERM mid-scan on the simulated chip: exit 143, the laser off, drivers disabled,
 # no report (nor its .part) and the simulator's log complete
 cl_term() {
-    printf 'biconic\n%s\nsim\nk.log\n2\nspiral\n10000\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-\n1\nkrep.txt\n' \
+    printf 'biconic\n%s\nsim\nk.log\n2\nspiral\n10000\n4\nframes\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n14\n640\n480\n-\n1\n0\nkrep\nn\n' \
         "$RIGGOLD" > "$CL/k.in"
     (cd "$CL" && exec "$BIN" --cornea-scan -i k.in k.rec > k.out 2> k.err) &
     p=$!
@@ -119,7 +121,7 @@ cl_term() {
     wait "$p"
     rc=$?
     [ "$rc" -eq 143 ] || { echo "exit $rc"; cat "$CL/k.err"; return 1; }
-    [ ! -e "$CL/krep.txt" ] && [ ! -e "$CL/krep.txt.part" ] && [ ! -e "$CL/k.log.part" ] &&
+    [ ! -e "$CL/krep.txt" ] && [ ! -e "$CL/krep.txt.part" ] && [ ! -e "$CL/krep.csv" ] && [ ! -e "$CL/k.log.part" ] &&
         grep -q 'final laser=0 light=0 enable=000000' "$CL/k.log" && ! grep -q VIOLATION "$CL/k.log" &&
         [ "$(grep -c ' laser 1' "$CL/k.log")" -gt 0 ] && [ "$(grep -c ' laser 1' "$CL/k.log")" -lt 10000 ] &&
         ! grep -q '^Errors' "$CL/k.out"
@@ -141,7 +143,7 @@ cl_camera() {
     cl_frames "$CL/sv.in" 30 14 640 480 - spiral 'fr%04d.png'
     cl_run "$BIN" sv.in sv.rec || { cat "$CL/sv.rec.err"; return 1; }
     [ "$(ls "$CL"/fr*.png | wc -l)" -eq 30 ] && grep -q '^Frames saved as fr%04d.png (numbered 1 to 30)' "$CL/sv.rec" || return 1
-    printf 'biconic\n-\nspiral\n30\n12\ncamera\nfr%%04d.png\n14\ncrep2.txt\n' > "$CL/cam.in"
+    printf 'biconic\n-\nspiral\n30\n12\ncamera\nfr%%04d.png\n14\ncrep2\nn\n' > "$CL/cam.in"
     cl_run "$BIN" cam.in cam.rec || { cat "$CL/cam.rec.err"; return 1; }
     grep -q '^Camera: frames from fr%04d.png' "$CL/cam.rec" && grep -q '^Spots: 30 fitted' "$CL/cam.rec" &&
         ! grep -q -e '^Errors' -e 'simulated eye' "$CL/cam.rec" && grep -q '^Tracer check: .*agrees' "$CL/cam.rec" &&
@@ -160,7 +162,7 @@ check "cornea loop: a camera with fewer frames than exposures is an error" cl_ca
 # half-written frame (each is written to a temporary name and renamed)
 cl_term_frames() {
     mkdir -p "$CL/tf" && rm -f "$CL"/tf/*
-    cl_frames "$CL/tf.in" 10000 14 640 480 tf/rep.txt spiral 'tf/g%05d.png'
+    cl_frames "$CL/tf.in" 10000 14 640 480 tf/rep spiral 'tf/g%05d.png'
     (cd "$CL" && exec "$BIN" --cornea-scan -i tf.in tf.rec > tf.out 2> tf.err) &
     p=$!
     sleep 1

@@ -13,12 +13,21 @@
 /* Difference steps: small against each parameter's scale, large against rounding
  * of ~65 mm paths (1e-14 mm), so central differences keep ~9 digits. */
 const double cn_step[CN_NPARAM] = {1e-5, 1e-7, 1e-7, 1e-4, 1e-4,
-                                   1e-5, 1e-5, 1e-5, 1e-6, 1e-6};
+                                   1e-5, 1e-5, 1e-5, 1e-6, 1e-6, 1e-7, 1e-8};
 /* A parameter whose uncertainty exceeds its limit is "not determined": a number
  * with that error bar is no measurement (R 50 um, cylinder components 0.5 D,
- * Q 0.2, position 0.1 mm, tilt 2 deg). */
+ * Q 0.2, position 0.1 mm, tilt 2 deg; A4 5e-5 mm^-3, the s^4 term of Q 0.2 at R
+ * 7.8, and A6 2e-5 mm^-5, the same height as that A4 at s = 1.5 mm). */
 static const double limit[CN_NPARAM] = {0.05, 0.5 / 337.5, 0.5 / 337.5, 0.2, 0.2,
-                                        0.1, 0.1, 0.1, 0.035, 0.035};
+                                        0.1, 0.1, 0.1, 0.035, 0.035, 5e-5, 2e-5};
+
+double cn_limit(int k) { return k >= 0 && k < CN_NPARAM ? limit[k] : 0; }
+
+void cn_free_mask_q(int model, int fix_tilt, int free_q, int free[CN_NPARAM])
+{
+    cn_free_mask(model, fix_tilt, free);
+    if (model == CN_ASPHERE) free[CN_QF] = free_q != 0;
+}
 
 void cn_free_mask(int model, int fix_tilt, int free[CN_NPARAM])
 {
@@ -28,6 +37,7 @@ void cn_free_mask(int model, int fix_tilt, int free[CN_NPARAM])
     free[CN_QF] = 1;
     if (!fix_tilt) free[CN_TX] = free[CN_TY] = 1;
     if (model == CN_BICONIC) free[CN_C0] = free[CN_C45] = free[CN_QS] = 1;
+    if (model == CN_ASPHERE) free[CN_A4] = free[CN_A6] = 1;   /* Q: cn_free_mask_q */
 }
 
 int cn_jacobian(int model, const cn_params *p, const double apex0[3], const cn_plane *pl,
@@ -141,7 +151,8 @@ int cn_analyse(const double *J, int m, int model, const cn_params *p, double rco
 
 /* Clinical values of a parameter vector. */
 enum { V_R, V_Q, V_RF, V_RS, V_QF, V_QS, V_K1, V_K2, V_AX, V_KM, V_CYL, V_P,
-       V_DX, V_DY, V_DZ, V_TX, V_TY, V_N };
+       V_DX, V_DY, V_DZ, V_TX, V_TY, V_ZK1, V_ZK2, V_ZAX, V_ZKM, V_ZCYL, V_N };
+#define ZONE_H 1.5                     /* the 3 mm zone's ring (mm) */
 static void values(int model, const cn_params *p, double v[V_N])
 {
     cn_surf s;
@@ -164,6 +175,13 @@ static void values(int model, const cn_params *p, double v[V_N])
     v[V_DZ] = p->p[CN_DZ];
     v[V_TX] = p->p[CN_TX] * 180 / M_PI;
     v[V_TY] = p->p[CN_TY] * 180 / M_PI;
+    double km, amp, steep;
+    if (cn_zone_simk(&s, ZONE_H, &km, &amp, &steep)) km = amp = steep = NAN;
+    v[V_ZKM] = kn * km;
+    v[V_ZK1] = kn * (km - amp);
+    v[V_ZK2] = kn * (km + amp);
+    v[V_ZCYL] = kn * 2 * amp;
+    v[V_ZAX] = fmod(steep + 90, 180);      /* the flat meridian */
 }
 
 void cn_clinical_of(int model, const cn_params *p, const double *cov,
@@ -180,7 +198,7 @@ void cn_clinical_of(int model, const cn_params *p, const double *cov,
         values(model, &pb, b);
         for (int i = 0; i < V_N; i++) {
             double d = a[i] - b[i];
-            if (i == V_AX) d = remainder(d, 180.0);   /* the axis wraps at 180 */
+            if (i == V_AX || i == V_ZAX) d = remainder(d, 180.0);   /* axes wrap */
             g[j][i] = d / (2 * cn_step[j]);
         }
     }
@@ -218,4 +236,15 @@ void cn_clinical_of(int model, const cn_params *p, const double *cov,
     k->dz = v[V_DZ]; k->sd_dz = sd[V_DZ];
     k->tx = v[V_TX]; k->sd_tx = sd[V_TX];
     k->ty = v[V_TY]; k->sd_ty = sd[V_TY];
+    k->zone_h = ZONE_H;
+    k->zK1 = v[V_ZK1]; k->sd_zK1 = sd[V_ZK1];
+    k->zK2 = v[V_ZK2]; k->sd_zK2 = sd[V_ZK2];
+    k->zKm = v[V_ZKM]; k->sd_zKm = sd[V_ZKM];
+    k->zcyl = v[V_ZCYL]; k->sd_zcyl = sd[V_ZCYL];
+    if (model == CN_BICONIC) {
+        k->zK1_axis = v[V_ZAX];
+        k->zK2_axis = fmod(v[V_ZAX] + 90, 180);
+        k->sd_zaxis = sd[V_ZAX];
+    } else
+        k->zK1_axis = k->zK2_axis = k->sd_zaxis = NAN;
 }

@@ -1,7 +1,7 @@
 /* cn_api.c -- the cornea engine's table: the one exported symbol, cornea_get_api. */
 #include "cn_int.h"
 
-static const char *version(void) { return "lensmat-cornea 1"; }
+static const char *version(void) { return "lensmat-cornea 2"; }
 
 static const cornea_api api = {
     .abi = CORNEA_ABI,
@@ -16,6 +16,11 @@ static const cornea_api api = {
     .fit = cn_fit,
     .predict = cn_predict_scan,
     .report = cn_report,
+    .reimage = cn_reimage,
+    .map = cn_map,
+    .spot_xy = cn_spot_xy,
+    .report_csv = cn_report_csv,
+    .report_json = cn_report_json,
 };
 
 __attribute__((visibility("default"))) const cornea_api *cornea_get_api(int abi)

@@ -61,6 +61,82 @@ static int f_jac(const gsl_vector *x, void *data, gsl_matrix *J)
     return GSL_SUCCESS;
 }
 
+/* The residual map's test: the mean correlation of each spot's normalised residual
+ * vector with its nearest neighbour's on the cornea (rx: x, y, ru, rv per spot).
+ * Noise gives ~0 (sd about 1/sqrt(n)); a shape the model lacks (a cone) gives
+ * neighbours that miss alike, near 1.  O(n^2) (10 000 spots: 1e8 distances), so the
+ * stop callback is polled every 256 spots: NaN when it asks to stop. */
+static double cn_resid_corr(const double *rx, int n, int (*stop)(void *), void *sctx)
+{
+    double num = 0, den = 0;
+    for (int i = 0; i < n; i++) {
+        if ((i & 255) == 0 && stop && stop(sctx)) return NAN;
+        const double *a = &rx[4 * i];
+        double best = INFINITY;
+        int bj = -1;
+        for (int j = 0; j < n; j++) {
+            if (j == i) continue;
+            double d = (rx[4 * j] - a[0]) * (rx[4 * j] - a[0]) +
+                       (rx[4 * j + 1] - a[1]) * (rx[4 * j + 1] - a[1]);
+            if (d < best) { best = d; bj = j; }
+        }
+        if (bj < 0) continue;
+        num += a[2] * rx[4 * bj + 2] + a[3] * rx[4 * bj + 3];
+        den += a[2] * a[2] + a[3] * a[3];
+    }
+    return den > 0 ? num / den : 0;
+}
+
+static int solve(fctx *c, cn_params *p, int max_iter, int (*stop)(void *), void *sctx);
+
+static double chi2_of(const fctx *c, const cn_params *p)
+{
+    double s = 0;
+    for (int i = 0; i < c->n; i++) {
+        const cn_spot *sp = &c->s[c->use[i]];
+        double u, v;
+        if (cn_forward(c->model, p, c->apex0, c->pl, &sp->ray, &u, &v, NULL, NULL))
+            return INFINITY;
+        s += ((u - sp->u) * (u - sp->u) + (v - sp->v) * (v - sp->v)) / (sp->sigma * sp->sigma);
+    }
+    return s;
+}
+
+/* Shifting the eye across and tilting it about its centre of curvature look alike
+ * (the dy / tilt_x valley of a nearly spherical cornea), and a fit can stop in the
+ * valley away from the truth.  When the first solution is poor (chi^2 more than 4 sd
+ * above its dof), solve again from starts turned about the start's centre of
+ * curvature by +-3 deg about x and about y, and keep the lowest chi^2.  Returns the
+ * iterations spent or CN_ESTOP. */
+static int valley_restarts(fctx *c, const cn_params *start, cn_params *best, int max_iter,
+                           int (*stop)(void *), void *sctx)
+{
+    int dof = 2 * c->n - c->nf, iters = 0;
+    double cb = chi2_of(c, best);
+    if (dof <= 0 || !((cb - dof) / sqrt(2.0 * dof) > 4)) return 0;
+    const double a = 3 * M_PI / 180;
+    const double turns[4][2] = {{a, 0}, {-a, 0}, {0, a}, {0, -a}};
+    double R = start->p[CN_R];
+    for (int t = 0; t < 4; t++) {
+        cn_params q = *start;
+        double tx0 = q.p[CN_TX], ty0 = q.p[CN_TY];
+        double tx = tx0 + turns[t][0], ty = ty0 + turns[t][1];
+        /* centre of curvature T + R Rot(tx, ty) z: kept where the start has it */
+        double c0[3] = {sin(ty0) * cos(tx0), -sin(tx0), cos(ty0) * cos(tx0)};
+        double c1[3] = {sin(ty) * cos(tx), -sin(tx), cos(ty) * cos(tx)};
+        for (int i = 0; i < 3; i++) q.p[CN_DX + i] += R * (c0[i] - c1[i]);
+        q.p[CN_TX] = tx;
+        q.p[CN_TY] = ty;
+        int rc = solve(c, &q, max_iter, stop, sctx);
+        if (rc == CN_ESTOP) return rc;
+        if (rc < 0) continue;
+        iters += rc;
+        double cq = chi2_of(c, &q);
+        if (cq < cb) { cb = cq; *best = q; }
+    }
+    return iters;
+}
+
 static int cmpd(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -111,7 +187,7 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     cn_fit_opts d = {0};
     if (!o) o = &d;
     memset(res, 0, sizeof *res);
-    if (o->model < CN_SPHERE || o->model > CN_BICONIC || n < 0) {
+    if (o->model < CN_SPHERE || o->model > CN_ASPHERE || n < 0) {
         snprintf(err, errcap, "bad fit options (model %d, %d spots)", o->model, n);
         return CN_EINVAL;
     }
@@ -127,7 +203,7 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     }
     if (o->model == CN_SPHERE) p.p[CN_TX] = p.p[CN_TY] = 0;
     fctx c = {.model = o->model, .s = spots, .pl = &pl, .apex0 = apex0};
-    cn_free_mask(o->model, o->fix_tilt, res->free);
+    cn_free_mask_q(o->model, o->fix_tilt, o->free_q, res->free);
     for (int k = 0; k < CN_NPARAM; k++) if (res->free[k]) c.idx[c.nf++] = k;
     int *use = malloc(sizeof *use * (n > 0 ? n : 1));
     double *tmp = malloc(sizeof *tmp * (n > 0 ? n : 1));
@@ -139,7 +215,9 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
             spots[i].status = CN_S_NONE;
     }
     double k_rej = o->reject_k > 0 ? o->reject_k : 5;
-    int rounds = o->reject_rounds == 0 ? 3 : o->reject_rounds < 0 ? 0 : o->reject_rounds;
+    /* rejection rounds until none is new (at most 12): a local shape the model lacks
+     * is carved out step by step, each refit lowering the robust scale */
+    int rounds = o->reject_rounds == 0 ? 12 : o->reject_rounds < 0 ? 0 : o->reject_rounds;
     int max_iter = o->max_iter > 0 ? o->max_iter : 1000;
     int rc = 0, iters = 0;
     for (int round = 0;; round++) {
@@ -151,10 +229,16 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
             rc = CN_EFIT;
             goto out;
         }
+        cn_params p0 = p;
         rc = solve(&c, &p, max_iter, o->stop, o->stop_ctx);
         if (rc < 0) { snprintf(err, errcap, rc == CN_ESTOP ? "stopped" : "fit failed"); goto out; }
         iters += rc;
         rc = 0;
+        if (round == 0 && res->free[CN_TX] && res->free[CN_TY]) {
+            int more = valley_restarts(&c, &p0, &p, max_iter, o->stop, o->stop_ctx);
+            if (more < 0) { snprintf(err, errcap, "stopped"); rc = more; goto out; }
+            iters += more;
+        }
         /* normalised residuals; robust scale from their median (Rayleigh: 1.1774) */
         int m = 0;
         for (int i = 0; i < c.n; i++) {
@@ -184,11 +268,19 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     int M = 2 * c.n;
     double *J = malloc(sizeof *J * (size_t)M * c.nf);
     if (!J) { snprintf(err, errcap, "out of memory"); rc = CN_ENOMEM; goto out; }
-    double chi2 = 0, ss = 0;
+    double chi2 = 0, ss = 0, hmax = 0;
+    double *rx = malloc(sizeof *rx * 4 * (size_t)(c.n > 0 ? c.n : 1));   /* x y ru rv */
+    if (!rx) { free(J); snprintf(err, errcap, "out of memory"); rc = CN_ENOMEM; goto out; }
     for (int i = 0; i < c.n; i++) {
         const cn_spot *s = &spots[use[i]];
-        double u, v;
-        cn_forward(o->model, &p, apex0, &pl, &s->ray, &u, &v, NULL, NULL);
+        double u, v, at[3], e[3];
+        cn_forward(o->model, &p, apex0, &pl, &s->ray, &u, &v, at, NULL);
+        cn_to_eye(&p, apex0, at, e);
+        hmax = fmax(hmax, hypot(e[0], e[1]));
+        rx[4 * i] = e[0];
+        rx[4 * i + 1] = e[1];
+        rx[4 * i + 2] = (u - s->u) / s->sigma;
+        rx[4 * i + 3] = (v - s->v) / s->sigma;
         ss += (u - s->u) * (u - s->u) + (v - s->v) * (v - s->v);
         chi2 += s->nres * s->nres;
         cn_jacobian(o->model, &p, apex0, &pl, s, c.idx, c.nf, &J[2 * i * c.nf],
@@ -206,6 +298,10 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     res->rms = c.n ? sqrt(ss / c.n) : NAN;
     res->chi2_dof = M > c.nf ? chi2 / (M - c.nf) : NAN;
     res->par = p;
+    res->hmax = hmax;
+    res->resid_corr = cn_resid_corr(rx, c.n, o->stop, o->stop_ctx);
+    free(rx);
+    if (isnan(res->resid_corr)) { snprintf(err, errcap, "stopped"); rc = CN_ESTOP; goto out; }
     res->nfree = c.nf;
     memcpy(res->idx, c.idx, sizeof res->idx);
     memcpy(res->sv, a.sv, sizeof a.sv);
@@ -214,6 +310,21 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
     res->cond = a.cond;
     res->undetermined = a.undetermined;
     memcpy(res->why, a.why, sizeof res->why);
+    /* many outliers: the robust test carved a region out of the scan (a cone, a
+     * scar), or the scan is bad; the numbers describe the surface without it */
+    int nout = 0, nin = 0;
+    for (int i = 0; i < n; i++) {
+        nout += spots[i].status == CN_S_OUTLIER;
+        nin += spots[i].status == CN_S_OK || spots[i].status == CN_S_OUTLIER;
+    }
+    if (nin > 0 && nout > 0.1 * nin) {
+        size_t l = strlen(res->why);
+        if (l + 230 < sizeof res->why)
+            snprintf(res->why + l, sizeof res->why - l, "MANY OUTLIERS: %d of %d spots "
+                     "(%.0f %%) rejected by the robust test: a local shape the model lacks "
+                     "(a cone?) or a bad scan; the numbers describe the surface without "
+                     "them (see the residual map)\n", nout, nin, 100.0 * nout / nin);
+    }
     /* chi^2 test: a fit far above its noise is a local minimum, the wrong model or
      * a sigma too small; what its weakest direction mixes is then not trustworthy */
     int dof = M - c.nf;
@@ -235,6 +346,31 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
                               cn_param_name(c.idx[q]));
             }
         if (l + 1 < sizeof res->why) strcat(res->why, "\n");
+        l = strlen(res->why);
+        if (res->resid_corr > 0.3) {
+            /* the wrong model: its honest uncertainty is at least the covariance
+             * scaled by chi^2/dof; what that puts over its limit is not determined */
+            l += snprintf(res->why + l, sizeof res->why - l, "SYSTEMATIC RESIDUALS: "
+                          "neighbour correlation %.2f: the model misses a shape of the "
+                          "surface (a local steepening?): see the residual map; over "
+                          "their limits with the covariance scaled by chi2/dof:",
+                          res->resid_corr);
+            for (int i = 0; i < CN_NPARAM * CN_NPARAM; i++)
+                if (isfinite(res->cov[i])) res->cov[i] *= res->chi2_dof;
+            for (int q = 0; q < c.nf; q++) {
+                int k = c.idx[q];
+                if (sqrt(res->cov[k * (CN_NPARAM + 1)]) > cn_limit(k)) {
+                    res->undetermined |= 1u << k;
+                    res->cov[k * (CN_NPARAM + 1)] = INFINITY;
+                    if (l + 12 < sizeof res->why)
+                        l += snprintf(res->why + l, sizeof res->why - l, " %s",
+                                      cn_param_name(k));
+                }
+            }
+            if (l + 1 < sizeof res->why) strcat(res->why, "\n");
+        } else
+            snprintf(res->why + l, sizeof res->why - l, "residuals not correlated between "
+                     "neighbours (%.2f): sigma too small or outliers\n", res->resid_corr);
     }
     cn_clinical_of(o->model, &p, res->cov, res->undetermined, &res->k);
 out:
@@ -251,7 +387,7 @@ int cn_predict_scan(const rg_geometry *g, const cn_spot *spots, int n, int model
     int free_[CN_NPARAM];
     memset(pr, 0, sizeof *pr);
     cn_plane_of(g, &pl);
-    cn_free_mask(model, fix_tilt, free_);
+    cn_free_mask_q(model, fix_tilt, 0, free_);
     cn_svd a = {0};
     for (int k = 0; k < CN_NPARAM; k++) if (free_[k]) a.idx[a.nfree++] = k;
     double *J = malloc(sizeof *J * 2 * (size_t)(n > 0 ? n : 1) * a.nfree);
@@ -283,7 +419,7 @@ int cn_predict_scan(const rg_geometry *g, const cn_spot *spots, int n, int model
 
 const char *cn_report(const cn_result *r, char *buf, size_t cap)
 {
-    static const char *const mn[] = {"sphere", "conic", "biconic"};
+    static const char *const mn[] = {"sphere", "conic", "biconic", "asphere"};
     const cn_clinical *k = &r->k;
     size_t l = 0;
 #define OUT(...) do { if (l < cap) l += snprintf(buf + l, cap - l, __VA_ARGS__); } while (0)
@@ -291,7 +427,14 @@ const char *cn_report(const cn_result *r, char *buf, size_t cap)
     OUT("model %s: %d spots fitted, %d left out, %d iterations, residual RMS %.3g um, "
         "chi2/dof %.3g\n", mn[r->model], r->nused, r->nrejected, r->iterations,
         r->rms * 1000, r->chi2_dof);
-    OUT("apex radius R %.5f +- %.5f mm   Q %.4f +- %.4f\n", k->R, k->sd_R, k->Q, k->sd_Q);
+    if (r->free[CN_QF] || r->model == CN_SPHERE)
+        OUT("apex radius R %.5f +- %.5f mm   Q %.4f +- %.4f\n", k->R, k->sd_R, k->Q, k->sd_Q);
+    else
+        OUT("apex radius R %.5f +- %.5f mm   Q %.4f (held)\n", k->R, k->sd_R, k->Q);
+    if (r->model == CN_ASPHERE)
+        OUT("asphere A4 %.5g +- %.2g mm^-3   A6 %.5g +- %.2g mm^-5%s\n", r->par.p[CN_A4],
+            sqrt(r->cov[CN_A4 * (CN_NPARAM + 1)]), r->par.p[CN_A6],
+            sqrt(r->cov[CN_A6 * (CN_NPARAM + 1)]), r->free[CN_QF] ? "" : "   (Q held)");
     if (r->model == CN_BICONIC)
         OUT("R flat %.5f +- %.5f mm (Q %.4f +- %.4f)   R steep %.5f +- %.5f mm "
             "(Q %.4f +- %.4f)\n", k->R_flat, k->sd_R_flat, k->Q_flat, k->sd_Q_flat,
@@ -306,13 +449,21 @@ const char *cn_report(const cn_result *r, char *buf, size_t cap)
     } else
         OUT("K (n 1.3375) %.3f +- %.3f D (no cylinder in this model)   corneal power "
             "(n 1.376) %.3f +- %.3f D\n", k->Km, k->sd_Km, k->P, k->sd_P);
+    if (r->model == CN_BICONIC)
+        OUT("Sim K 3 mm zone: K1 %.3f +- %.3f D @ %.1f   K2 %.3f +- %.3f D @ %.1f   mean "
+            "%.3f +- %.3f D   cylinder %.3f +- %.3f D", k->zK1, k->sd_zK1, k->zK1_axis,
+            k->zK2, k->sd_zK2, k->zK2_axis, k->zKm, k->sd_zKm, k->zcyl, k->sd_zcyl);
+    else
+        OUT("Sim K 3 mm zone: mean %.3f +- %.3f D", k->zKm, k->sd_zKm);
+    if (r->hmax < k->zone_h) OUT("   (extrapolated: data to %.2f mm)", r->hmax);
+    OUT("\n");
     OUT("eye: apex shift %.4f %.4f %.4f mm (+- %.4f %.4f %.4f), tilt %.3f %.3f deg "
         "(+- %.3f %.3f)\n", k->dx, k->dy, k->dz, k->sd_dx, k->sd_dy, k->sd_dz, k->tx,
         k->ty, k->sd_tx, k->sd_ty);
     OUT("singular values (scaled columns):");
     for (int i = 0; i < r->nfree; i++) OUT(" %.3g", r->sv[i]);
     OUT("   condition %.3g\n", r->cond);
-    if (r->undetermined || r->poor) OUT("%s", r->why);
+    if (r->why[0]) OUT("%s", r->why);
 #undef OUT
     return buf;
 }

@@ -9,6 +9,8 @@
 typedef struct cn_surf {
     double cf, cs, qf, qs;          /* flat/steep apex curvatures (1/mm) and Q */
     double alpha, ca, sa;           /* flat meridian angle, its cos and sin */
+    double a4, a6;                  /* even asphere terms (CN_ASPHERE) */
+    cn_bump bump;                   /* keratoconus-like bump (h 0: none) */
 } cn_surf;
 
 const char *cn_param_name(int k);
@@ -30,9 +32,33 @@ int cn_predict_scan(const rg_geometry *g, const cn_spot *spots, int n, int model
                     int fix_tilt, const cn_params *p, double sigma, cn_predict *pr,
                     char *err, size_t errcap);
 const char *cn_report(const cn_result *r, char *buf, size_t cap);
+/* cn_model.c: the surface alone (eye frame) and the forward model with a bump */
+int cn_sag(const cn_surf *s, double x, double y, double *z, double *zx, double *zy);
+int cn_forward_bump(int model, const cn_params *p, const cn_bump *bump,
+                    const double apex0[3], const cn_plane *pl, const cn_ray *r,
+                    double *u, double *v, double spot[3], double normal[3]);
+/* rig-frame point -> eye frame of p */
+void cn_to_eye(const cn_params *p, const double apex0[3], const double x[3], double e[3]);
+/* cn_zone.c: axial and tangential curvature (1/mm) at (x, y) along the meridian
+ * through it; the 3 mm-zone Sim K of a surface */
+int cn_curvatures(const cn_surf *s, double x, double y, double *axial, double *tang);
+int cn_zone_simk(const cn_surf *s, double h, double *km, double *amp, double *steep_deg);
+/* cn_map.c / cn_export.c */
+int cn_reimage(const rg_geometry *g, int model, const cn_params *p, const cn_bump *bump,
+               double sigma, unsigned long long seed, cn_spot *spots, int n);
+int cn_map(int kind, int model, const cn_params *p, const cn_bump *bump, double hmax,
+           int n, double *grid, double *aux);
+void cn_spot_xy(const rg_geometry *g, const cn_result *r, const cn_spot *spots, int n,
+                double *xy);
+size_t cn_report_csv(const cn_result *r, const cn_spot *spots, int n, char *buf,
+                     size_t cap);
+size_t cn_report_json(const cn_result *r, const cn_spot *spots, int n, char *buf,
+                      size_t cap);
 
 /* cn_analyse.c: Jacobian, SVD, covariance, determinacy, clinical numbers */
 void cn_free_mask(int model, int fix_tilt, int free[CN_NPARAM]);
+double cn_limit(int k);   /* sd above which parameter k is "not determined" */
+void cn_free_mask_q(int model, int fix_tilt, int free_q, int free[CN_NPARAM]);
 extern const double cn_step[CN_NPARAM];
 int cn_jacobian(int model, const cn_params *p, const double apex0[3], const cn_plane *pl,
                 const cn_spot *s, const int *idx, int nfree, double *row_u,

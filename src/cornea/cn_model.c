@@ -8,7 +8,8 @@
 #include "cn_int.h"
 
 static const char *const names[CN_NPARAM] = {"R", "C0", "C45", "Q_flat", "Q_steep",
-                                              "dx", "dy", "dz", "tilt_x", "tilt_y"};
+                                              "dx", "dy", "dz", "tilt_x", "tilt_y",
+                                              "A4", "A6"};
 const char *cn_param_name(int k) { return k >= 0 && k < CN_NPARAM ? names[k] : NULL; }
 
 static double dot3(const double a[3], const double b[3])
@@ -54,9 +55,15 @@ void cn_surface(int model, const cn_params *p, cn_surf *s)
     s->alpha = amp > 0 ? 0.5 * (atan2(c45, c0) + M_PI) : 0;
     s->ca = cos(s->alpha);
     s->sa = sin(s->alpha);
+    s->a4 = model == CN_ASPHERE ? p->p[CN_A4] : 0;
+    s->a6 = model == CN_ASPHERE ? p->p[CN_A6] : 0;
+    memset(&s->bump, 0, sizeof s->bump);
 }
 
 /* Sag and slopes in the eye frame; -1 beyond the surface's edge. */
+static int sag(const cn_surf *s, double x, double y, double *z, double *zx, double *zy);
+int cn_sag(const cn_surf *s, double x, double y, double *z, double *zx, double *zy)
+{ return sag(s, x, y, z, zx, zy); }
 static int sag(const cn_surf *s, double x, double y, double *z, double *zx, double *zy)
 {
     double xp = s->ca * x + s->sa * y, yp = -s->sa * x + s->ca * y;
@@ -72,6 +79,19 @@ static int sag(const cn_surf *s, double x, double y, double *z, double *zx, doub
     double zyp = (2 * s->cs * yp * D - A * By / (2 * S)) / (D * D);
     *zx = s->ca * zxp - s->sa * zyp;
     *zy = s->sa * zxp + s->ca * zyp;
+    if (s->a4 != 0 || s->a6 != 0) {        /* even asphere: + a4 s^4 + a6 s^6 */
+        double s2 = x * x + y * y, ds = 4 * s->a4 * s2 + 6 * s->a6 * s2 * s2;
+        *z += (s->a4 + s->a6 * s2) * s2 * s2;
+        *zx += ds * x;
+        *zy += ds * y;
+    }
+    if (s->bump.h != 0 && s->bump.w > 0) { /* the cone: a Gaussian toward -z */
+        double bx = x - s->bump.x0, by = y - s->bump.y0, w2 = s->bump.w * s->bump.w;
+        double e = s->bump.h * exp(-(bx * bx + by * by) / (2 * w2));
+        *z -= e;
+        *zx += e * bx / w2;
+        *zy += e * by / w2;
+    }
     return 0;
 }
 
@@ -86,9 +106,25 @@ static void rotation(double tx, double ty, double m[9])
 int cn_forward(int model, const cn_params *p, const double apex0[3], const cn_plane *pl,
                const cn_ray *r, double *u, double *v, double spot[3], double normal[3])
 {
+    return cn_forward_bump(model, p, NULL, apex0, pl, r, u, v, spot, normal);
+}
+
+void cn_to_eye(const cn_params *p, const double apex0[3], const double x[3], double e[3])
+{
+    double m[9], rel[3];
+    rotation(p->p[CN_TX], p->p[CN_TY], m);
+    for (int i = 0; i < 3; i++) rel[i] = x[i] - apex0[i] - p->p[CN_DX + i];
+    for (int i = 0; i < 3; i++) e[i] = m[i] * rel[0] + m[3 + i] * rel[1] + m[6 + i] * rel[2];
+}
+
+int cn_forward_bump(int model, const cn_params *p, const cn_bump *bump,
+                    const double apex0[3], const cn_plane *pl, const cn_ray *r,
+                    double *u, double *v, double spot[3], double normal[3])
+{
     cn_surf s;
     double m[9], T[3], o[3], d[3], rel[3];
     cn_surface(model, p, &s);
+    if (bump) s.bump = *bump;
     rotation(p->p[CN_TX], p->p[CN_TY], m);
     for (int i = 0; i < 3; i++) T[i] = apex0[i] + p->p[CN_DX + i];
     for (int i = 0; i < 3; i++) rel[i] = r->o[i] - T[i];
@@ -145,6 +181,10 @@ void cn_params_from_cornea(const rg_cornea *c, const double apex0[3], double rx,
     double cf = 1 / c->R, cs = 1 / c->R, qf = c->Q, qs = c->Q, a = 0;
     if (c->model == RG_SPHERE) qf = qs = 0;
     if (c->model == RG_BICONIC) { cs = 1 / c->R2; qs = c->Q2; a = c->axis; }
+    if (c->model == RG_ASPHERE) {
+        p->p[CN_A4] = c->nasph > 0 ? c->asph[0] : 0;
+        p->p[CN_A6] = c->nasph > 1 ? c->asph[1] : 0;
+    }
     double cm = (cf + cs) / 2, amp = (cs - cf) / 2;
     p->p[CN_R] = 1 / cm;
     p->p[CN_C0] = -amp * cos(2 * a);
@@ -179,7 +219,13 @@ void cn_cornea_from_params(const rig_api *rg, int model, const cn_params *p,
     cn_surf s;
     cn_surface(model, p, &s);
     memset(c, 0, sizeof *c);
-    c->model = model == CN_SPHERE ? RG_SPHERE : model == CN_CONIC ? RG_CONIC : RG_BICONIC;
+    c->model = model == CN_SPHERE ? RG_SPHERE : model == CN_CONIC ? RG_CONIC
+             : model == CN_ASPHERE ? RG_ASPHERE : RG_BICONIC;
+    if (model == CN_ASPHERE) {
+        c->nasph = 2;
+        c->asph[0] = p->p[CN_A4];
+        c->asph[1] = p->p[CN_A6];
+    }
     c->R = 1 / s.cf;
     c->Q = s.qf;
     c->R2 = 1 / s.cs;

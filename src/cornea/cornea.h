@@ -1,8 +1,10 @@
 /* cornea.h -- public face of the cornea analysis engine (issue 12): fit a cornea model
- * (sphere, conic, biconic/toric) and the eye's pose to laser-spot positions on the
- * rig's detector, report what clinicians read (apex radius, Q, Sim K, cylinder, power)
- * with uncertainties, say which parameters a scan does not determine (SVD of the
- * weighted Jacobian), and predict the accuracy of a rig and scan before building it.
+ * (sphere, conic, biconic/toric, even asphere) and the eye's pose to laser-spot
+ * positions on the rig's detector, report what clinicians read (apex radius, Q, Sim K
+ * at the apex and over the 3 mm zone, cylinder, power) with uncertainties, say which
+ * parameters a scan does not determine (SVD of the weighted Jacobian) and when the
+ * residuals are systematic (a cone), predict the accuracy of a rig and scan before
+ * building it; and give what maps and reports need (map grids, CSV and JSON).
  * Lives in build/lib/lensmat-cornea.so:
  *     cornea_get_api_fn get = (cornea_get_api_fn)lm_engine_symbol("cornea",
  *                                                                 CORNEA_API_SYMBOL);
@@ -22,7 +24,7 @@
 #include <stddef.h>
 #include "rig/rig.h"
 
-#define CORNEA_ABI 1
+#define CORNEA_ABI 2
 #define CORNEA_API_SYMBOL "cornea_get_api"
 
 enum { CN_OK = 0, CN_EINVAL = -1, CN_ENOMEM = -2, CN_EFIT = -3, CN_ESTOP = -4,
@@ -32,8 +34,13 @@ enum { CN_OK = 0, CN_EINVAL = -1, CN_ENOMEM = -2, CN_EFIT = -3, CN_ESTOP = -4,
  * curvature, c(phi) = 1/R + C0 cos 2phi + C45 sin 2phi (1/mm), well conditioned at
  * zero cylinder; R_flat, R_steep and the axis are derived from them. */
 enum cn_param { CN_R, CN_C0, CN_C45, CN_QF, CN_QS, CN_DX, CN_DY, CN_DZ, CN_TX, CN_TY,
+                CN_A4, CN_A6,      /* even asphere (section 33): + A4 s^4 + A6 s^6, mm^-3
+                                      and mm^-5, about the conic of R and Q_flat */
                 CN_NPARAM };
-enum cn_model { CN_SPHERE, CN_CONIC, CN_BICONIC };
+/* CN_ASPHERE: rotational conic (R, Q_flat) plus A4 s^4 + A6 s^6 and the pose.  Q and
+ * A4 change the same s^4 term (a conic's s^4 coefficient is (1+Q)/(8R^3)), so Q is
+ * held at its start value (the rig file's cornea_Q) unless cn_fit_opts.free_q. */
+enum cn_model { CN_SPHERE, CN_CONIC, CN_BICONIC, CN_ASPHERE };
 
 typedef struct cn_plane {          /* the detector plane */
     double at[3], w[3];            /* detector point; unit normal */
@@ -59,11 +66,13 @@ typedef struct cn_fit_opts {
     int model;                     /* enum cn_model */
     int fix_tilt;                  /* 1: tilt held at the start value (sphere: always) */
     double reject_k;               /* outlier: |r|/sigma > k * robust scale (0: 5) */
-    int reject_rounds;             /* refits after rejection (0: 3; -1: none) */
+    int reject_rounds;             /* refits after rejection, until none is new
+                                      (0: at most 12; -1: none) */
     double rcond;                  /* singular value / largest below it: not
                                       determined (0: 1e-9) */
     int max_iter;                  /* trust-region iterations (0: 100) */
     int (*stop)(void *ctx); void *stop_ctx;   /* polled each iteration */
+    int free_q;                    /* asphere: fit Q too (its s^4 term is A4's) */
 } cn_fit_opts;
 
 /* What the clinician reads, each with its standard uncertainty (sd_*; INFINITY when
@@ -81,6 +90,14 @@ typedef struct cn_clinical {
     double P, sd_P;                /* mean corneal power with n = 1.376 (D) */
     double dx, dy, dz, sd_dx, sd_dy, sd_dz;   /* eye pose: apex shift (mm) */
     double tx, ty, sd_tx, sd_ty;   /* tilt (deg) */
+    /* Sim K over the standard 3 mm zone, as keratometers and topographers report it:
+     * the axial (sagittal) curvature of the fitted surface on the ring of height
+     * zone_h = 1.5 mm about its axis, 72 meridians, its mean and second harmonic
+     * (K(phi) = zKm + A cos 2(phi - zK2_axis)); the apex values above are the
+     * limit zone_h -> 0.  D, n 1.3375; axes deg 0-180. */
+    double zone_h;
+    double zK1, sd_zK1, zK1_axis, zK2, sd_zK2, zK2_axis, sd_zaxis;
+    double zKm, sd_zKm, zcyl, sd_zcyl;
 } cn_clinical;
 
 #define CN_KERATO_N 1.3375
@@ -111,6 +128,11 @@ typedef struct cn_result {
                                       weakest direction's parameters then marked) */
     double chi2_z;                 /* (chi^2 - dof) / sqrt(2 dof) */
     cn_clinical k;
+    double hmax;                   /* largest height of a fitted spot from the fitted
+                                      surface's axis (mm): the data's zone */
+    double resid_corr;             /* residual map test: mean correlation of each
+                                      spot's residual with its nearest neighbour's
+                                      (noise ~0; a shape the model lacks ~1) */
 } cn_result;
 
 typedef struct cn_predict {        /* accuracy of a rig and scan before building it */
@@ -134,6 +156,24 @@ typedef struct cn_scan_opts {
     unsigned long long seed;
     int quantise;                  /* 1: commanded poses on the step grid */
 } cn_scan_opts;
+
+/* A keratoconus-like local steepening (a model of the truth for simulations, never
+ * fitted): a Gaussian protrusion of the surface toward the observer added to the
+ * sag in the eye frame,
+ *     z(x, y) -= h exp(-((x - x0)^2 + (y - y0)^2) / (2 w^2)),
+ * which steepens the apex curvature at (x0, y0) by h / w^2 (1/mm), i.e.
+ * 337.5 h / w^2 D: h 10 um over w 0.8 mm is 5.3 D, a mild cone.  mm. */
+typedef struct cn_bump { double h, w, x0, y0; } cn_bump;
+
+/* Maps of a fitted surface, in its eye frame (apex at the origin, x, y in mm as the
+ * rig's eye frame), on an n x n grid over [-hmax, hmax]^2, row 0 at y = +hmax,
+ * column 0 at x = -hmax; NaN outside the disc of radius hmax or off the surface. */
+enum cn_map_kind {
+    CN_MAP_ELEVATION,    /* height above the best-fit sphere (um, + toward the
+                            observer); the sphere's radius in *aux */
+    CN_MAP_AXIAL,        /* axial (sagittal) curvature, D (n 1.3375) */
+    CN_MAP_TANGENTIAL    /* tangential (meridional) curvature, D */
+};
 
 typedef struct cornea_api {
     int abi;
@@ -173,6 +213,31 @@ typedef struct cornea_api {
                    char *err, size_t errcap);
     /* Plain-text report of a result into buf; returns buf. */
     const char *(*report)(const cn_result *r, char *buf, size_t cap);
+    /* --- ABI 2 --- */
+    /* Re-image a planned scan through a truth of `model` and p plus an optional
+     * bump (NULL: none), by the analytic model (equal to rig_api.forward to 1e-12
+     * mm): each spot's (u, v) from its ray, plus Gaussian noise sigma (mm) from
+     * seed (drawn for every spot, as simulate).  Status CN_S_NONE where the beam
+     * misses.  Returns the number of spots on the detector. */
+    int (*reimage)(const rg_geometry *g, int model, const cn_params *p,
+                   const cn_bump *bump, double sigma, unsigned long long seed,
+                   cn_spot *spots, int n);
+    /* A map (enum cn_map_kind) of model and p (bump: NULL, or the truth's) into
+     * grid[n * n]; aux: the best-fit sphere's radius (elevation).  CN_OK or
+     * CN_EINVAL. */
+    int (*map)(int kind, int model, const cn_params *p, const cn_bump *bump,
+               double hmax, int n, double *grid, double *aux);
+    /* Where each fitted spot met the fitted surface, in its eye frame (x, y mm):
+     * spot i -> xy[2i], xy[2i+1] (NaN when it missed). */
+    void (*spot_xy)(const rg_geometry *g, const cn_result *r, const cn_spot *spots,
+                    int n, double *xy);
+    /* The report as CSV (one `quantity,value,sd,unit` row per number; documented in
+     * README "Cornea measurement") or as one JSON object; returns bytes written
+     * (snprintf's rule: >= cap means truncated). */
+    size_t (*report_csv)(const cn_result *r, const cn_spot *spots, int n, char *buf,
+                         size_t cap);
+    size_t (*report_json)(const cn_result *r, const cn_spot *spots, int n, char *buf,
+                          size_t cap);
 } cornea_api;
 
 typedef const cornea_api *(*cornea_get_api_fn)(int abi);

@@ -52,3 +52,12 @@ build/obj/cornea_tests/scan_plot: tests/cornea/scan_plot.c build/lib/lensmat-ima
 	$(CC) $(BASE) $(OPT) -o $@ $< build/lib/lensmat-imaging.so \
 	    -Wl,-rpath,$(abspath build/lib) -lm
 MODULE_BENCH_BINS += build/obj/cornea_tests/scan_plot
+
+# the many-eyes study's plot (scripts/cornea-study.sh), on the imaging engine
+build/obj/cornea_tools/study_plot: tests/cornea/study_plot.c build/lib/lensmat-imaging.so \
+                                   src/imaging/imaging.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -o $@ $< -L$(abspath build/lib) -l:lensmat-imaging.so \
+	    -Wl,-rpath,$(abspath build/lib) -lm
+all: build/obj/cornea_tools/study_plot
+MODULE_TEST_BINS += build/obj/cornea_tools/study_plot

@@ -326,6 +326,24 @@ static int take(job *j)
     return k;
 }
 
+/* With a cone: the hit of point q's beam through the true eye with the cone, by the
+ * cornea engine's analytic model (equal to the tracer's on the eye without it to
+ * 1e-12 mm); 0, or -1 (status NONE, why said) when the beam misses. */
+static int cone_hit(const cl_run *r, const cn_plane *pl, cl_point *q, double hit[3])
+{
+    cn_spot b = q->spot;
+    if (r->cn->reimage(r->g, CN_BICONIC, &r->truth_p, r->bump, 0, 0, &b, 1) != 1) {
+        q->spot.status = CN_S_NONE;
+        q->spot.u = q->spot.v = NAN;
+        snprintf(q->why, sizeof q->why, "the beam misses the cornea with its cone");
+        return -1;
+    }
+    q->hit_u = b.u;
+    q->hit_v = b.v;
+    for (int i = 0; i < 3; i++) hit[i] = pl->at[i] + b.u * pl->e1[i] + b.v * pl->e2[i];
+    return 0;
+}
+
 static void measure_one(job *j, im_centroider *cz, int k)
 {
     cl_run *r = j->r;
@@ -346,6 +364,11 @@ static void measure_one(job *j, im_centroider *cz, int k)
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         /* the camera still takes the frame: it shows no spot */
+        if (r->source == CL_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
+            fail_job(j);
+        return;
+    }
+    if (r->bump && cone_hit(r, &j->pl, q, hit)) {
         if (r->source == CL_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
             fail_job(j);
         return;
@@ -595,6 +618,13 @@ int cl_measure(cl_run *r, char *err, size_t cap)
         j.phase = 1;
         j.gf = *r->g;
         r->cn->cornea_from_params(rg, r->model, &r->res.par, r->g->cornea.trans, &j.gf.cornea);
+        if (r->model == CN_ASPHERE && !(j.gf.cornea.zone > 0)) {
+            /* the tracer refuses an unbounded asphere: bound it at the rig's zone,
+               else 6 mm (a cornea's semi-diameter), inside its conic's edge */
+            const rg_cornea *fc = &j.gf.cornea;
+            double edge = 1 + fc->Q > 0 ? 0.999 * fc->R / sqrt(1 + fc->Q) : INFINITY;
+            j.gf.cornea.zone = fmin(r->g->cornea.zone > 0 ? r->g->cornea.zone : 6.0, edge);
+        }
         r->cn->plane(&j.gf, &j.plf);
         double *keep = malloc(sizeof *keep * (size_t)(n ? n : 1));
         if (!keep) { snprintf(err, cap, "out of memory"); goto fail; }

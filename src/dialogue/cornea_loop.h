@@ -68,6 +68,11 @@ typedef struct cl_run {
     const char *save;           /* CL_SRC_FRAMES: write frame N to this %d pattern
                                    (NULL: not saved) */
     int have_truth;             /* 0: a real eye (camera): nothing to trace */
+    const cn_bump *bump;        /* a keratoconus-like cone on the true eye (NULL:
+                                   none): the tracer has no such surface, so each
+                                   spot's hit comes from the cornea engine's analytic
+                                   model of the true eye with it (cornea_api.reimage) */
+    cn_params truth_p;          /* with bump: the true eye as a biconic's parameters */
     uint64_t seed;
     int threads;                /* workers for the per-point work (>= 1) */
     /* machine (NULL: planned only) and its rig file (step sizes) */

@@ -5,10 +5,12 @@
  * traced through the eye and made into a full detector frame whose centroid is the
  * measurement (or, quicker, the traced hit plus Gaussian noise); the cornea engine
  * fits the chosen model, the fit's model is checked against the tracer, and the report
- * is printed, recorded and (optionally) written to a report file: Sim K, radii, Q,
- * pose, singular values, what is not determined, the spots rejected and why.  The
- * loop itself is cornea_loop.c; texts in prompts/cornea_scan.txt.  The rig, cornea
- * and trace engines are loaded here; the imaging engine only when frames are used. */
+ * is printed, recorded and (optionally) written under a name: Sim K (apex and 3 mm
+ * zone), radii, Q, pose, singular values, what is not determined, the spots rejected
+ * and why, as NAME.txt, NAME.csv and NAME.json, with the four maps when asked
+ * (cornea_out.c).  The eye may carry a keratoconus-like cone.  The loop itself is
+ * cornea_loop.c; texts in prompts/cornea_scan.txt.  The rig, cornea and trace engines
+ * are loaded here; the imaging engine only when frames or maps are used. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -19,6 +21,7 @@
 #include <unistd.h>
 #include "calcio.h"
 #include "cornea_loop.h"
+#include "cornea_out.h"
 #include "dialogues.h"
 #include "engine.h"
 #include "../imaging/imaging.h"
@@ -55,7 +58,7 @@ typedef struct cs {
     rg_rig rig;
     int have_rig;
     char rigname[WORD], log[WORD], report[WORD], camera[WORD], save[WORD];
-    char *text;                 /* the report as said, for the report file */
+    char *text;                 /* the report as said, for NAME.txt */
     size_t len, cap;
 } cs;
 
@@ -86,26 +89,6 @@ static void say(cs *s, const char *fmt, ...)
     }
     memcpy(s->text + s->len, line, n + 1);
     s->len += n;
-}
-
-/* The report file: everything the session said about the measurement, written to
- * NAME.part and renamed when complete (a stopped session leaves nothing under NAME).
- * The one place the report file is made: the maps and other numbers join here. */
-static int cs_write_report(const char *path, const char *text, size_t len, char *err,
-                           size_t cap)
-{
-    char part[WORD + 8];
-    FILE *f;
-    snprintf(part, sizeof part, "%s.part", path);
-    if (!(f = fopen(part, "w"))) { snprintf(err, cap, "%s", strerror(errno)); return -1; }
-    int ok = fwrite(text, 1, len, f) == len;
-    ok = !fclose(f) && ok;
-    if (!ok || lm_stop_requested() || rename(part, path)) {
-        snprintf(err, cap, "%s", ok ? strerror(errno) : "write error");
-        unlink(part);
-        return -1;
-    }
-    return 0;
 }
 
 /* ---- answers checked as they come ----------------------------------------------- */
@@ -140,23 +123,27 @@ static int check_log(void *ctx, const char *word, char *msg, size_t cap)
     return 0;
 }
 
+/* The report's name: "-", or one whose files (NAME.txt, .csv, .json, the maps, their
+ * .part) are none of this session's inputs: the answers, the record (cs_check_name),
+ * the rig file or the simulator's log. */
 static int check_report(void *ctx, const char *word, char *msg, size_t cap)
 {
     cs *s = ctx;
-    char name[WORD + 16];
+    char name[WORD + 32];
+    if (cs_check_name(s->cc.io, word, msg, cap)) return -1;
     if (!strcmp(word, "-")) return 0;
-    for (int i = 0; i < 2; i++) {
-        snprintf(name, sizeof name, "%s%s", word, i ? ".part" : "");
-        if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
-        if (s->have_rig && same_file(name, s->rig.path)) {
-            snprintf(msg, cap, CS(REPORT_IS_RIG), name);
-            return -1;
+    for (int k = 0; cs_out_suffix[k]; k++)
+        for (int i = 0; i < 2; i++) {
+            snprintf(name, sizeof name, "%s%s%s", word, cs_out_suffix[k], i ? ".part" : "");
+            if (s->have_rig && same_file(name, s->rig.path)) {
+                snprintf(msg, cap, CS(REPORT_IS_RIG), name);
+                return -1;
+            }
+            if (s->log[0] && strcmp(s->log, "-") && !strcmp(name, s->log)) {
+                snprintf(msg, cap, CS(REPORT_IS_LOG), name);
+                return -1;
+            }
         }
-        if (s->log[0] && strcmp(s->log, "-") && !strcmp(word, s->log)) {
-            snprintf(msg, cap, CS(REPORT_IS_LOG), name);
-            return -1;
-        }
-    }
     return 0;
 }
 
@@ -205,9 +192,79 @@ static double check_tol_um(void)
 
 static int run(cs *s, cl_run *r, rg_machine **m);
 
+/* What the report adds beside the engine's numbers: the scan's settings and, for a
+ * synthetic eye, its truth and the errors. */
+typedef struct cs_truth {
+    const rg_cornea *eye;
+    const cn_params *t;
+    const cn_bump *cone;
+    double km, cyl, axis_err, np, zone, noise, pitch, seed;
+} cs_truth;
+
+static void say_line(void *ctx, const char *line) { say(ctx, CS(LINE), line); }
+
+/* The maps (when asked: their lines join the report) and the report under s->report,
+ * from the fitted spots of the run whatever their source (frames, model, camera). */
+static int cs_files(cs *s, const cl_run *r, int maps, const cs_truth *tr)
+{
+    const cornea_api *cn = r->cn;
+    const cn_clinical *k = &r->res.k;
+    const cn_params *t = tr->t;
+    const rg_cornea *eye = tr->eye;
+    char msg[512];
+    int n = 0, rc = LM_GO;
+    cn_spot *sp = malloc(sizeof *sp * (size_t)(r->npoints ? r->npoints : 1));
+    if (!sp) return calc_fail(&s->cc, CS(NO_MEMORY));
+    for (int i = 0; i < r->npoints; i++)    /* the fit's spots, in the fit's order */
+        if (r->pt[i].planned) sp[n++] = r->pt[i].spot;
+    const cs_row rows[] = {
+        {"scan_points", tr->np, NAN, ""}, {"scan_zone", tr->zone, NAN, "deg"},
+        {"scan_source", r->source, NAN, ""}, {"scan_pattern", r->pattern, NAN, ""},
+        {"scan_noise", tr->noise, NAN, "px"}, {"scan_pitch", tr->pitch, NAN, "um"},
+        {"scan_seed", tr->seed, NAN, ""},
+        {"true_R", t->p[CN_R], NAN, "mm"}, {"true_R_flat", eye->R, NAN, "mm"},
+        {"true_R_steep", eye->R2, NAN, "mm"}, {"true_Q", eye->Q, NAN, ""},
+        {"true_Km", tr->km, NAN, "D"}, {"true_cyl", tr->cyl, NAN, "D"},
+        {"true_dx", t->p[CN_DX], NAN, "mm"}, {"true_dy", t->p[CN_DY], NAN, "mm"},
+        {"true_tilt_x", t->p[CN_TX] / DEG, NAN, "deg"},
+        {"true_tilt_y", t->p[CN_TY] / DEG, NAN, "deg"},
+        {"true_cone_h", tr->cone->h * 1e3, NAN, "um"}, {"true_cone_w", tr->cone->w, NAN, "mm"},
+        {"true_cone_x", tr->cone->x0, NAN, "mm"}, {"true_cone_y", tr->cone->y0, NAN, "mm"},
+        {"err_R", (k->R - t->p[CN_R]) * 1e3, k->sd_R * 1e3, "um"},
+        {"err_R_flat", (k->R_flat - eye->R) * 1e3, k->sd_R_flat * 1e3, "um"},
+        {"err_R_steep", (k->R_steep - eye->R2) * 1e3, k->sd_R_steep * 1e3, "um"},
+        {"err_Q", k->Q - eye->Q, k->sd_Q, ""},
+        {"err_Km", k->Km - tr->km, k->sd_Km, "D"},
+        {"err_cyl", r->model == CN_BICONIC ? k->cyl - tr->cyl : NAN, k->sd_cyl, "D"},
+        {"err_axis", r->model == CN_BICONIC && tr->cyl > 0 ? tr->axis_err : NAN, k->sd_axis,
+         "deg"},
+        {"err_dx", (k->dx - t->p[CN_DX]) * 1e3, k->sd_dx * 1e3, "um"},
+        {"err_dy", (k->dy - t->p[CN_DY]) * 1e3, k->sd_dy * 1e3, "um"},
+        {"err_tilt_x", k->tx - t->p[CN_TX] / DEG, k->sd_tx, "deg"},
+        {"err_tilt_y", k->ty - t->p[CN_TY] / DEG, k->sd_ty, "deg"},
+    };
+    /* a camera's eye is unknown: the scan's settings only */
+    int nrows = r->have_truth ? (int)(sizeof rows / sizeof *rows) : 7;
+    if (maps && cs_write_maps(cn, r->g, s->report, &r->res, sp, n, stop_cb, say_line, s, msg,
+                              sizeof msg)) {
+        rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
+        fprintf(stderr, "lensmat: ");
+        fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
+    } else if (cs_write_report(cn, s->report, s->text, s->len, &r->res, sp, n, rows, nrows,
+                               msg, sizeof msg)) {
+        rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
+        fprintf(stderr, "lensmat: ");
+        fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
+    } else {
+        lm_say(s->cc.io, LM_OUT, CS(REPORT_WRITTEN), s->report, s->report, s->report);
+    }
+    free(sp);
+    return rc;
+}
+
 int lm_cornea_scan(lm_io *io)
 {
-    static const char *const models[] = {"sphere", "conic", "biconic", NULL};
+    static const char *const models[] = {"sphere", "conic", "biconic", "asphere", NULL};
     static const char *const chips[] = {"none", "sim", "gpiod", NULL};
     static const char *const patterns[] = {"spiral", "rings", "grid", NULL};
     static const char *const sources[] = {"frames", "model", "camera", NULL};
@@ -273,10 +330,22 @@ int lm_cornea_scan(lm_io *io)
          (rc = lm_ask_word(io, CS(SAVE), CS(SAVE), CS(SAVE_WHAT), check_save, s, s->save,
                            sizeof s->save))))
         goto out;
-    if ((source != CL_SRC_CAMERA &&
-         (rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed))) ||
-        (rc = lm_ask_word(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), check_report, s,
-                          s->report, sizeof s->report)))
+    cn_bump cone = {0, 0, 0, 0};       /* a cone on the synthetic eye (not a camera's) */
+    if (source != CL_SRC_CAMERA &&
+        ((rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)) ||
+         (rc = ranged(c, CS(CONE), CS(CONE_WHAT), CS(CONE_RANGE), 0, 50, 0, &cone.h))))
+        goto out;
+    if (cone.h > 0 &&
+        ((rc = ranged(c, CS(CONE_W), CS(CONE_W_WHAT), CS(CONE_W_RANGE), 0.2, 3, 0, &cone.w)) ||
+         (rc = ranged(c, CS(CONE_X), CS(CONE_X_WHAT), CS(CONE_XY_RANGE), -2, 2, 0, &cone.x0)) ||
+         (rc = ranged(c, CS(CONE_Y), CS(CONE_Y_WHAT), CS(CONE_XY_RANGE), -2, 2, 0, &cone.y0))))
+        goto out;
+    double cone_um = cone.h;
+    cone.h *= 1e-3;                    /* um -> mm */
+    int maps = 0;
+    if ((rc = lm_ask_word(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), check_report, s,
+                          s->report, sizeof s->report)) ||
+        (strcmp(s->report, "-") && (rc = calc_yn(c, CS(MAPS), CS(MAPS_WHAT), &maps))))
         goto out;
 
     /* the rig's geometry: the rig file's, or the example */
@@ -299,6 +368,12 @@ int lm_cornea_scan(lm_io *io)
     r->g = &g;
     r->truth = eye;
     r->have_truth = source != CL_SRC_CAMERA;
+    cn_params t;                       /* the true eye as the engine's parameters */
+    cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
+    if (cone.h > 0) {
+        r->bump = &cone;
+        r->truth_p = t;
+    }
     r->camera = source == CL_SRC_CAMERA ? s->camera : NULL;
     r->save = source == CL_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
     r->pattern = pattern;
@@ -319,6 +394,7 @@ int lm_cornea_scan(lm_io *io)
         goto out;
     }
     if (s->have_rig) say(s, CS(RIG_LOADED), s->rig.path, g.cornea.R);
+    if (cone.h > 0) say(s, CS(CONE_ON), cone_um, cone.w, cone.x0, cone.y0);
     {
         trace_get_api_fn tget =
             (trace_get_api_fn)lm_engine_symbol("trace", TRACE_API_SYMBOL);
@@ -362,13 +438,11 @@ int lm_cornea_scan(lm_io *io)
     }
     rc = run(s, r, &m);
     if (rc == LM_GO && r->save) say(s, CS(SAVED), r->save, r->nplanned);
+    double axis_err = model == CN_BICONIC
+                      ? remainder(r->res.k.K1_axis - fmod(axis + 360, 180), 180.0) : 0.0;
     if (rc == LM_GO && r->have_truth) {
-        cn_params t;
-        cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
         say(s, CS(TRUTH), eye.R, eye.R2, km, cyl);
-        say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km,
-            model == CN_BICONIC ? remainder(r->res.k.K1_axis - fmod(axis + 360, 180), 180.0)
-                                : 0.0);
+        say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km, axis_err);
     }
     if (rc == LM_GO) {
         if (r->check_max > r->check_tol) {
@@ -379,15 +453,8 @@ int lm_cornea_scan(lm_io *io)
     }
     if (m) { rg->close(m); m = NULL; }       /* laser off, then drivers disabled */
     if (rc == LM_GO && strcmp(s->report, "-")) {
-        char err[256];
-        if (cs_write_report(s->report, s->text ? s->text : "", s->len, err, sizeof err)) {
-            if (lm_stop_requested()) rc = LM_FAIL;
-            else rc = calc_fail(c, CS(NO_REPORT));
-            fprintf(stderr, "lensmat: ");
-            fprintf(stderr, CS(REPORT_FAILED), s->report, err);
-        } else {
-            lm_say(io, LM_OUT, CS(REPORT_WRITTEN), s->report);
-        }
+        const cs_truth tr = {&eye, &t, &cone, km, cyl, axis_err, np, zone, noise, pitch, seed};
+        rc = cs_files(s, r, maps, &tr);
     }
     if (rc == LM_GO) rc = calc_done(c);
 out:

@@ -42,6 +42,7 @@ public:
     /* Encode and write atomically.  IM_OK or an error with err set. */
     int write(const im_out *out, char *err, size_t cap) const;
     const cv::Mat &image() const { return img_; }
+    cv::Mat &pixels() { return img_; }   /* rasters (maps): PNG only, not in the SVG */
 private:
     void seg(Pt a, Pt b, Rgb c, double width);
     void run(const std::vector<Pt> &p, Rgb c, double width, double dash);

@@ -152,6 +152,39 @@ typedef struct im_plot_info {
     im_plot_mark mark[IM_MAXPLOTMARK];
 } im_plot_info;
 
+/* A map of a scalar on a grid (cornea maps: elevation, axial and tangential
+ * curvature, residuals): v[j * nx + i] is the value at column i (x from xmin to
+ * xmax), row j (y from ymax at the top down to ymin), NaN where there is none; drawn
+ * in colour bands of `step` (dark blue low .. dark red high) with a colour bar.
+ * PNG only (out->svg must be NULL). */
+typedef struct im_map {
+    const char *title, *unit, *note;       /* note: a line under the map, or NULL */
+    const char *xlabel, *ylabel;           /* NULL: "x (mm)", "y (mm)" */
+    int nx, ny;
+    const double *v;
+    double xmin, xmax, ymin, ymax;         /* the grid's extent (cell edges) */
+    double disc;                           /* > 0: outline the disc of this radius
+                                              about (0, 0) */
+    double step;                           /* band width; 0: the first of steps[]
+                                              giving at most max_bands bands, else a
+                                              1-2-5 step */
+    const double *steps; int nsteps;       /* e.g. 0.25 0.5 1 ... D (topographers) */
+    int max_bands;                         /* 0: 24 */
+    double lo, hi;                         /* lo < hi: a fixed scale (scans compared
+                                              on one scale); else the data's range */
+    int symmetric;                         /* 1: centred on 0 (elevation, residual) */
+    int npts;                              /* scattered points painted on the scale */
+    const double *px, *py, *pv;
+    const unsigned char *mark;             /* NULL, or 1: ring point k (rejected) */
+    double point_r;                        /* their radius in pixels (0: 3) */
+} im_map;
+typedef struct im_map_info {
+    double lo, hi, step;                   /* the scale drawn */
+    int nbands, skipped;                   /* bands; grid cells without a value */
+    double vmin, vmax;                     /* the data's range */
+    double box_x0, box_y0, box_x1, box_y1; /* the map's box in PNG pixels */
+} im_map_info;
+
 typedef struct im_draw_api im_draw_api;
 struct im_draw_api {
     int (*layout)(const im_layout *l, const im_out *out, im_layout_info *info,
@@ -162,6 +195,9 @@ struct im_draw_api {
                 char *err, size_t errcap);
     /* Statistics alone (no picture): the spot's centroid, RMS and max radius. */
     void (*spot_stat)(const im_sd_point *pt, int n, int group, im_sd_stat *out);
+    /* A map (im_map); info (optional): the scale drawn. */
+    int (*map)(const im_map *m, const im_out *out, im_map_info *info, char *err,
+               size_t errcap);
 };
 /* ==== end of pictures ============================================================ */
 

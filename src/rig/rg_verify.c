@@ -10,7 +10,9 @@
 #include "rig/rg_geom.h"
 #include "rig/rg_vec.h"
 
-#define DET_RADIUS 5.0      /* mm: wide enough to catch a quantised pose's miss */
+#define DET_RADIUS 25.0     /* mm: a catching disc, wide enough for a quantised pose's
+                               miss and for the spots of an eye decentred 0.5 mm or
+                               tilted 5 deg (the many-eyes study's population) */
 
 typedef struct vf_ctx {
     int ids[4];             /* m1, m2, cornea, detector */
