@@ -244,11 +244,106 @@ static void transmittance(void)
     CHECK(px_glass_absorption("N-BK7", 2.6, &a) == PX_GLASS_RANGE, "N-BK7 at 2.6 um refused");
     CHECK(px_glass_absorption("F2", 0.325, &a) == PX_GLASS_RANGE,
           "F2 below its first transparent point refused");
-    CHECK(px_glass_absorption("N-SF6", 0.5, &a) == PX_NO_TAU, "a glass without data: NO_TAU");
+    CHECK(px_glass_absorption("DIAMOND", 0.5, &a) == PX_NO_TAU, "a medium without data: NO_TAU");
     CHECK(px_glass_absorption("1.5168/64.17", 0.5, &a) == PX_NO_TAU, "a model glass: NO_TAU");
     CHECK(px_glass_absorption("unobtainium", 0.5, &a) == PX_NO_GLASS, "an unknown name");
     CHECK(px_glass_absorption("N-BK7", -1, &a) == PX_BAD &&
           px_glass_absorption("N-BK7", NAN, &a) == PX_BAD, "a wavelength that is no number");
+}
+
+/* The internal transmittance tables against SCHOTT's figures typed here from the
+ * source (schott.agf, status 24 April 2013, github.com/nzhagen/zemaxglass: the "IT"
+ * lines, 25 mm, of each glass added from it, and of F2 and N-BAF10; LITHOSIL-Q for
+ * F_SILICA, LITHOTEC-CAF2 for CAF2),
+ * independently of data/glass.txt: the compiled table holds every point (wavelength
+ * and value), and px_glass_absorption gives back exp(-25 alpha) = T at each to 1e-12
+ * (T = 0: outside the range, refused).  A typo on either side fails. */
+typedef struct typed_tau { const char *name; int n; double p[40][2]; } typed_tau;
+static const typed_tau schott_it[] = {
+    {"F2", 23, {{0.320, 0.000}, {0.334, 0.211}, {0.350, 0.780}, {0.365, 0.921},
+     {0.370, 0.940}, {0.380, 0.963}, {0.390, 0.977}, {0.400, 0.985}, {0.405, 0.987},
+     {0.420, 0.991}, {0.436, 0.993}, {0.460, 0.994}, {0.500, 0.997}, {0.546, 0.998},
+     {0.580, 0.998}, {0.620, 0.998}, {0.660, 0.997}, {0.700, 0.998}, {1.060, 0.998},
+     {1.530, 0.989}, {1.970, 0.876}, {2.325, 0.685}, {2.500, 0.589}}},
+    {"N-BAF10", 21, {{0.350, 0.010}, {0.365, 0.310}, {0.370, 0.440}, {0.380, 0.660},
+     {0.390, 0.800}, {0.400, 0.880}, {0.405, 0.900}, {0.420, 0.940}, {0.436, 0.954},
+     {0.460, 0.967}, {0.500, 0.981}, {0.546, 0.990}, {0.580, 0.990}, {0.620, 0.991},
+     {0.660, 0.990}, {0.700, 0.994}, {1.060, 0.994}, {1.530, 0.980}, {1.970, 0.920},
+     {2.325, 0.680}, {2.500, 0.450}}},
+    {"N-SF5", 19, {{0.370, 0.040}, {0.380, 0.330}, {0.390, 0.620}, {0.400, 0.780},
+     {0.405, 0.830}, {0.420, 0.910}, {0.436, 0.935}, {0.460, 0.956}, {0.500, 0.976},
+     {0.546, 0.988}, {0.580, 0.991}, {0.620, 0.988}, {0.660, 0.987}, {0.700, 0.989},
+     {1.060, 0.994}, {1.530, 0.975}, {1.970, 0.880}, {2.325, 0.630}, {2.500, 0.500}}},
+    {"SF5", 21, {{0.350, 0.310}, {0.365, 0.730}, {0.370, 0.800}, {0.380, 0.880},
+     {0.390, 0.920}, {0.400, 0.950}, {0.405, 0.959}, {0.420, 0.973}, {0.436, 0.982},
+     {0.460, 0.988}, {0.500, 0.993}, {0.546, 0.996}, {0.580, 0.996}, {0.620, 0.995},
+     {0.660, 0.995}, {0.700, 0.996}, {1.060, 0.996}, {1.530, 0.987}, {1.970, 0.900},
+     {2.325, 0.740}, {2.500, 0.660}}},
+    {"N-SF6", 19, {{0.370, 0.010}, {0.380, 0.160}, {0.390, 0.410}, {0.400, 0.610},
+     {0.405, 0.680}, {0.420, 0.810}, {0.436, 0.870}, {0.460, 0.905}, {0.500, 0.943},
+     {0.546, 0.972}, {0.580, 0.980}, {0.620, 0.978}, {0.660, 0.976}, {0.700, 0.983},
+     {1.060, 0.996}, {1.530, 0.978}, {1.970, 0.860}, {2.325, 0.590}, {2.500, 0.530}}},
+    {"N-SK16", 24, {{0.310, 0.020}, {0.320, 0.110}, {0.334, 0.400}, {0.350, 0.700},
+     {0.365, 0.860}, {0.370, 0.890}, {0.380, 0.930}, {0.390, 0.956}, {0.400, 0.970},
+     {0.405, 0.974}, {0.420, 0.979}, {0.436, 0.981}, {0.460, 0.984}, {0.500, 0.991},
+     {0.546, 0.994}, {0.580, 0.994}, {0.620, 0.993}, {0.660, 0.994}, {0.700, 0.996},
+     {1.060, 0.995}, {1.530, 0.973}, {1.970, 0.880}, {2.325, 0.540}, {2.500, 0.260}}},
+    {"SF2", 21, {{0.350, 0.370}, {0.365, 0.720}, {0.370, 0.790}, {0.380, 0.870},
+     {0.390, 0.920}, {0.400, 0.954}, {0.405, 0.962}, {0.420, 0.975}, {0.436, 0.982},
+     {0.460, 0.988}, {0.500, 0.993}, {0.546, 0.995}, {0.580, 0.995}, {0.620, 0.995},
+     {0.660, 0.994}, {0.700, 0.996}, {1.060, 0.996}, {1.530, 0.985}, {1.970, 0.880},
+     {2.325, 0.710}, {2.500, 0.620}}},
+    {"F_SILICA", 29, {{0.250, 0.999}, {0.260, 0.999}, {0.270, 0.999}, {0.280, 0.999},
+     {0.290, 0.999}, {0.300, 0.999}, {0.310, 0.999}, {0.320, 0.999}, {0.334, 0.999},
+     {0.350, 0.999}, {0.365, 0.999}, {0.370, 0.999}, {0.380, 0.999}, {0.390, 0.999},
+     {0.400, 0.999}, {0.405, 0.999}, {0.420, 0.999}, {0.436, 0.999}, {0.460, 0.999},
+     {0.500, 0.999}, {0.546, 0.999}, {0.580, 0.999}, {0.620, 0.999}, {0.660, 0.999},
+     {0.700, 0.999}, {1.060, 0.999441}, {1.530, 0.999441}, {1.970, 0.985985},
+     {2.325, 0.796739}}},
+    {"CAF2", 30, {{0.250, 0.998}, {0.260, 0.998}, {0.270, 0.998}, {0.280, 0.998},
+     {0.290, 0.998}, {0.300, 0.998}, {0.310, 0.998}, {0.320, 0.998}, {0.334, 0.998},
+     {0.350, 0.998}, {0.365, 0.998}, {0.370, 0.998}, {0.380, 0.998}, {0.390, 0.998},
+     {0.400, 0.998}, {0.405, 0.998}, {0.420, 0.998}, {0.436, 0.998}, {0.460, 0.998},
+     {0.500, 0.999}, {0.546, 0.999}, {0.580, 0.999}, {0.620, 0.999}, {0.660, 0.999},
+     {0.700, 0.999}, {1.060, 0.999}, {1.530, 0.999}, {1.970, 0.999}, {2.325, 0.999},
+     {2.500, 0.999}}},
+};
+
+static void transmittance_published(void)
+{
+    for (size_t g = 0; g < sizeof schott_it / sizeof schott_it[0]; g++) {
+        const typed_tau *w = &schott_it[g];
+        const px_tau_rec *t = px_glass_tau(w->name, 0);
+        int same = t && t->thickness == 25 && t->n == w->n && !px_glass_tau(w->name, 1);
+        double worst = 0, a, lo, hi;
+        for (int j = 0; same && j < w->n; j++)
+            same = t->l[j] == w->p[j][0] && t->t[j] == w->p[j][1];
+        CHECK(same, "%s: data/glass.txt's table is SCHOTT's %d IT points (25 mm)", w->name,
+              w->n);
+        int j0 = 0;
+        while (j0 < w->n && w->p[j0][1] == 0) j0++;     /* opaque ends: outside */
+        for (int j = 0; j < w->n; j++) {
+            int rc = px_glass_absorption(w->name, w->p[j][0], &a);
+            if (j < j0) { if (rc != PX_GLASS_RANGE) worst = 1; continue; }
+            if (rc != PX_OK) { worst = 1; break; }
+            double e = fabs(exp(-25 * a) - w->p[j][1]);
+            if (e > worst) worst = e;
+        }
+        CHECK(worst < 1e-12, "%s: every point reproduced (worst |exp(-25 alpha) - T| %.2g)",
+              w->name, worst);
+        CHECK(px_glass_absorption_range(w->name, &lo, &hi) == PX_OK &&
+              lo == w->p[j0][0] && hi == w->p[w->n - 1][0],
+              "%s: absorption data span %.3f-%.3f um", w->name, w->p[j0][0], w->p[w->n - 1][0]);
+    }
+    /* a few values by hand: alpha = -ln(T)/25 */
+    double a;
+    CHECK(px_glass_absorption("N-SF6", 0.4, &a) == PX_OK &&
+          fabs(a - 0.0197718529) < 1e-9, "N-SF6 at 400 nm: alpha %.9f /mm (-ln 0.610 / 25)", a);
+    CHECK(px_glass_absorption("F_SILICA", 2.325, &a) == PX_OK &&
+          fabs(a - 0.00908913) < 1e-8, "fused silica at 2325 nm: alpha %.7f /mm (-ln 0.796739 "
+          "/ 25)", a);
+    CHECK(px_glass_absorption("CAF2", 0.6328, &a) == PX_OK &&
+          fabs(a - 4.002001e-5) < 1e-11, "CaF2 at 632.8 nm: alpha %.4g /mm (-ln 0.999 / 25)", a);
 }
 
 int main(void)
@@ -260,5 +355,6 @@ int main(void)
     singlet();
     achromat();
     transmittance();
+    transmittance_published();
     return unit_failed();
 }

@@ -150,6 +150,11 @@ static int do_scene(tdlg *t)
         if (!t->io->interactive) return LM_FAIL;
         return LM_GO;
     }
+    for (const char *p = res.note; *p; ) {   /* glasses traced outside their data */
+        int len = (int)strcspn(p, "\n");
+        lm_say(t->io, LM_BOTH, P(WARN_ABSORPTION), len, p);
+        p += len + (p[len] == '\n');
+    }
     report_summary(t, &res.sum);
     report_outputs(t);
     return LM_GO;

@@ -149,6 +149,8 @@ typedef struct sc_result {
     int progress_shown;       /* a progress line was drawn on stderr */
     int stopped;              /* the stop callback stopped it (outputs left as .part) */
     int mismatch_failed;      /* `mismatch error` and rays met disagreeing media */
+    char note[SC_ERRMAX];     /* "FILE:LINE: what" lines ('\n' between) for glasses
+                                 traced outside their transmittance data ("" if none) */
 } sc_result;
 
 /* The error-against-run-time table: a spherical singlet modelled analytically and as

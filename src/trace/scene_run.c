@@ -61,12 +61,26 @@ static int source_at(const sc_scene *sc, const sc_source *s, double l)
     return 0;
 }
 
+/* Append "SRC:LINE: what" to the notes (SC_ERRMAX bytes, one a line) unless `what`
+ * is there already (a glass on both faces of a lens is noted once per wavelength). */
+static void add_note(char *note, const char *src, long line, const char *what)
+{
+    size_t len;
+    if (!note || strstr(note, what)) return;
+    len = strlen(note);
+    snprintf(note + len, SC_ERRMAX - len, "%s%s:%ld: %s", len ? "\n" : "", src, line, what);
+}
+
 /* The index and absorption coefficient (1/mm: scene lengths are millimetres) of a
  * medium at l um (0: none named, the d line): a plain number n as it is, transparent;
- * a glass from the catalogue, absorbing where it has transmittance data.  0, or -1
- * with "SRC:LINE: why" in err. */
+ * a glass from the catalogue, absorbing where it has transmittance data.  A glass
+ * whose index holds at l but whose transmittance table does not reach l is not
+ * refused: its absorption is held at the value of the table's nearest end, and `note`
+ * (if not NULL) says so -- an estimate, not data (outside its tabulated span a glass
+ * usually absorbs more: toward its UV edge, and its IR bands).  0, or -1 with
+ * "SRC:LINE: why" in err. */
 static int medium_at(const char *glass, double n, double l, const char *src, long line,
-                     double *nout, double *aout, char *err)
+                     double *nout, double *aout, char *err, char *note)
 {
     double um = l > 0 ? l : PX_LAMBDA_D, lo, hi;
     const px_glass_rec *g;
@@ -88,11 +102,18 @@ static int medium_at(const char *glass, double n, double l, const char *src, lon
     rc = px_glass_absorption(glass, um, aout);
     if (rc == PX_NO_TAU) { *aout = 0; return 0; }
     if (rc == PX_OK) return 0;
-    if (rc == PX_GLASS_RANGE && px_glass_absorption_range(glass, &lo, &hi) == PX_OK)
-        snprintf(err, SC_ERRMAX, "%s:%ld: %s's internal transmittance is known from "
-                 "%.10g to %.10g nm, not at %.10g nm (below, it is nearly opaque)", src, line,
-                 glass, lo * 1e3, hi * 1e3, um * 1e3);
-    else
+    if (rc == PX_GLASS_RANGE && px_glass_absorption_range(glass, &lo, &hi) == PX_OK &&
+        px_glass_absorption(glass, um < lo ? lo : hi, aout) == PX_OK) {
+        char what[SC_ERRMAX / 2];
+        snprintf(what, sizeof what, "%s's internal transmittance is known from %.10g to "
+                 "%.10g nm, not at %.10g nm: traced with its absorption at %.10g nm, "
+                 "%.3g /mm (an estimate; outside its data a glass usually absorbs more)",
+                 glass, lo * 1e3, hi * 1e3, um * 1e3, (um < lo ? lo : hi) * 1e3, *aout);
+        if (note) add_note(note, src, line, what);
+        return 0;
+    }
+    *aout = 0;
+    if (rc == PX_GLASS_RANGE)
         snprintf(err, SC_ERRMAX, "%s:%ld: %s: no transmittance at %.10g nm", src, line,
                  glass, um * 1e3);
     return -1;
@@ -100,21 +121,22 @@ static int medium_at(const char *glass, double n, double l, const char *src, lon
 
 /* The media of every refracting surface and every source at every wavelength, before
  * anything is traced or written: 0 or -1 (err). */
-static int check_media(const sc_scene *sc, const double *wl, int nwl, char *err)
+static int check_media(const sc_scene *sc, const double *wl, int nwl, char *err,
+                       char *note)
 {
     double n, a;
     for (int k = 0; k < nwl; k++) {
         for (int i = 0; i < sc->nsurf; i++) {
             const sc_surface *s = &sc->surf[i];
             if (s->kind != SC_REFRACT) continue;
-            if (medium_at(s->glass[0], s->n1, wl[k], s->src, s->line, &n, &a, err) ||
-                medium_at(s->glass[1], s->n2, wl[k], s->src, s->line, &n, &a, err))
+            if (medium_at(s->glass[0], s->n1, wl[k], s->src, s->line, &n, &a, err, note) ||
+                medium_at(s->glass[1], s->n2, wl[k], s->src, s->line, &n, &a, err, note))
                 return -1;
         }
         for (int i = 0; i < sc->nsource; i++) {
             const sc_source *s = &sc->source[i];
             if (source_at(sc, s, wl[k]) &&
-                medium_at(s->glass, s->medium, wl[k], s->src, s->line, &n, &a, err))
+                medium_at(s->glass, s->medium, wl[k], s->src, s->line, &n, &a, err, note))
                 return -1;
         }
     }
@@ -193,8 +215,8 @@ static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s
     trace_mesh mesh;
     double n1 = s->n1, n2 = s->n2, a1 = 0, a2 = 0;
     if (s->kind == SC_REFRACT &&
-        (medium_at(s->glass[0], s->n1, l, s->src, s->line, &n1, &a1, err) ||
-         medium_at(s->glass[1], s->n2, l, s->src, s->line, &n2, &a2, err)))
+        (medium_at(s->glass[0], s->n1, l, s->src, s->line, &n1, &a1, err, NULL) ||
+         medium_at(s->glass[1], s->n2, l, s->src, s->line, &n2, &a2, err, NULL)))
         return -1;
     to_material(s, n1, n2, &m);
     if (s->shape != SC_MESH && !s->tessellate) {
@@ -232,7 +254,8 @@ static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, 
     memcpy(t.at, s->from, sizeof t.at);
     memcpy(t.dir, s->dir, sizeof t.dir);
     t.power = s->power;
-    if (medium_at(s->glass, s->medium, l, s->src, s->line, &t.n_medium, &t.alpha_medium, err))
+    if (medium_at(s->glass, s->medium, l, s->src, s->line, &t.n_medium, &t.alpha_medium, err,
+                  NULL))
         return -1;
     t.lambda = l;
     if (s->polarised) {
@@ -508,7 +531,8 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     memset(per, 0, sizeof per);
     if (!tr) return snprintf(err, SC_ERRMAX, "the trace engine's ABI does not match"), -1;
     nwl = scene_wavelengths(sc, wl);
-    if (check_media(sc, wl, nwl, err) || build_scene(tr, sc, wl[0], &ts, err)) return -1;
+    if (check_media(sc, wl, nwl, err, res->note) || build_scene(tr, sc, wl[0], &ts, err))
+        return -1;
     tr->options_default(&opt);
     opt.max_depth = sc->depth;
     opt.cutoff = sc->cutoff;
