@@ -218,6 +218,19 @@ pk_examples() {
 if [ -f "$TOP/build/lib/lensmat-trace.so" ]; then
     check "scene lens path: the example scenes, every output the same both ways" pk_examples
 fi
+# the screen names the packet kernel that ran: LENSMAT_ISA's choice, the same bits
+pk_kernel() {
+    d=$PK/kernel; rm -rf "$d"
+    LENSMAT_ISA=sse2 trace_session "$BIN" "$d/sse2" scene "$TOP/scenes/singlet.scene" n || return 1
+    LENSMAT_ISA=scalar trace_session "$BIN" "$d/scalar" scene "$TOP/scenes/singlet.scene" n || return 1
+    grep -q '^Sequential lens: 3 surfaces traced on the lens path (kernel sse2;' "$d/sse2/out" ||
+        { grep '^Sequential' "$d/sse2/out"; return 1; }
+    grep -q '(kernel scalar;' "$d/scalar/out" || { grep '^Sequential' "$d/scalar/out"; return 1; }
+    cmp "$d/sse2/r.rec" "$d/scalar/r.rec"
+}
+if [ -f "$TOP/build/lib/lensmat-trace.so" ] && grep -qw sse2 /proc/cpuinfo 2>/dev/null; then
+    check "scene lens path: the screen names the kernel LENSMAT_ISA chose" pk_kernel
+fi
 if [ -f "$TOP/build/asan/lib/lensmat-trace.so" ]; then
     pk_asan() {
         { cat "$PK/mesh.body"; pk_outputs; } > "$PK/asan.scene"

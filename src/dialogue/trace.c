@@ -116,7 +116,8 @@ static void report_summary(tdlg *t, const trace_summary *s)
         lm_say(io, LM_BOTH, P(WARN_BALANCE), bal);
     lm_say(io, LM_OUT, P(TIMING_OUT), s->build_ms, s->trace_ms,
            s->trace_ms > 0 ? (double)s->rays / (s->trace_ms / 1e3) : 0.0);
-    if (s->lens_surfaces) lm_say(io, LM_OUT, P(LENS_PATH_OUT), s->lens_surfaces);
+    if (s->lens_surfaces)
+        lm_say(io, LM_OUT, P(LENS_PATH_OUT), s->lens_surfaces, s->lens_kernel);
 }
 
 /* The stop callback long traces poll: a signal arrived (ask.h). */

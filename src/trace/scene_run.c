@@ -453,7 +453,10 @@ static void add_summary(trace_summary *a, const trace_summary *b)
     a->cutoff += b->cutoff;
     a->build_ms += b->build_ms;
     a->trace_ms += b->trace_ms;
-    if (b->lens_surfaces > a->lens_surfaces) a->lens_surfaces = b->lens_surfaces;
+    if (b->lens_surfaces > a->lens_surfaces) {
+        a->lens_surfaces = b->lens_surfaces;
+        memcpy(a->lens_kernel, b->lens_kernel, sizeof a->lens_kernel);
+    }
 }
 
 static int write_summary(const sc_scene *sc, const trace_summary *s, const double *wl,

@@ -390,6 +390,10 @@ int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
     }
     s.trace_ms = tr_now_ms() - t0;
     s.lens_surfaces = lens_surfaces(sc, &o);
+    if (s.lens_surfaces) {
+        const char *k = sc->absorbing || !tr_pk_usable() ? "scalar" : trace_isa_active();
+        snprintf(s.lens_kernel, sizeof s.lens_kernel, "%s", k);
+    }
     if (rc == TRACE_OK) rc = numeric_check(sc, &s, &p.fail);
     if (mu) pthread_mutex_destroy(&p.mu);
     if (more) pthread_cond_destroy(&p.more);

@@ -239,6 +239,9 @@ typedef struct trace_summary {
     int lens_surfaces;         /* surfaces of the sequential lens the run took the lens
                                   shortcut through (add_lens's, or one found inside the
                                   scene: tr_seqscan.c); 0: every segment by Embree */
+    char lens_kernel[12];      /* with lens_surfaces: the packet kernel that ran it
+                                  (trace_isa_active(); "scalar": rays one by one, as
+                                  with an absorbing medium) */
 } trace_summary;
 
 /* A sequential lens as the classic dialogue enters it: surfaces left to right with
