@@ -19,9 +19,12 @@
 #   tx ty  tilt              N(0, 1.5) deg each, clipped to +-5
 #   noise  centroid noise    uniform 0.02 .. 0.08 px (5 um pixels)
 #   scan   POINTS points (300) over 12 deg, a biconic fit (-m to change), seed per eye
-# Several machines: lensmat built at the same path on each (LENSMAT, default this
-# tree's ./lensmat); -S takes parallel's --sshlogin list (e.g. ":,4/user@host2");
-# each eye's answers go out and its record, report and output come back (--trc).
+# Several machines: lensmat built or installed at the same path on each (LENSMAT,
+# default this tree's ./lensmat); -S takes parallel's --sshlogin list (e.g.
+# ":,4/user@host2"); each eye's answers go out and its record, report and output come
+# back (--trc, by rsync over ssh: both needed here and on every host, with perl); on
+# a host they sit in the login folder while the eye runs and are removed after.
+# PARALLEL_SSH names another ssh command (tests/cornea/fake-ssh: hosts faked here).
 set -e
 TOP=$(cd "$(dirname "$0")/.." && pwd)
 LENSMAT=${LENSMAT:-$TOP/lensmat}
@@ -31,7 +34,7 @@ while getopts "M:s:p:j:o:m:S:h" o; do
     case $o in
     M) M=$OPTARG ;; s) SEED=$OPTARG ;; p) POINTS=$OPTARG ;; j) JOBS=$OPTARG ;;
     o) DIR=$OPTARG ;; m) MODEL=$OPTARG ;; S) SSH=$OPTARG ;;
-    *) sed -n '2,28p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
+    *) sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
     esac
 done
 case $M in ''|*[!0-9]*) echo "$0: -M wants a whole number of eyes" >&2; exit 2 ;; esac
@@ -40,6 +43,10 @@ case $SEED$POINTS in *[!0-9]*) echo "$0: -s and -p want whole numbers" >&2; exit
 command -v parallel >/dev/null 2>&1 && parallel --version 2>/dev/null | grep -q 'GNU parallel' ||
     { echo "$0: GNU parallel is not installed (scripts/install-deps.sh installs it)" >&2; exit 3; }
 [ -x "$LENSMAT" ] || { echo "$0: $LENSMAT not built (run make)" >&2; exit 3; }
+if [ -n "$SSH" ] && [ "$SSH" != : ]; then
+    command -v rsync >/dev/null 2>&1 ||
+        { echo "$0: -S needs rsync (parallel sends the eyes' files with it; scripts/install-deps.sh installs it)" >&2; exit 3; }
+fi
 mkdir -p "$DIR"
 cd "$DIR"
 rm -f eye-*.in eye-*.rec eye-*.txt eye-*.csv eye-*.json eye-*.out study.tsv percentiles.tsv

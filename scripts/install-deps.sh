@@ -8,6 +8,7 @@ PKGS="gcc g++ make libreadline-dev libgsl-dev libembree-dev libgpiod-dev
 PKGS="$PKGS pkg-config zlib1g-dev"   # the imaging module: OpenCV flags, PNG data checks
 PKGS="$PKGS gcc-aarch64-linux-gnu libc6-dev-arm64-cross"   # make check: arm64 compile
 PKGS="$PKGS parallel"   # scripts/cornea-study.sh: GNU parallel fans the eyes out
+PKGS="$PKGS rsync openssh-client"   # cornea-study.sh -S: parallel sends files with rsync over ssh
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||

@@ -3,7 +3,8 @@
 # the imaging engine, written via .part), from the model's spots and from synthetic
 # frames' centroids, replayed from the record to the same report,
 # outputs that would overwrite an input refused, the compare script, and the
-# many-eyes study under GNU parallel (skipped with a message when it is missing).
+# many-eyes study under GNU parallel, here and over two fake hosts (skipped with a
+# message when parallel or rsync is missing).
 cm_in() {   # model points name maps(y/n) [seed] -> answers (the example geometry, a
             # spiral, spots from the model: the traced hit plus 0.04 px; no cone)
     printf '%s\n-\nspiral\n%s\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n%s\n0\n%s\n%s\n' \
@@ -169,6 +170,40 @@ if command -v parallel >/dev/null 2>&1 && parallel --version 2>/dev/null | grep 
         ! cmp -s "$d/eye-0001.in" "$d.c/eye-0001.in"
     }
     check "cornea-study.sh: 6 eyes under GNU parallel, one table, percentiles, plot; replayable, seeded" cm_study
+    # several hosts without a network: tests/cornea/fake-ssh stands in for ssh (and for
+    # rsync's remote shell), each fake host a home of its own, so the eyes' files really
+    # go out and come back through parallel's --trc; lensmat installed into a prefix
+    # (make install), as on a real host, not this build tree
+    cm_hosts() {
+        d="$WORK/cm/study" h="$WORK/cm/hosts" pfx="$WORK/cm/remote-prefix"
+        rm -rf "$h" "$d.r" && mkdir -p "$h" &&
+        make -s -C "$TOP" install PREFIX="$pfx" > "$WORK/cm/install.log" 2>&1 ||
+            { cat "$WORK/cm/install.log"; return 1; }
+        # the stand-in is honest: a job that was sent nothing finds nothing
+        if (cd "$d" && FAKE_SSH_ROOT=$h parallel --ssh "$TOP/tests/cornea/fake-ssh" -S 1/fakehost0 \
+                'cat {}' ::: eye-0001.in) > /dev/null 2>&1; then
+            echo "fake-ssh ran in this folder, not the fake host's"; return 1; fi
+        FAKE_SSH_ROOT=$h PARALLEL_SSH=$TOP/tests/cornea/fake-ssh LENSMAT=$pfx/bin/lensmat \
+            "$TOP/scripts/cornea-study.sh" -M 6 -p 100 -s 7 -j 1 -S 1/fakehost1,1/fakehost2 -o "$d.r" \
+            > "$WORK/cm/hosts.log" 2>&1 || { cat "$WORK/cm/hosts.log"; return 1; }
+        cmp "$d/study.tsv" "$d.r/study.tsv" || return 1
+        for f in "$d"/eye-*.csv "$d"/eye-*.json "$d"/eye-*.rec "$d"/eye-*.txt; do
+            cmp "$f" "$d.r/${f##*/}" || return 1
+        done
+        # both hosts ran eyes (none here), the answers went out and the files came back
+        # by rsync over the stand-in, and --cleanup left both homes empty
+        awk -F'\t' 'NR > 1 { n[$2]++; if ($5 <= 0 || $6 <= 0) bad = 1 }
+            END { exit bad || n["fakehost1"] < 1 || n["fakehost2"] < 1 || n["fakehost1"] + n["fakehost2"] != 6 }' \
+            "$d.r/joblog.txt" || { cat "$d.r/joblog.txt"; return 1; }
+        grep -q '^rsync --server -' "$h/fakehost1.log" && grep -q '^cd .*rsync --server --sender' "$h/fakehost2.log" &&
+        grep -q '^exec perl ' "$h/fakehost2.log" || { cat "$h"/*.log; return 1; }
+        [ -z "$(find "$h/fakehost1" "$h/fakehost2" -mindepth 1)" ] || { ls -laR "$h"; return 1; }
+    }
+    if command -v rsync >/dev/null 2>&1; then
+        check "cornea-study.sh -S over 2 fake hosts (fake-ssh, rsync, installed lensmat): the same table and reports, homes cleaned" cm_hosts
+    else
+        echo "SKIP t_92 study over several hosts: rsync is not installed (scripts/install-deps.sh)"
+    fi
 else
     echo "SKIP t_92 many-eyes study: GNU parallel is not installed (scripts/install-deps.sh)"
 fi
