@@ -8,7 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include "unit.h"
+#include "../src/trace/scene_lex.c"
+#include "../src/trace/scene_mesh.c"
 #include "../src/trace/scene_read.c"
+#include "../src/trace/scene_axial.c"
 #include "../src/trace/scene_geom.c"
 
 static int parse_scene(const char *text, char *err)

@@ -1,10 +1,9 @@
-/* scene_read.c -- the trace front end's readers: scene files (one directive per
- * line, '#' comments), the document's triangle files (three lines "x y z" per
- * triangle, as opticrt reads sphercap.t), media files ("n1 n2" per triangle, as
- * opticrt's p.n) and OBJ meshes (v and f lines).  Buffers in, plain data out, every
- * error as "FILE:LINE: what"; nothing here prints, opens a file or needs Embree, so
- * the whole file is fuzzed alone (tests/fuzz_trace_scene.c).  Reading a scene from
- * disk with its meshes is scene_load.c. */
+/* scene_read.c -- the trace front end's scene-file parser: one directive per line
+ * (surfaces, sources, settings), each checked to its FILE:LINE.  Buffers in, plain
+ * data out; nothing here prints, opens a file or needs Embree, so it is fuzzed alone
+ * (tests/fuzz_trace_scene.c).  Its siblings: the token reader (scene_lex.c), the mesh
+ * readers (scene_mesh.c), the axial-surface checks (scene_axial.c); reading a scene
+ * from disk with its meshes is scene_load.c. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -13,353 +12,12 @@
 #include <string.h>
 #include <strings.h>
 #include "paraxial/paraxial.h"
-#include "scene.h"
+#include "scene_int.h"
 
 #define PI 3.14159265358979323846
 
-#define MAXTOK 64          /* items on one line */
-#define NUMLEN 64          /* longest number token */
-#define MAXTRI 50000000L   /* triangles in one mesh (1.8 GB of doubles) */
 #define MAXSURF 100000
 #define MAXSOURCE 10000
-
-/* ---- lines and tokens --------------------------------------------------------- */
-
-typedef struct tok { const char *s; size_t n; } tok;
-
-typedef struct reader {
-    const char *p, *end, *name;
-    long line;
-    tok t[MAXTOK];
-    int nt;
-    char *err;
-} reader;
-
-static int fail(reader *r, const char *fmt, ...)
-{
-    va_list ap;
-    int k = snprintf(r->err, SC_ERRMAX, "%s:%ld: ", r->name, r->line);
-    if (k < 0 || k >= SC_ERRMAX) k = 0;
-    va_start(ap, fmt);
-    vsnprintf(r->err + k, SC_ERRMAX - k, fmt, ap);
-    va_end(ap);
-    return -1;
-}
-
-static int is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-/* Next line with at least one item (comments and blank lines skipped).  1 with the
- * items in r->t, 0 at the end, -1 on an error. */
-static int next_line(reader *r)
-{
-    while (r->p < r->end) {
-        const char *nl = memchr(r->p, '\n', (size_t)(r->end - r->p));
-        const char *e = nl ? nl : r->end, *q = r->p;
-        r->line++;
-        r->p = nl ? nl + 1 : r->end;
-        r->nt = 0;
-        if (memchr(q, '\0', (size_t)(e - q)))
-            return fail(r, "a NUL byte: this is not a text file");
-        while (q < e) {
-            const char *b;
-            while (q < e && is_blank(*q)) q++;
-            if (q == e || *q == '#') break;
-            b = q;
-            while (q < e && !is_blank(*q) && *q != '#') q++;
-            if (r->nt == MAXTOK) return fail(r, "more than %d items on one line", MAXTOK);
-            r->t[r->nt].s = b;
-            r->t[r->nt].n = (size_t)(q - b);
-            r->nt++;
-        }
-        if (r->nt) return 1;
-    }
-    return 0;
-}
-
-static int tok_is(const tok *t, const char *w) { return strlen(w) == t->n && !memcmp(t->s, w, t->n); }
-
-/* A finite decimal number (no hex, inf or nan).  0 or -1 (error reported). */
-static int tok_num(reader *r, const tok *t, const char *what, double *v)
-{
-    char buf[NUMLEN], *end;
-    size_t i;
-    if (t->n >= NUMLEN) return fail(r, "%s: '%.20s...' is too long for a number", what, t->s);
-    memcpy(buf, t->s, t->n);
-    buf[t->n] = '\0';
-    for (i = 0; i < t->n; i++)
-        if (!strchr("0123456789+-.eE", buf[i])) break;
-    if (i < t->n || !t->n) {
-        if (!strncmp(buf, "nan", 3) || !strncmp(buf, "NaN", 3) || !strncmp(buf, "-nan", 4))
-            return fail(r, "%s: '%s': NaN is not a number", what, buf);
-        if (strstr(buf, "inf") || strstr(buf, "Inf"))
-            return fail(r, "%s: '%s': infinite values are not allowed", what, buf);
-        return fail(r, "%s: '%s' is not a number", what, buf);
-    }
-    errno = 0;
-    *v = strtod(buf, &end);
-    if (end != buf + t->n) return fail(r, "%s: '%s' is not a number", what, buf);
-    if (errno == ERANGE && fabs(*v) > 1) return fail(r, "%s: '%s' is out of range", what, buf);
-    if (!isfinite(*v) || fabs(*v) > 1e30)
-        return fail(r, "%s: '%s' is out of range (|x| <= 1e30)", what, buf);
-    /* one range for every number: 0, or 1e-30 <= |x| <= 1e30 (squares and products
-     * of lengths then neither underflow nor overflow; see README, Conventions) */
-    if ((*v != 0 && fabs(*v) < 1e-30) || (*v == 0 && errno == ERANGE))
-        return fail(r, "%s: '%s' is out of range (0, or 1e-30 <= |x| <= 1e30)", what, buf);
-    return 0;
-}
-
-/* Read the whole line as exactly n numbers. */
-static int line_nums(reader *r, int n, const char *what, double *v)
-{
-    if (r->nt != n)
-        return fail(r, "expected %d numbers (%s), found %d item%s", n, what, r->nt,
-                    r->nt == 1 ? "" : "s");
-    for (int i = 0; i < n; i++)
-        if (tok_num(r, &r->t[i], what, &v[i])) return -1;
-    return 0;
-}
-
-static void reader_init(reader *r, const char *text, size_t len, const char *name,
-                        char *err)
-{
-    memset(r, 0, sizeof *r);
-    r->p = text;
-    r->end = text + len;
-    r->name = name;
-    r->err = err;
-    err[0] = '\0';
-}
-
-/* Growable arrays of doubles. */
-typedef struct dvec { double *v; size_t n, cap; } dvec;
-
-static int dvec_push(dvec *a, const double *x, size_t k)
-{
-    if (a->n + k > a->cap) {
-        size_t cap = a->cap ? a->cap * 2 : 256;
-        double *v;
-        while (cap < a->n + k) cap *= 2;
-        v = realloc(a->v, cap * sizeof *v);
-        if (!v) return -1;
-        a->v = v;
-        a->cap = cap;
-    }
-    memcpy(a->v + a->n, x, k * sizeof *x);
-    a->n += k;
-    return 0;
-}
-
-/* ---- triangles ---------------------------------------------------------------- */
-
-static void sub3(const double *a, const double *b, double *c)
-{
-    c[0] = a[0] - b[0]; c[1] = a[1] - b[1]; c[2] = a[2] - b[2];
-}
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static void cross3(const double *a, const double *b, double *c)
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-/* Why triangle t is unusable, or NULL. */
-static const char *bad_triangle(const double *t)
-{
-    double e1[3], e2[3], e3[3], c[3], l2;
-    for (int i = 0; i < 9; i++)
-        if (!isfinite(t[i])) return "has a non-finite coordinate";
-    sub3(t + 3, t, e1);
-    sub3(t + 6, t, e2);
-    sub3(t + 6, t + 3, e3);
-    cross3(e1, e2, c);
-    l2 = fmax(dot3(e1, e1), fmax(dot3(e2, e2), dot3(e3, e3)));
-    if (l2 == 0) return "is degenerate (its vertices coincide, or its edges are too short "
-                        "to measure)";
-    /* twice the area against the longest edge squared: ~ the smallest angle */
-    if (sqrt(dot3(c, c)) <= 1e-12 * l2) return "has zero area (collinear vertices)";
-    return NULL;
-}
-
-int sc_check_triangles(const double *tri, long ntri, const char *name, char *err)
-{
-    for (long i = 0; i < ntri; i++) {
-        const char *why = bad_triangle(tri + 9 * i);
-        if (why) {
-            snprintf(err, SC_ERRMAX, "%s: triangle %ld %s", name, i + 1, why);
-            return -1;
-        }
-    }
-    return 0;
-}
-
-int sc_parse_triangles(const char *text, size_t len, const char *name, double **tri,
-                       long *ntri, char *err)
-{
-    reader r;
-    dvec a = {0};
-    double v[9];
-    long first = 0;
-    int k = 0, st;
-
-    reader_init(&r, text, len, name, err);
-    *tri = NULL;
-    *ntri = 0;
-    while ((st = next_line(&r)) > 0) {
-        const char *why;
-        if (k == 0) first = r.line;
-        if (line_nums(&r, 3, "a vertex: x y z", v + 3 * k)) goto bad;
-        if (++k < 3) continue;
-        k = 0;
-        if ((why = bad_triangle(v))) {
-            r.line = first;
-            fail(&r, "triangle %ld (lines %ld-%ld) %s", (long)(a.n / 9) + 1, first,
-                 first + 2, why);
-            goto bad;
-        }
-        if (a.n / 9 >= (size_t)MAXTRI) { fail(&r, "more than %ld triangles", MAXTRI); goto bad; }
-        if (dvec_push(&a, v, 9)) { fail(&r, "out of memory"); goto bad; }
-    }
-    if (st < 0) goto bad;
-    if (k) {
-        fail(&r, "the file ends inside triangle %ld (%d of its 3 vertex lines; "
-             "each triangle is three lines x y z)", (long)(a.n / 9) + 1, k);
-        goto bad;
-    }
-    if (!a.n) { fail(&r, "no triangles (each triangle is three lines x y z)"); goto bad; }
-    *tri = a.v;
-    *ntri = (long)(a.n / 9);
-    return 0;
-bad:
-    free(a.v);
-    return -1;
-}
-
-int sc_parse_media(const char *text, size_t len, const char *name, long ntri,
-                   double **media, char *err)
-{
-    reader r;
-    double *m = NULL;
-    long n = 0;
-    int st;
-
-    reader_init(&r, text, len, name, err);
-    *media = NULL;
-    if (ntri <= 0 || !(m = malloc((size_t)ntri * 2 * sizeof *m))) {
-        if (ntri > 0) fail(&r, "out of memory");
-        else fail(&r, "no triangles to give media to");
-        return -1;
-    }
-    while ((st = next_line(&r)) > 0) {
-        double v[2];
-        if (n == ntri) {
-            fail(&r, "more media lines than the mesh has triangles (%ld)", ntri);
-            goto bad;
-        }
-        if (line_nums(&r, 2, "indices of refraction: n1 n2", v)) goto bad;
-        for (int i = 0; i < 2; i++)
-            if (!(v[i] > 0)) {
-                fail(&r, "index of refraction n%d = %g must be positive", i + 1, v[i]);
-                goto bad;
-            }
-        m[2 * n] = v[0];
-        m[2 * n + 1] = v[1];
-        n++;
-    }
-    if (st < 0) goto bad;
-    if (n != ntri) {
-        fail(&r, "%ld media lines for %ld triangles (one line n1 n2 per triangle)", n,
-             ntri);
-        goto bad;
-    }
-    *media = m;
-    return 0;
-bad:
-    free(m);
-    return -1;
-}
-
-/* An OBJ vertex reference "i", "i/t", "i//n", "i/t/n"; negative counts back. */
-static int obj_index(reader *r, const tok *t, long nv, long *idx)
-{
-    tok head = *t;
-    const char *slash = memchr(t->s, '/', t->n);
-    double v;
-    if (slash) head.n = (size_t)(slash - t->s);
-    if (!head.n) return fail(r, "face: a vertex reference without a number");
-    if (tok_num(r, &head, "face vertex index", &v)) return -1;
-    double given = v;
-    if (v != floor(v)) return fail(r, "face: vertex index %g is not an integer", v);
-    if (v < 0) v += (double)nv + 1;
-    if (v < 1 || v > (double)nv)
-        return fail(r, "face: vertex %.0f does not exist (%ld vertices so far)", given, nv);
-    *idx = (long)v - 1;
-    return 0;
-}
-
-int sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
-                 long *ntri, char *err)
-{
-    static const char *const ignored[] = {"vt", "vn", "vp", "o", "g", "s", "usemtl",
-                                          "mtllib", NULL};
-    reader r;
-    dvec v = {0}, a = {0};
-    int st;
-
-    reader_init(&r, text, len, name, err);
-    *tri = NULL;
-    *ntri = 0;
-    while ((st = next_line(&r)) > 0) {
-        int skip = 0;
-        for (int i = 0; ignored[i]; i++) skip |= tok_is(&r.t[0], ignored[i]);
-        if (skip) continue;
-        if (tok_is(&r.t[0], "v")) {
-            double x[3];
-            if (r.nt != 4 && r.nt != 5) {
-                fail(&r, "v: expected x y z [w], found %d numbers", r.nt - 1);
-                goto bad;
-            }
-            for (int i = 0; i < 3; i++)
-                if (tok_num(&r, &r.t[i + 1], "v", &x[i])) goto bad;
-            if ((long)(v.n / 3) >= 3 * MAXTRI) { fail(&r, "too many vertices"); goto bad; }
-            if (dvec_push(&v, x, 3)) { fail(&r, "out of memory"); goto bad; }
-        } else if (tok_is(&r.t[0], "f")) {
-            long idx[MAXTOK], nv = (long)(v.n / 3);
-            if (r.nt < 4) { fail(&r, "f: a face needs at least 3 vertices"); goto bad; }
-            for (int i = 1; i < r.nt; i++)
-                if (obj_index(&r, &r.t[i], nv, &idx[i - 1])) goto bad;
-            for (int i = 1; i + 1 < r.nt - 1; i++) {   /* fan: 0, i, i+1 */
-                double t[9];
-                const char *why;
-                memcpy(t, v.v + 3 * idx[0], 3 * sizeof *t);
-                memcpy(t + 3, v.v + 3 * idx[i], 3 * sizeof *t);
-                memcpy(t + 6, v.v + 3 * idx[i + 1], 3 * sizeof *t);
-                if ((why = bad_triangle(t))) {
-                    fail(&r, "f: triangle %ld %s", (long)(a.n / 9) + 1, why);
-                    goto bad;
-                }
-                if (a.n / 9 >= (size_t)MAXTRI) { fail(&r, "too many triangles"); goto bad; }
-                if (dvec_push(&a, t, 9)) { fail(&r, "out of memory"); goto bad; }
-            }
-        } else {
-            char w[32];
-            snprintf(w, sizeof w, "%.*s", (int)(r.t[0].n < 24 ? r.t[0].n : 24), r.t[0].s);
-            fail(&r, "'%s': not an OBJ statement this reader knows (v, f; vt, vn, o, g, "
-                 "s, usemtl, mtllib are ignored)", w);
-            goto bad;
-        }
-    }
-    if (st < 0) goto bad;
-    if (!a.n) { fail(&r, "no faces (f lines)"); goto bad; }
-    free(v.v);
-    *tri = a.v;
-    *ntri = (long)(a.n / 9);
-    return 0;
-bad:
-    free(v.v);
-    free(a.v);
-    return -1;
-}
 
 /* ---- scene files -------------------------------------------------------------- */
 
@@ -395,7 +53,7 @@ typedef struct fields {
 static int key_index(const tok *t)
 {
     for (int i = 0; i < NKEYS; i++)
-        if (tok_is(t, keys[i].name)) return i;
+        if (sl_tok_is(t, keys[i].name)) return i;
     return -1;
 }
 
@@ -440,20 +98,20 @@ static int index_glass(reader *r, const char *what, int *i, char *name, double *
 {
     const tok *t = &r->t[*i];
     const px_glass_rec *g;
-    if (tok_is(t, "glass")) {
+    if (sl_tok_is(t, "glass")) {
         if (*i + 1 == r->nt || key_index(&r->t[*i + 1]) >= 0)
-            return fail(r, "%s: 'glass' needs a glass name", what);
+            return sl_fail(r, "%s: 'glass' needs a glass name", what);
         t = &r->t[++*i];
     }
     if (t->n >= SC_GLASSMAX)
-        return fail(r, "%s: '%.24s...' is too long for a glass name", what, t->s);
+        return sl_fail(r, "%s: '%.24s...' is too long for a glass name", what, t->s);
     memcpy(name, t->s, t->n);
     name[t->n] = '\0';
     int rc = px_glass_index(name, PX_LAMBDA_D, n);
     if (rc == PX_GLASS_RANGE && (g = px_glass_find(name)))
         rc = px_glass_index(name, 0.5 * (g->lmin + g->lmax), n);
     if (rc != PX_OK)
-        return fail(r, "%s: '%s' is neither a number nor a glass of the catalogue (a name "
+        return sl_fail(r, "%s: '%s' is neither a number nor a glass of the catalogue (a name "
                     "such as N-BK7, a model glass ND/VD such as 1.5168/64.17, or a medium "
                     "such as water)", what, name);
     if ((g = px_glass_find(name))) strcpy(name, g->name);   /* the catalogue's spelling */
@@ -471,12 +129,12 @@ static int parse_fields(reader *r, int first, const char *dname, const char *all
         char w[32], what[64];
         snprintf(w, sizeof w, "%.*s", (int)(r->t[i].n < 24 ? r->t[i].n : 24), r->t[i].s);
         if (k < 0 || !word_in(allowed, keys[k].name))
-            return fail(r, "%s: unexpected '%s' (expected one of: %s)", dname, w, allowed);
-        if (f->has[k]) return fail(r, "%s: '%s' given twice", dname, w);
+            return sl_fail(r, "%s: unexpected '%s' (expected one of: %s)", dname, w, allowed);
+        if (f->has[k]) return sl_fail(r, "%s: '%s' given twice", dname, w);
         f->has[k] = 1;
         i++;
         if (keys[k].nargs == ARGS_WORD) {
-            if (i == r->nt) return fail(r, "%s: '%s' needs a file name", dname, w);
+            if (i == r->nt) return sl_fail(r, "%s: '%s' needs a file name", dname, w);
             f->word[k] = r->t[i++];
             continue;
         }
@@ -488,38 +146,38 @@ static int parse_fields(reader *r, int first, const char *dname, const char *all
                 snprintf(b, sizeof b, "%.*s", (int)(r->t[i].n < NUMLEN - 1 ? r->t[i].n :
                                                     NUMLEN - 1), r->t[i].s);
                 if (f->count[k] == SC_MAXWL)
-                    return fail(r, "%s: more than %d wavelengths", dname, SC_MAXWL);
+                    return sl_fail(r, "%s: more than %d wavelengths", dname, SC_MAXWL);
                 if (r->t[i].n >= NUMLEN || px_wavelength(b, &um) != PX_OK)
-                    return fail(r, "%s: '%s' is not a wavelength (nm above 100, else um, "
+                    return sl_fail(r, "%s: '%s' is not a wavelength (nm above 100, else um, "
                                 "or F d C e g hene)", what, b);
                 for (int j = 0; j < f->count[k]; j++)   /* (587.5618 is d) */
                     if (fabs(f->num[k][j] - um) <= 1e-12 * um)
-                        return fail(r, "%s: wavelength '%s' given twice", what, b);
+                        return sl_fail(r, "%s: wavelength '%s' given twice", what, b);
                 f->num[k][f->count[k]++] = um;
                 i++;
             }
-            if (!f->count[k]) return fail(r, "%s: '%s' needs at least one wavelength", dname, w);
+            if (!f->count[k]) return sl_fail(r, "%s: '%s' needs at least one wavelength", dname, w);
             continue;
         }
         if (keys[k].nargs == ARGS_VAR) {
             while (i < r->nt && key_index(&r->t[i]) < 0) {
                 if (f->count[k] == SC_MAXCOEF)
-                    return fail(r, "%s: more than %d '%s' values", dname, SC_MAXCOEF, w);
-                if (tok_num(r, &r->t[i], what, &f->num[k][f->count[k]++])) return -1;
+                    return sl_fail(r, "%s: more than %d '%s' values", dname, SC_MAXCOEF, w);
+                if (sl_tok_num(r, &r->t[i], what, &f->num[k][f->count[k]++])) return -1;
                 i++;
             }
-            if (!f->count[k]) return fail(r, "%s: '%s' needs at least one number", dname, w);
+            if (!f->count[k]) return sl_fail(r, "%s: '%s' needs at least one number", dname, w);
             continue;
         }
         for (int j = 0; j < keys[k].nargs; j++, i++) {
             if (i == r->nt || key_index(&r->t[i]) >= 0)
-                return fail(r, "%s: '%s' needs %d number%s, found %d", dname, w,
+                return sl_fail(r, "%s: '%s' needs %d number%s, found %d", dname, w,
                             keys[k].nargs, keys[k].nargs == 1 ? "" : "s", j);
             if (is_index_key(k) && !tok_numeric(&r->t[i])) {
                 if (index_glass(r, what, &i, f->glass[k][j], &f->num[k][j])) return -1;
                 continue;
             }
-            if (tok_num(r, &r->t[i], what, &f->num[k][j])) return -1;
+            if (sl_tok_num(r, &r->t[i], what, &f->num[k][j])) return -1;
         }
         f->count[k] = keys[k].nargs;
     }
@@ -543,7 +201,7 @@ static int unit_vec(reader *r, const fields *f, const char *dname, const char *k
     const double *v = val(f, k);
     double m = sqrt(dot3(v, v));
     if (!(m > 0) || !isfinite(m))
-        return fail(r, "%s: '%s' %g %g %g is a zero-length direction", dname, k, v[0],
+        return sl_fail(r, "%s: '%s' %g %g %g is a zero-length direction", dname, k, v[0],
                     v[1], v[2]);
     for (int i = 0; i < 3; i++) u[i] = v[i] / m;
     return 0;
@@ -556,7 +214,7 @@ static int need(reader *r, const fields *f, const char *dname, const char *list)
     while (*p) {
         size_t n = strcspn(p, " ");
         snprintf(k, sizeof k, "%.*s", (int)n, p);
-        if (!has(f, k)) return fail(r, "%s: '%s' is missing", dname, k);
+        if (!has(f, k)) return sl_fail(r, "%s: '%s' is missing", dname, k);
         p += n;
         while (*p == ' ') p++;
     }
@@ -565,7 +223,7 @@ static int need(reader *r, const fields *f, const char *dname, const char *list)
 
 static int positive(reader *r, const char *dname, const char *what, double v)
 {
-    if (!(v > 0)) return fail(r, "%s: %s = %g must be positive", dname, what, v);
+    if (!(v > 0)) return sl_fail(r, "%s: %s = %g must be positive", dname, what, v);
     return 0;
 }
 
@@ -575,7 +233,7 @@ static int int_val(reader *r, const fields *f, const char *dname, const char *k,
 {
     double v = val(f, k)[0];
     if (v != floor(v) || v < (double)lo || v > (double)hi)
-        return fail(r, "%s: '%s' %g must be an integer from %ld to %ld", dname, k, v, lo,
+        return sl_fail(r, "%s: '%s' %g must be an integer from %ld to %ld", dname, k, v, lo,
                     hi);
     *out = (long)v;
     return 0;
@@ -590,7 +248,7 @@ static int surface_kind(reader *r, const fields *f, const char *dname, sc_surfac
     for (int i = 0; i < 5; i++)
         if (has(f, kinds[i])) { s->kind = i; n++; }
     if (n != 1)
-        return fail(r, "%s: give exactly one of refract N1 N2, %smirror, absorb, detect",
+        return sl_fail(r, "%s: give exactly one of refract N1 N2, %smirror, absorb, detect",
                     dname, s->shape == SC_MESH ? "media FILE, " : "");
     if (s->kind == SC_REFRACT) {
         int k = key_index(&(tok){"refract", 7});
@@ -598,7 +256,7 @@ static int surface_kind(reader *r, const fields *f, const char *dname, sc_surfac
         s->n2 = val(f, "refract")[1];
         memcpy(s->glass, f->glass[k], sizeof s->glass);
         if (!(s->n1 > 0) || !(s->n2 > 0))
-            return fail(r, "%s: refract %g %g: an index of refraction must be positive",
+            return sl_fail(r, "%s: refract %g %g: an index of refraction must be positive",
                         dname, s->n1, s->n2);
     }
     return 0;
@@ -626,7 +284,7 @@ static int up_vector(reader *r, const fields *f, const char *dname, const double
     p = dot3(u, d);
     for (int i = 0; i < 3; i++) u[i] -= p * d[i];
     m = sqrt(dot3(u, u));
-    if (m < 1e-9) return fail(r, "%s: 'up' is parallel to the direction", dname);
+    if (m < 1e-9) return sl_fail(r, "%s: 'up' is parallel to the direction", dname);
     for (int i = 0; i < 3; i++) u[i] /= m;
     return 0;
 }
@@ -639,9 +297,9 @@ static int axial_check(reader *r, const char *dname, const sc_surface *s)
     double q = 1 - (1 + s->conic) * c * c * a * a;
     if (q < 0) {
         if (s->shape == SC_CAP)
-            return fail(r, "%s: aperture %g exceeds the radius %g: no real surface there",
+            return sl_fail(r, "%s: aperture %g exceeds the radius %g: no real surface there",
                         dname, a, fabs(s->radius));
-        return fail(r, "%s: radius %g, conic %g: no real surface at the aperture %g "
+        return sl_fail(r, "%s: radius %g, conic %g: no real surface at the aperture %g "
                     "(1 - (1+k) s^2/R^2 = %g < 0; the surface ends at s = %g)", dname,
                     s->radius, s->conic, a, q, sqrt(1 / ((1 + s->conic) * c * c)));
     }
@@ -685,25 +343,25 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
     }
     s.refine = has(&f, "refine");
     if (s.refine && !s.tessellate)
-        return fail(r, "%s: 'refine' applies to a tessellated surface (tessellate N)", dname);
+        return sl_fail(r, "%s: 'refine' applies to a tessellated surface (tessellate N)", dname);
     switch (shape) {
     case SC_PLANE:
         memcpy(s.at, val(&f, "at"), sizeof s.at);
         if (unit_vec(r, &f, dname, "normal", s.axis)) return -1;
         if (has(&f, "disc") == has(&f, "rect"))
-            return fail(r, "plane: give its bounds, either disc R or rect W H");
+            return sl_fail(r, "plane: give its bounds, either disc R or rect W H");
         if (has(&f, "disc")) {
             s.aperture = val(&f, "disc")[0];
             if (positive(r, dname, "the disc radius", s.aperture)) return -1;
             if (has(&f, "hole")) {
                 s.hole = val(&f, "hole")[0];
                 if (!(s.hole > 0 && s.hole < s.aperture))
-                    return fail(r, "plane: hole %g must lie between 0 and the disc radius %g",
+                    return sl_fail(r, "plane: hole %g must lie between 0 and the disc radius %g",
                                 s.hole, s.aperture);
-                if (s.tessellate) return fail(r, "plane: a disc with a hole cannot be tessellated");
+                if (s.tessellate) return sl_fail(r, "plane: a disc with a hole cannot be tessellated");
             }
         } else {
-            if (has(&f, "hole")) return fail(r, "plane: 'hole' goes with 'disc'");
+            if (has(&f, "hole")) return sl_fail(r, "plane: 'hole' goes with 'disc'");
             s.rect[0] = val(&f, "rect")[0];
             s.rect[1] = val(&f, "rect")[1];
             if (positive(r, dname, "the width", s.rect[0]) ||
@@ -724,7 +382,7 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
         if (!s.mesh_file || (has(&f, "media") && !s.media_file)) {
             free(s.mesh_file);
             free(s.media_file);
-            return fail(r, "out of memory");
+            return sl_fail(r, "out of memory");
         }
         if (has(&f, "sphere")) {
             memcpy(s.sphere, val(&f, "sphere"), sizeof s.sphere);
@@ -745,11 +403,11 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
         if (axial_check(r, dname, &s)) return -1;
     }
     if (sc->nsurf == MAXSURF) {
-        fail(r, "more than %d surfaces", MAXSURF);
+        sl_fail(r, "more than %d surfaces", MAXSURF);
         goto mesh_bad;
     }
     grown = realloc(sc->surf, (size_t)(sc->nsurf + 1) * sizeof *grown);
-    if (!grown) { fail(r, "out of memory"); goto mesh_bad; }
+    if (!grown) { sl_fail(r, "out of memory"); goto mesh_bad; }
     sc->surf = grown;
     sc->surf[sc->nsurf++] = s;
     return 0;
@@ -781,11 +439,11 @@ static int read_source(reader *r, sc_scene *sc)
     sc_source *grown;
 
     if (r->nt < 2)
-        return fail(r, "source: which kind? (ray, fan, point, cone, collimated, gaussian)");
+        return sl_fail(r, "source: which kind? (ray, fan, point, cone, collimated, gaussian)");
     for (int i = 0; i < 6; i++)
-        if (tok_is(&r->t[1], types[i].name)) t = i;
+        if (sl_tok_is(&r->t[1], types[i].name)) t = i;
     if (t < 0)
-        return fail(r, "source: unknown kind '%.*s' (ray, fan, point, cone, collimated, "
+        return sl_fail(r, "source: unknown kind '%.*s' (ray, fan, point, cone, collimated, "
                     "gaussian)", (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
     snprintf(dname, sizeof dname, "source %s", types[t].name);
     if (parse_fields(r, 2, dname, types[t].allowed, &f) || need(r, &f, dname, types[t].required))
@@ -811,7 +469,7 @@ static int read_source(reader *r, sc_scene *sc)
         memcpy(s.glass, f.glass[key_index(&(tok){"medium", 6})][0], sizeof s.glass);
         s.medium = val(&f, "medium")[0];
         if (!(s.medium > 0))
-            return fail(r, "%s: medium %g: an index of refraction must be positive", dname,
+            return sl_fail(r, "%s: medium %g: an index of refraction must be positive", dname,
                         s.medium);
     }
     if (has(&f, "pol")) {
@@ -821,7 +479,7 @@ static int read_source(reader *r, sc_scene *sc)
     if (has(&f, "angle")) {
         s.angle = val(&f, "angle")[0];
         if (s.angle < 0 || s.angle >= (t == SC_FAN ? 180 : 90))
-            return fail(r, "%s: half angle %g must lie in [0, %d) degrees", dname, s.angle,
+            return sl_fail(r, "%s: half angle %g must lie in [0, %d) degrees", dname, s.angle,
                         t == SC_FAN ? 180 : 90);
     }
     if (has(&f, "radius")) {
@@ -843,25 +501,25 @@ static int read_source(reader *r, sc_scene *sc)
     switch (t) {
     case SC_FAN:
         if (has(&f, "to") == has(&f, "dir"))
-            return fail(r, "%s: give either dir D angle A [up U], or to P1 P2 (rays toward "
+            return sl_fail(r, "%s: give either dir D angle A [up U], or to P1 P2 (rays toward "
                         "points on the segment P1-P2, as opticrt)", dname);
         if (has(&f, "to")) {
             double a[3], b[3], c[3];
             if (has(&f, "angle") || has(&f, "up"))
-                return fail(r, "%s: 'angle' and 'up' go with 'dir', not with 'to'", dname);
+                return sl_fail(r, "%s: 'angle' and 'up' go with 'dir', not with 'to'", dname);
             s.has_to = 1;
             memcpy(s.to, val(&f, "to"), sizeof s.to);
             sub3(s.to[0], s.from, a);
             sub3(s.to[1], s.from, b);
             if (dot3(a, a) == 0 || (s.count > 1 && dot3(b, b) == 0))
-                return fail(r, "%s: a 'to' point is the source point: a zero-direction ray",
+                return sl_fail(r, "%s: a 'to' point is the source point: a zero-direction ray",
                             dname);
             cross3(a, b, c);
             if (s.count > 1 && dot3(c, c) == 0 && dot3(a, b) < 0)
-                return fail(r, "%s: the segment P1-P2 passes through the source point "
+                return sl_fail(r, "%s: the segment P1-P2 passes through the source point "
                             "(a zero-direction ray)", dname);
         } else {
-            if (!has(&f, "angle")) return fail(r, "%s: 'angle' is missing", dname);
+            if (!has(&f, "angle")) return sl_fail(r, "%s: 'angle' is missing", dname);
             if (up_vector(r, &f, dname, s.dir, s.up)) return -1;
         }
         break;
@@ -870,7 +528,7 @@ static int read_source(reader *r, sc_scene *sc)
         memcpy(s.toward, val(&f, "toward"), sizeof s.toward);
         sub3(s.toward, s.from, d);
         if (dot3(d, d) == 0)
-            return fail(r, "%s: 'toward' is the source point: a zero-direction ray", dname);
+            return sl_fail(r, "%s: 'toward' is the source point: a zero-direction ray", dname);
         break;
     }
     case SC_GAUSSIAN:
@@ -884,16 +542,16 @@ static int read_source(reader *r, sc_scene *sc)
             if (positive(r, dname, "trunc", s.trunc)) return -1;
         }
         if (s.wavelength / (PI * s.waist) > 0.5)
-            return fail(r, "%s: wavelength %g against waist %g: divergence %g rad is beyond "
+            return sl_fail(r, "%s: wavelength %g against waist %g: divergence %g rad is beyond "
                         "the paraxial Gaussian beam", dname, s.wavelength, s.waist,
                         s.wavelength / (PI * s.waist));
         break;
     default:
         break;
     }
-    if (sc->nsource == MAXSOURCE) return fail(r, "more than %d sources", MAXSOURCE);
+    if (sc->nsource == MAXSOURCE) return sl_fail(r, "more than %d sources", MAXSOURCE);
     grown = realloc(sc->source, (size_t)(sc->nsource + 1) * sizeof *grown);
-    if (!grown) return fail(r, "out of memory");
+    if (!grown) return sl_fail(r, "out of memory");
     sc->source = grown;
     sc->source[sc->nsource++] = s;
     return 0;
@@ -906,49 +564,49 @@ static int read_setting(reader *r, sc_scene *sc)
     double v;
     char w[32];
     const tok *d = &r->t[0];
-    if (tok_is(d, "output")) {
+    if (sl_tok_is(d, "output")) {
         static const char *const what[] = {"segments", "hits", "summary"};
         char **slot[] = {&sc->out_segments, &sc->out_hits, &sc->out_summary};
         if (r->nt != 3)
-            return fail(r, "output: expected 'output segments|hits|summary FILE'");
+            return sl_fail(r, "output: expected 'output segments|hits|summary FILE'");
         for (int i = 0; i < 3; i++)
-            if (tok_is(&r->t[1], what[i])) {
-                if (*slot[i]) return fail(r, "output %s given twice", what[i]);
-                if (!(*slot[i] = tok_dup(&r->t[2]))) return fail(r, "out of memory");
+            if (sl_tok_is(&r->t[1], what[i])) {
+                if (*slot[i]) return sl_fail(r, "output %s given twice", what[i]);
+                if (!(*slot[i] = tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
                 return 0;
             }
-        return fail(r, "output: '%.*s' is not segments, hits or summary",
+        return sl_fail(r, "output: '%.*s' is not segments, hits or summary",
                     (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
     }
-    if (tok_is(d, "mismatch")) {
-        if (r->nt != 2 || !(tok_is(&r->t[1], "warn") || tok_is(&r->t[1], "error")))
-            return fail(r, "mismatch: expected warn or error");
-        sc->mismatch_error = tok_is(&r->t[1], "error");
+    if (sl_tok_is(d, "mismatch")) {
+        if (r->nt != 2 || !(sl_tok_is(&r->t[1], "warn") || sl_tok_is(&r->t[1], "error")))
+            return sl_fail(r, "mismatch: expected warn or error");
+        sc->mismatch_error = sl_tok_is(&r->t[1], "error");
         return 0;
     }
-    if (tok_is(d, "fresnel") || tok_is(d, "reflections")) {
-        int *flag = tok_is(d, "fresnel") ? &sc->fresnel : &sc->reflections;
-        if (r->nt != 2 || !(tok_is(&r->t[1], "on") || tok_is(&r->t[1], "off")))
-            return fail(r, "%.*s: expected on or off", (int)d->n, d->s);
-        *flag = tok_is(&r->t[1], "on");
+    if (sl_tok_is(d, "fresnel") || sl_tok_is(d, "reflections")) {
+        int *flag = sl_tok_is(d, "fresnel") ? &sc->fresnel : &sc->reflections;
+        if (r->nt != 2 || !(sl_tok_is(&r->t[1], "on") || sl_tok_is(&r->t[1], "off")))
+            return sl_fail(r, "%.*s: expected on or off", (int)d->n, d->s);
+        *flag = sl_tok_is(&r->t[1], "on");
         return 0;
     }
-    if (r->nt != 2) return fail(r, "%.*s: expected one number", (int)d->n, d->s);
+    if (r->nt != 2) return sl_fail(r, "%.*s: expected one number", (int)d->n, d->s);
     snprintf(w, sizeof w, "%.*s", (int)(d->n < 24 ? d->n : 24), d->s);
-    if (tok_num(r, &r->t[1], w, &v)) return -1;
-    if (tok_is(d, "depth")) {
+    if (sl_tok_num(r, &r->t[1], w, &v)) return -1;
+    if (sl_tok_is(d, "depth")) {
         if (v != floor(v) || v < 1 || v > 1000)
-            return fail(r, "depth %g: must be an integer from 1 to 1000", v);
+            return sl_fail(r, "depth %g: must be an integer from 1 to 1000", v);
         sc->depth = (int)v;
-    } else if (tok_is(d, "cutoff")) {
-        if (!(v >= 0 && v < 1)) return fail(r, "cutoff %g: must lie in [0, 1)", v);
+    } else if (sl_tok_is(d, "cutoff")) {
+        if (!(v >= 0 && v < 1)) return sl_fail(r, "cutoff %g: must lie in [0, 1)", v);
         sc->cutoff = v;
-    } else if (tok_is(d, "escape")) {
-        if (!(v > 0)) return fail(r, "escape %g: the length must be positive", v);
+    } else if (sl_tok_is(d, "escape")) {
+        if (!(v > 0)) return sl_fail(r, "escape %g: the length must be positive", v);
         sc->escape = v;
     } else {
         if (v != floor(v) || v < 0 || v > 1024)
-            return fail(r, "threads %g: must be an integer from 0 (all cores) to 1024", v);
+            return sl_fail(r, "threads %g: must be an integer from 0 (all cores) to 1024", v);
         sc->threads = (int)v;
     }
     return 0;
@@ -963,135 +621,13 @@ static int read_directive(reader *r, sc_scene *sc)
                                            "reflections", "output", "mismatch", NULL};
     const tok *d = &r->t[0];
     for (int i = 0; i < 6; i++)
-        if (tok_is(d, shapes[i])) return read_surface(r, sc, shapes[i], i);
-    if (tok_is(d, "source")) return read_source(r, sc);
+        if (sl_tok_is(d, shapes[i])) return read_surface(r, sc, shapes[i], i);
+    if (sl_tok_is(d, "source")) return read_source(r, sc);
     for (int i = 0; settings[i]; i++)
-        if (tok_is(d, settings[i])) return read_setting(r, sc);
-    return fail(r, "unknown directive '%.*s' (plane, sphere, cap, conic, asphere, mesh, "
+        if (sl_tok_is(d, settings[i])) return read_setting(r, sc);
+    return sl_fail(r, "unknown directive '%.*s' (plane, sphere, cap, conic, asphere, mesh, "
                 "source, depth, cutoff, threads, escape, fresnel, reflections, output, mismatch)",
                 (int)(d->n < 24 ? d->n : 24), d->s);
-}
-
-/* ---- axial surfaces along one axis: crossing sags, media that disagree ---------
- * Caps, conics and aspheres whose axes lie on one line are taken in order along it
- * (ties in file order).  Two consecutive ones must not cross within the smaller
- * aperture (negative edge thickness: refused), and when both refract, the index one
- * gives the space between them should be the one the other expects: a disagreement
- * is counted, and the first is kept for the message after the trace (scene.h). */
-
-#define AXMAX 4096          /* beyond this many axial surfaces the pairs are not checked */
-
-static double axial_sag(const sc_surface *f, double s)
-{
-    double c = f->radius != 0 ? 1 / f->radius : 0, s2 = s * s, q;
-    q = 1 - (1 + f->conic) * c * c * s2;
-    double z = c * s2 / (1 + sqrt(q > 0 ? q : 0)), p = s2;
-    for (int i = 0; i < f->ncoef; i++) {
-        z += f->coef[i] * p;
-        p *= s2;
-    }
-    return z;
-}
-
-typedef struct axm {
-    const sc_surface *f;
-    double u, sign;         /* vertex position along the line; axis . direction */
-} axm;
-
-static int axm_cmp(const void *x, const void *y)
-{
-    const axm *a = x, *b = y;
-    if (a->u != b->u) return a->u < b->u ? -1 : 1;
-    return a->f < b->f ? -1 : a->f > b->f;      /* file order */
-}
-
-/* Position along the line of member m at height s. */
-static double axm_pos(const axm *m, double s) { return m->u + m->sign * axial_sag(m->f, s); }
-
-/* The pair a, b (a first along the line): 0, or -1 with err if their sags cross. */
-static int axm_cross(const axm *a, const axm *b, char *err)
-{
-    enum { N = 64 };
-    double smax = fmin(a->f->aperture, b->f->aperture), prev = 0, t = 0;
-    double scale = fabs(a->u) + fabs(b->u) + smax;
-    if (!(smax > 0)) return 0;
-    for (int i = 1; i <= N; i++) {
-        double s = smax * i / N;
-        t = axm_pos(b, s) - axm_pos(a, s);
-        if (t < -1e-12 * scale) {
-            double lo = prev, hi = s;       /* t(lo) >= -tol > t(hi) */
-            for (int k = 0; k < 100 && lo < hi; k++) {
-                double mid = 0.5 * (lo + hi);
-                if (!(mid > lo && mid < hi)) break;
-                if (axm_pos(b, mid) - axm_pos(a, mid) < 0) hi = mid; else lo = mid;
-            }
-            double rim = axm_pos(b, smax) - axm_pos(a, smax);
-            snprintf(err, SC_ERRMAX, "%s:%ld: and %s:%ld: the surfaces cross at height "
-                     "%.6g from their axis (edge thickness %.6g at %.6g): negative edge "
-                     "thickness", a->f->src, a->f->line, b->f->src, b->f->line,
-                     b->u == a->u ? 0.0 : lo, rim < t ? rim : t, rim < t ? smax : s);
-            return -1;
-        }
-        prev = s;
-    }
-    return 0;
-}
-
-/* The media of the pair a, b: the index a leaves on b's side, b on a's. */
-static void axm_media(sc_scene *sc, const axm *a, const axm *b)
-{
-    if (a->f->kind != SC_REFRACT || b->f->kind != SC_REFRACT) return;
-    double na = a->sign > 0 ? a->f->n2 : a->f->n1, nb = b->sign > 0 ? b->f->n1 : b->f->n2;
-    if (!(fabs(na - nb) > 1e-9 * na)) return;
-    if (!sc->nmismatch++)
-        snprintf(sc->mismatch_where, sizeof sc->mismatch_where, "%s:%ld: gives %.10g "
-                 "after it, %s:%ld: expects %.10g before it", a->f->src, a->f->line, na,
-                 b->f->src, b->f->line, nb);
-}
-
-static int axial_pairs(sc_scene *sc, char *err)
-{
-    int n = 0, rc = 0;
-    for (int i = 0; i < sc->nsurf; i++)
-        n += sc->surf[i].shape >= SC_CAP && sc->surf[i].shape <= SC_ASPHERE;
-    if (n < 2 || n > AXMAX) return 0;
-    axm *m = malloc((size_t)n * sizeof *m);
-    char *used = calloc((size_t)n, 1);
-    const sc_surface **ax = malloc((size_t)n * sizeof *ax);
-    if (!m || !used || !ax) { free(m); free(used); free(ax); return 0; }
-    n = 0;
-    for (int i = 0; i < sc->nsurf; i++)
-        if (sc->surf[i].shape >= SC_CAP && sc->surf[i].shape <= SC_ASPHERE)
-            ax[n++] = &sc->surf[i];
-    for (int i = 0; i < n && !rc; i++) {
-        const sc_surface *a = ax[i];
-        if (used[i]) continue;
-        int k = 0;
-        for (int j = i; j < n; j++) {               /* the surfaces on a's axis line */
-            const sc_surface *b = ax[j];
-            if (used[j]) continue;
-            double dot = dot3(a->axis, b->axis), w[3], x[3];
-            if (!(fabs(dot) > 1 - 1e-12)) continue;
-            sub3(b->at, a->at, w);
-            cross3(w, a->axis, x);
-            double off = sqrt(dot3(x, x)), scale = sqrt(dot3(w, w)) + a->aperture;
-            if (!(off <= 1e-12 * scale)) continue;
-            used[j] = 1;
-            m[k].f = b;
-            m[k].u = dot3(w, a->axis);
-            m[k].sign = dot > 0 ? 1 : -1;
-            k++;
-        }
-        qsort(m, (size_t)k, sizeof *m, axm_cmp);
-        for (int j = 1; j < k && !rc; j++) {
-            rc = axm_cross(&m[j - 1], &m[j], err);
-            if (!rc) axm_media(sc, &m[j - 1], &m[j]);
-        }
-    }
-    free(m);
-    free(used);
-    free(ax);
-    return rc;
 }
 
 void sc_scene_defaults(sc_scene *sc)
@@ -1110,15 +646,15 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
     int st;
 
     sc_scene_defaults(sc);
-    reader_init(&r, text, len, name, err);
+    sl_reader_init(&r, text, len, name, err);
     if (!(sc->name = malloc(strlen(name) + 1))) return -1;
     strcpy(sc->name, name);
     r.name = sc->name;
-    while ((st = next_line(&r)) > 0)
+    while ((st = sl_next_line(&r)) > 0)
         if (read_directive(&r, sc)) goto bad;
     if (st < 0) goto bad;
-    if (!sc->nsurf) { fail(&r, "the scene has no surface"); goto bad; }
-    if (!sc->nsource) { fail(&r, "the scene has no source of rays"); goto bad; }
+    if (!sc->nsurf) { sl_fail(&r, "the scene has no surface"); goto bad; }
+    if (!sc->nsource) { sl_fail(&r, "the scene has no source of rays"); goto bad; }
     {   /* wavelengths: named by some source?  (at most SC_MAXWLS distinct ones) */
         double seen[SC_MAXWLS];
         int nseen = 0;
@@ -1136,7 +672,7 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
                 seen[nseen++] = sc->source[i].lambda[j];
             }
     }
-    if (axial_pairs(sc, err)) goto bad;
+    if (sc_axial_pairs(sc, err)) goto bad;
     if (sc_check_coincident(sc, err)) goto bad;     /* with both lines */
     return 0;
 bad:
