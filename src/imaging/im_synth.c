@@ -648,7 +648,7 @@ int im_synth(const im_sensor *s, const im_spot_src *spots, int nspots, uint64_t 
         return rc;
     plan_init(&p, s, L, nspots, seed);
     p.dk = plan_dark(&p);
-    p.f = im_frame_new(s->width, s->height, s->bits);
+    p.f = im_frame_new_raw(s->width, s->height, s->bits);   /* every sample is written */
     if (!p.f) {
         dark_put(p.dk);
         free_layers(L, nspots);
