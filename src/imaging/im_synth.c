@@ -145,7 +145,7 @@ static double poisson(gsl_rng *r, ptrs *c, double mu)
  * klo + i), each tail from erfc of its own side, so no cancellation) over c +- 13 sigma
  * (the mass beyond, below 1e-38, joins the end values), and one 64-bit draw u per pixel
  * gives the first i with T[i] > u: a guide on u's top 13 bits answers at once unless a
- * threshold falls inside u's bucket (DK_SEARCH; ~4 % of the draws at sigma 50), when
+ * threshold falls inside u's bucket (DK_SEARCH; ~3 % of the draws at sigma 50), when
  * the search compares from there.  Exact to erfc's double precision, where the
  * ziggurat and the floor it replaces resolved ~2^-31; ~1 ns a pixel instead of ~3.
  * Tables live in a small cache keyed by (c, sigma, max): every frame of a scan shares
