@@ -3,6 +3,7 @@
  * central-difference Jacobian), robust outlier rejection by normalised residuals,
  * and the predicted accuracy of a scan before it is run. */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +18,7 @@ typedef struct fctx {
     const cn_plane *pl;
     const double *apex0;
     cn_params base;
+    int threads;                    /* residuals and Jacobian rows over this many */
 } fctx;
 
 static void unpack(const fctx *c, const gsl_vector *x, cn_params *p)
@@ -25,39 +27,82 @@ static void unpack(const fctx *c, const gsl_vector *x, cn_params *p)
     for (int k = 0; k < c->nf; k++) p->p[c->idx[k]] = gsl_vector_get(x, k);
 }
 
-static int f_res(const gsl_vector *x, void *data, gsl_vector *f)
+/* Rows [i0, i1) of the residuals (J NULL) or of the Jacobian (f NULL) at p: every
+ * spot's rows depend on that spot alone, so the split over threads changes no bit. */
+static void rows(const fctx *c, const cn_params *p, int i0, int i1, gsl_vector *f,
+                 gsl_matrix *J)
 {
-    const fctx *c = data;
-    cn_params p;
-    unpack(c, x, &p);
-    for (int i = 0; i < c->n; i++) {
+    double ru[CN_NPARAM], rv[CN_NPARAM];
+    for (int i = i0; i < i1; i++) {
         const cn_spot *s = &c->s[c->use[i]];
+        if (J) {
+            if (cn_jacobian(c->model, p, c->apex0, c->pl, s, c->idx, c->nf, ru, rv))
+                memset(ru, 0, sizeof ru), memset(rv, 0, sizeof rv);
+            for (int k = 0; k < c->nf; k++) {
+                gsl_matrix_set(J, 2 * i, k, ru[k]);
+                gsl_matrix_set(J, 2 * i + 1, k, rv[k]);
+            }
+            continue;
+        }
         double u, v;
-        if (cn_forward(c->model, &p, c->apex0, c->pl, &s->ray, &u, &v, NULL, NULL)) {
+        if (cn_forward(c->model, p, c->apex0, c->pl, &s->ray, &u, &v, NULL, NULL)) {
             u = s->u + 10; v = s->v + 10;   /* a miss: a large residual turns the
                                                trust region back */
         }
         gsl_vector_set(f, 2 * i, (u - s->u) / s->sigma);
         gsl_vector_set(f, 2 * i + 1, (v - s->v) / s->sigma);
     }
+}
+
+typedef struct rows_job {
+    const fctx *c;
+    const cn_params *p;
+    int i0, i1;
+    gsl_vector *f;
+    gsl_matrix *J;
+} rows_job;
+
+static void *rows_thread(void *arg)
+{
+    rows_job *j = arg;
+    rows(j->c, j->p, j->i0, j->i1, j->f, j->J);
+    return NULL;
+}
+
+/* All rows, on c->threads threads when there are enough spots to pay for them (the
+ * calling thread takes the first share; a thread that cannot start leaves its share
+ * to the caller). */
+static void all_rows(const fctx *c, const gsl_vector *x, gsl_vector *f, gsl_matrix *J)
+{
+    enum { MAXT = 16, MIN_PER_THREAD = 64 };
+    cn_params p;
+    unpack(c, x, &p);
+    int nt = c->threads < 1 ? 1 : c->threads > MAXT ? MAXT : c->threads;
+    if (nt > c->n / MIN_PER_THREAD) nt = c->n / MIN_PER_THREAD > 1 ? c->n / MIN_PER_THREAD : 1;
+    pthread_t tid[MAXT];
+    rows_job job[MAXT];
+    int started[MAXT] = {0};
+    for (int t = 1; t < nt; t++) {
+        job[t] = (rows_job){c, &p, (int)((long)c->n * t / nt), (int)((long)c->n * (t + 1) / nt),
+                            f, J};
+        started[t] = pthread_create(&tid[t], NULL, rows_thread, &job[t]) == 0;
+    }
+    rows(c, &p, 0, (int)((long)c->n / nt), f, J);
+    for (int t = 1; t < nt; t++) {
+        if (started[t]) pthread_join(tid[t], NULL);
+        else rows(c, &p, job[t].i0, job[t].i1, f, J);
+    }
+}
+
+static int f_res(const gsl_vector *x, void *data, gsl_vector *f)
+{
+    all_rows(data, x, f, NULL);
     return GSL_SUCCESS;
 }
 
 static int f_jac(const gsl_vector *x, void *data, gsl_matrix *J)
 {
-    const fctx *c = data;
-    cn_params p;
-    double ru[CN_NPARAM], rv[CN_NPARAM];
-    unpack(c, x, &p);
-    for (int i = 0; i < c->n; i++) {
-        if (cn_jacobian(c->model, &p, c->apex0, c->pl, &c->s[c->use[i]], c->idx, c->nf,
-                        ru, rv))
-            memset(ru, 0, sizeof ru), memset(rv, 0, sizeof rv);
-        for (int k = 0; k < c->nf; k++) {
-            gsl_matrix_set(J, 2 * i, k, ru[k]);
-            gsl_matrix_set(J, 2 * i + 1, k, rv[k]);
-        }
-    }
+    all_rows(data, x, NULL, J);
     return GSL_SUCCESS;
 }
 
@@ -202,7 +247,8 @@ int cn_fit(const rg_geometry *g, cn_spot *spots, int n, const cn_params *start,
             p.p[CN_C0] = -1e-4;   /* off the axis singularity of zero cylinder */
     }
     if (o->model == CN_SPHERE) p.p[CN_TX] = p.p[CN_TY] = 0;
-    fctx c = {.model = o->model, .s = spots, .pl = &pl, .apex0 = apex0};
+    fctx c = {.model = o->model, .s = spots, .pl = &pl, .apex0 = apex0,
+              .threads = o->threads};
     cn_free_mask_q(o->model, o->fix_tilt, o->free_q, res->free);
     for (int k = 0; k < CN_NPARAM; k++) if (res->free[k]) c.idx[c.nf++] = k;
     int *use = malloc(sizeof *use * (n > 0 ? n : 1));

@@ -73,6 +73,8 @@ typedef struct cn_fit_opts {
     int max_iter;                  /* trust-region iterations (0: 100) */
     int (*stop)(void *ctx); void *stop_ctx;   /* polled each iteration */
     int free_q;                    /* asphere: fit Q too (its s^4 term is A4's) */
+    int threads;                   /* residuals and Jacobian on this many threads
+                                      (0, 1: the caller's; the same bits for any) */
 } cn_fit_opts;
 
 /* What the clinician reads, each with its standard uncertainty (sd_*; INFINITY when

@@ -7,7 +7,7 @@
 CN_SRC   := $(wildcard src/cornea/cn_*.c)
 CN_OBJ   := $(patsubst src/%.c,build/obj/%.o,$(CN_SRC))
 CN_SOBJ  := $(patsubst src/%.c,build/asan/%.o,$(CN_SRC))
-CN_LIBS  := -lgsl -lgslcblas -lm
+CN_LIBS  := -lgsl -lgslcblas -lm -pthread
 CN_TESTS := $(wildcard tests/cornea/t_*.c)
 CN_BENCH := $(wildcard tests/cornea/bench_*.c)
 CN_TBIN  := $(patsubst tests/cornea/%.c,build/obj/cornea_tests/%,$(CN_TESTS)) \

@@ -590,7 +590,8 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     if (!sp || !of) { free(sp); free(of); snprintf(err, cap, "out of memory"); goto fail; }
     for (int k = 0; k < n; k++)
         if (r->pt[k].planned) { sp[m] = r->pt[k].spot; of[m++] = k; }
-    cn_fit_opts fo = {.model = r->model, .stop = r->stop, .stop_ctx = r->stop_ctx};
+    cn_fit_opts fo = {.model = r->model, .stop = r->stop, .stop_ctx = r->stop_ctx,
+                      .threads = r->threads};
     int rc = r->cn->fit(r->g, sp, m, NULL, &fo, &r->res, err, cap);
     for (int i = 0; i < m; i++) {
         cl_point *q = &r->pt[of[i]];

@@ -26,6 +26,7 @@ int im_err(char *err, size_t cap, int code, const char *fmt, ...)
 
 /* Frames (im_frame.c). */
 im_frame *im_frame_new(int width, int height, int bits);
+im_frame *im_frame_new_raw(int width, int height, int bits);   /* samples unset */
 void im_frame_free(im_frame *f);
 int im_decode_raw(const void *buf, size_t len, const char *name, int width, int height,
                   int bits, im_frame **out, char *err, size_t cap);

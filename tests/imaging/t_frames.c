@@ -44,6 +44,110 @@ static void determinism(void)
     fa->frame_free(a); fa->frame_free(b); fa->frame_free(c); fa->frame_free(d);
 }
 
+/* The dark pixels' fast path (no background light: counts from their tabulated law)
+ * and the spot's full path in one frame: the same bits whatever the thread count, and a
+ * gain that is not 1. */
+static void determinism_dark(void)
+{
+    im_sensor s = it_sensor();
+    s.shot_noise = 1; s.gain = 2.5; s.bias = 300;
+    im_spot_src sp[2] = {it_spot(100.5, 200.25), it_spot(400.2, 31.7)};
+    im_frame *a, *b, *c;
+    fa->synth(&s, sp, 2, 42, 1, &a, err, sizeof err);
+    fa->synth(&s, sp, 2, 42, 2, &b, err, sizeof err);
+    fa->synth(&s, sp, 2, 42, 5, &c, err, sizeof err);
+    CHECK(same(a, b) && same(a, c), "dark pixels: the same frame with 1, 2 and 5 threads");
+    fa->frame_free(a); fa->frame_free(b); fa->frame_free(c);
+}
+
+static double phi(double z) { return 0.5 * erfc(-z / sqrt(2)); }
+
+/* Dark pixels against their exact law: count = clamp(floor(bias + 0.5 + sigma Z), 0,
+ * max), so P(count = k) = Phi((k + 1 - c) / sigma) - Phi((k - c) / sigma), c = bias +
+ * 0.5, all of the mass below 1 at 0.  Bias 100, sigma 50: 2.3 % of the pixels clip at 0.
+ * A Pearson chi-square over every value with 20 or more expected pixels (the tails
+ * pooled) on three frames, and the share at 0 on its own. */
+static void dark_law(void)
+{
+    im_sensor s = it_sensor();
+    enum { K = 400 };
+    static long h[K];
+    long tot = 0, n0 = 0;
+    double c = s.bias + 0.5, sg = s.read_noise;
+    memset(h, 0, sizeof h);
+    for (uint64_t seed = 30; seed < 33; seed++) {
+        im_frame *f;
+        fa->synth(&s, NULL, 0, seed, 2, &f, err, sizeof err);
+        for (int i = 0; i < f->width * f->height; i++, tot++) {
+            h[f->px[i] < K - 1 ? f->px[i] : K - 1]++;
+            n0 += f->px[i] == 0;
+        }
+        fa->frame_free(f);
+    }
+    double chi2 = 0, pe = 0, acc = 0;
+    long po = 0;
+    int dof = -1;
+    for (int k = 0; k < K; k++) {
+        double p = k == 0 ? phi((1 - c) / sg) : k == K - 1 ? 1 - phi((k - c) / sg)
+                 : phi((k + 1 - c) / sg) - phi((k - c) / sg);
+        pe += p * tot; po += h[k];                      /* pooled until 20 expected */
+        if (pe >= 20 || k == K - 1) {
+            chi2 += (po - pe) * (po - pe) / pe;
+            dof++;
+            acc += pe;
+            pe = 0; po = 0;
+        }
+    }
+    double e0 = phi((1 - c) / sg) * tot;
+    CHECK(fabs(acc - tot) < 1e-6 * tot && chi2 < dof + 5 * sqrt(2.0 * dof),
+          "dark pixels' counts: chi-square %.1f on %d degrees of freedom", chi2, dof);
+    CHECK(fabs(n0 - e0) < 4 * sqrt(e0), "dark pixels clipped at 0: %ld (%.0f expected)",
+          n0, e0);
+}
+
+/* Every pixel's mean and variance over 600 frames against the model, on a small sensor
+ * with a bright spot under shot noise (peak 10 000 e-: variance 4x the read noise's),
+ * so a pixel drawn from the wrong law -- no Poisson on the spot, a read noise too wide
+ * or too narrow, a seam between the spot's full path and the dark pixels' table --
+ * fails: mean bias + e, variance e + sigma^2 + 1/12 (e from synth_expected). */
+static void pixel_moments(void)
+{
+    enum { W = 64, H = 48, M = 600 };
+    im_sensor s = it_sensor();
+    s.width = W; s.height = H; s.bias = 1000; s.shot_noise = 1;
+    im_spot_src sp = it_spot(30.3, 20.6);
+    sp.peak = 1e4;
+    static double e[W * H], sm[W * H], sq[W * H];
+    memset(sm, 0, sizeof sm); memset(sq, 0, sizeof sq);
+    fa->synth_expected(&s, &sp, 1, e, err, sizeof err);
+    for (int k = 0; k < M; k++) {
+        im_frame *f;
+        fa->synth(&s, &sp, 1, 5000 + (uint64_t)k, 1, &f, err, sizeof err);
+        for (int i = 0; i < W * H; i++) {
+            double d = f->px[i] - s.bias - e[i];
+            sm[i] += d;
+            sq[i] += d * d;
+        }
+        fa->frame_free(f);
+    }
+    double zm = 0, vr_spot = 0, vr_dark = 0;
+    int nspot = 0, ndark = 0;
+    for (int i = 0; i < W * H; i++) {
+        double v = e[i] + s.read_noise * s.read_noise + 1.0 / 12, mu = sm[i] / M;
+        double sv = (sq[i] - M * mu * mu) / (M - 1);
+        zm += mu * mu / (v / M);
+        if (e[i] > 2500) { vr_spot += sv / v; nspot++; }
+        else if (e[i] == 0) { vr_dark += sv / v; ndark++; }
+    }
+    vr_spot /= nspot; vr_dark /= ndark;
+    CHECK(fabs(zm - W * H) < 5 * sqrt(2.0 * W * H),
+          "pixel means against bias + e: chi-square %.0f on %d pixels", zm, W * H);
+    CHECK(nspot > 10 && fabs(vr_spot - 1) < 5 * sqrt(2.0 / (M - 1) / nspot) &&
+          ndark > 1000 && fabs(vr_dark - 1) < 5 * sqrt(2.0 / (M - 1) / ndark),
+          "pixel variances against e + sigma^2 + 1/12: %.4f on %d spot pixels, %.4f on %d "
+          "dark ones", vr_spot, nspot, vr_dark, ndark);
+}
+
 static void stats(const im_frame *f, double *mean, double *var)
 {
     double m = 0, q = 0, n = (double)f->width * f->height;
@@ -463,7 +567,10 @@ int main(int argc, char **argv)
     fa = it_api();
     dir = argc > 1 ? argv[1] : "/tmp";
     determinism();
+    determinism_dark();
     noise_model();
+    dark_law();
+    pixel_moments();
     quantisation();
     binning();
     analytic();
