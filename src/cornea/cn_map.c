@@ -7,20 +7,8 @@
 #include <stdint.h>
 #include <string.h>
 #include "cn_int.h"
+#include "common/lm_rand.h"
 
-static uint64_t splitmix(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-static double gauss(uint64_t *s)
-{
-    double u1 = ((splitmix(s) >> 11) + 0.5) / 9007199254740992.0;
-    double u2 = ((splitmix(s) >> 11) + 0.5) / 9007199254740992.0;
-    return sqrt(-2 * log(u1)) * cos(2 * M_PI * u2);
-}
 
 int cn_reimage(const rg_geometry *g, int model, const cn_params *p, const cn_bump *bump,
                double sigma, unsigned long long seed, cn_spot *spots, int n)
@@ -31,7 +19,7 @@ int cn_reimage(const rg_geometry *g, int model, const cn_params *p, const cn_bum
     int on = 0;
     for (int i = 0; i < n; i++) {
         cn_spot *s = &spots[i];
-        double nu = gauss(&st), nv = gauss(&st), u, v;
+        double nu = lm_gauss(&st), nv = lm_gauss(&st), u, v;
         s->nres = NAN;
         if (cn_forward_bump(model, p, bump, g->cornea.trans, &pl, &s->ray, &u, &v, NULL,
                             NULL)) {

@@ -7,20 +7,8 @@
 #include <stdio.h>
 #include <string.h>
 #include "cn_int.h"
+#include "common/lm_rand.h"
 
-static uint64_t splitmix(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-static double gauss(uint64_t *s)
-{
-    double u1 = ((splitmix(s) >> 11) + 0.5) / 9007199254740992.0;
-    double u2 = ((splitmix(s) >> 11) + 0.5) / 9007199254740992.0;
-    return sqrt(-2 * log(u1)) * cos(2 * M_PI * u2);
-}
 
 int cn_simulate(const rig_api *rg, const rg_geometry *g, const rg_cornea *truth,
                 const cn_scan_opts *o, cn_spot *spots, int cap, char *err, size_t errcap)
@@ -59,7 +47,7 @@ int cn_simulate(const rig_api *rg, const rg_geometry *g, const rg_cornea *truth,
         rg_beam b;
         rg->forward(&gt, &pose, &b, e, sizeof e);
         sp->sigma = o->sigma > 0 ? o->sigma : 1e-4;
-        double nu = gauss(&seed), nv = gauss(&seed);   /* drawn for every target:
+        double nu = lm_gauss(&seed), nv = lm_gauss(&seed);   /* drawn for every target:
                                                           the noise of point k does
                                                           not depend on the others */
         double dn = b.d3[0] * pl.w[0] + b.d3[1] * pl.w[1] + b.d3[2] * pl.w[2];

@@ -13,6 +13,7 @@
 #include <string.h>
 #include <time.h>
 #include "cornea_loop.h"
+#include "../common/lm_rand.h"
 #include "../imaging/imaging.h"
 #include "../trace/trace.h"
 
@@ -114,20 +115,6 @@ int cl_pattern(int pattern, int n, double zone, rg_target *t)
 
 /* ---- per-point work ---------------------------------------------------------------- */
 
-static uint64_t splitmix(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-static double gauss(uint64_t *s)
-{
-    double u1 = ((splitmix(s) >> 11) + 0.5) / 9007199254740992.0;
-    double u2 = ((splitmix(s) >> 11) + 0.5) / 9007199254740992.0;
-    return sqrt(-2 * log(u1)) * cos(2 * PI * u2);
-}
 
 static double dot(const double a[3], const double b[3])
 {
@@ -378,7 +365,7 @@ static void measure_one(job *j, im_centroider *cz, int k)
         return;
     }
     uint64_t s = r->seed * 0x9E3779B97F4A7C15ull ^ (uint64_t)k * 0xD1B54A32D192ED03ull;
-    double nu = gauss(&s), nv = gauss(&s);
+    double nu = lm_gauss(&s), nv = lm_gauss(&s);
     q->spot.u = q->hit_u + (r->sigma > 0 ? r->sigma * nu : 0);
     q->spot.v = q->hit_v + (r->sigma > 0 ? r->sigma * nv : 0);
     q->spot.status = CN_S_OK;

@@ -8,6 +8,15 @@
 #include <strings.h>
 #include "lens_text.h"
 
+int ln_vfail(char *err, size_t cap, const char *src, long line, const char *fmt,
+             va_list ap)
+{
+    char why[LN_ERR_MAX];
+    vsnprintf(why, sizeof why, fmt, ap);
+    snprintf(err, cap, "%s:%ld: %s", src, line, why);
+    return LN_BAD;
+}
+
 static void vput(char **s, size_t *len, size_t *cap, int *err, const char *fmt, va_list ap)
 {
     va_list aq;

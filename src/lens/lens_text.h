@@ -11,6 +11,10 @@ void ln_buf_printf(ln_buf *b, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 /* b's text (malloc'd), or NULL (freed) if a printf ran out of memory. */
 char *ln_buf_done(ln_buf *b);
+/* "SRC:LINE: " and the message into err (cap bytes); returns LN_BAD (the readers'
+ * one way to refuse a line). */
+int ln_vfail(char *err, size_t cap, const char *src, long line, const char *fmt,
+             va_list ap);
 void ln_note(ln_notes *n, const char *src, long line, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 

@@ -31,13 +31,11 @@ typedef struct rd {
 static int bad(rd *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static int bad(rd *r, const char *fmt, ...)
 {
-    char why[LN_ERR_MAX];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(why, sizeof why, fmt, ap);
+    int rc = ln_vfail(r->err, r->cap, r->src, r->line, fmt, ap);
     va_end(ap);
-    snprintf(r->err, r->cap, "%s:%ld: %s", r->src, r->line, why);
-    return LN_BAD;
+    return rc;
 }
 
 static int number(rd *r, const char *what, const char *tok, int allow_inf, double *v)

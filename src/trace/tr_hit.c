@@ -198,6 +198,18 @@ static void near_edge(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
     }
 }
 
+/* The analytic surface the intersection callbacks kept (x->best_*) as the hit: 1. */
+static int analytic_hit(const tr_ctx *x, int surf, tr_hitrec *h)
+{
+    h->surf = surf;
+    h->prim = -1;
+    h->t = x->best_t;
+    v_set(h->n, x->best_n);
+    h->far = x->best_far;
+    v_set(h->q, x->best_q);
+    return 1;
+}
+
 /* Nearest hit among what Embree holds, its ray starting at o + ta d; 0 if none. */
 static int embree_nearest(const trace_scene *sc, int float_hits, const double o[3],
                           const double d[3], int last_surf, long last_prim, double ta,
@@ -256,15 +268,7 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     if (!float_hits) near_edge(sc, &x, &rh, o, d, last_surf, last_prim, ta);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return 0;
     const tr_surf *f = sc->surf[rh.hit.geomID];
-    if (!f->is_mesh) {
-        h->surf = f->id;
-        h->prim = -1;
-        h->t = x.best_t;
-        v_set(h->n, x.best_n);
-        h->far = x.best_far;
-        v_set(h->q, x.best_q);
-        return 1;
-    }
+    if (!f->is_mesh) return analytic_hit(&x, f->id, h);
     long prim = rh.hit.primID;
     double t = float_hits ? ta + rh.ray.tfar : tri_plane_t(f, prim, o, d), n[3];
     if (!(t > 0 && isfinite(t))) t = ta + rh.ray.tfar;
@@ -280,15 +284,8 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
         if (v_dot(an, n) < 0) { an[0] = -an[0]; an[1] = -an[1]; an[2] = -an[2]; }
         v_set(n, an);
     }
-    if (x.best_surf >= 0 && x.best_t < t) {      /* an analytic surface is nearer */
-        h->surf = x.best_surf;
-        h->prim = -1;
-        h->t = x.best_t;
-        v_set(h->n, x.best_n);
-        h->far = x.best_far;
-        v_set(h->q, x.best_q);
-        return 1;
-    }
+    if (x.best_surf >= 0 && x.best_t < t)         /* an analytic surface is nearer */
+        return analytic_hit(&x, x.best_surf, h);
     h->surf = f->id;
     h->prim = prim;
     h->t = t;
