@@ -9,6 +9,9 @@ PKGS="$PKGS pkg-config zlib1g-dev"   # the imaging module: OpenCV flags, PNG dat
 PKGS="$PKGS gcc-aarch64-linux-gnu libc6-dev-arm64-cross"   # make check: arm64 compile
 PKGS="$PKGS parallel"   # scripts/cornea-study.sh: GNU parallel fans the eyes out
 PKGS="$PKGS rsync openssh-client"   # cornea-study.sh -S: parallel sends files with rsync over ssh
+PKGS="$PKGS libfftw3-dev"   # the wave-optics engine: PSF and MTF transforms
+PKGS="$PKGS libdouble-conversion-dev libhdf5-dev python3-numpy"   # trace outputs: shortest round-trip numbers, HDF5; .npy read back by NumPy in tests
+PKGS="$PKGS stress-ng"   # make check on a loaded machine (tests and the stop check)
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||
