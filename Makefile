@@ -142,10 +142,15 @@ install: all
 	    install -m 644 "$$m" $(DESTDIR)$(MODDIR)/; done
 	install -m 644 doc/lensmat.1 $(DESTDIR)$(MANDIR)/lensmat.1
 	install -m 644 README.md $(DESTDIR)$(DOCDIR)/README.md
+	install -d $(DESTDIR)$(DOCDIR)/doc/img
+	install -m 644 doc/*.md $(DESTDIR)$(DOCDIR)/doc/
+	install -m 644 doc/img/*.png $(DESTDIR)$(DOCDIR)/doc/img/
 uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/lensmat $(DESTDIR)$(MODDIR)/lensmat-*.so \
 	    $(DESTDIR)$(MANDIR)/lensmat.1 $(DESTDIR)$(DOCDIR)/README.md
-	-rmdir $(DESTDIR)$(MODDIR) $(DESTDIR)$(DOCDIR) 2> /dev/null
+	rm -f $(DESTDIR)$(DOCDIR)/doc/*.md $(DESTDIR)$(DOCDIR)/doc/img/*.png
+	-rmdir $(DESTDIR)$(DOCDIR)/doc/img $(DESTDIR)$(DOCDIR)/doc $(DESTDIR)$(MODDIR) \
+	    $(DESTDIR)$(DOCDIR) 2> /dev/null
 
 clean:
 	rm -rf build lensmat example.rec

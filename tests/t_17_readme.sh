@@ -1,6 +1,5 @@
-# t_17_readme.sh -- every command README.md shows is run and checked, by the
-# convention README's "README's examples" paragraph (section "Tests, benchmarks,
-# fuzzing") sets out:
+# t_17_readme.sh -- every command README.md and doc/*.md show is run and checked, by
+# the convention doc/hacking.md's "README's examples" paragraph sets out:
 # - a block fenced ```sh is a script: its lines run in order with `sh -e`;
 # - a block fenced ```console holds `$ COMMAND` lines, each followed by the output
 #   it shows (stdout and stderr, trailing blanks ignored; a line `...` stands for any
@@ -22,14 +21,29 @@ for e in "$TOP"/* "$TOP"/.[!.]*; do
     ln -s "$e" "$RM_DIR/run/${e##*/}"
 done
 
-# Cut README into blocks: blocks/NNNNN.sh or .console, NNNNN the line of the fence.
-awk -v dir="$RM_DIR/blocks" '
-    !inb && /^```(sh|console)[ \t]*$/ {
-        inb = 1; kind = substr($0, 4); sub(/[ \t]+$/, "", kind)
-        f = sprintf("%s/%05d.%s", dir, NR, kind); printf "" > f; next }
-    !inb && /^```/ { other = !other; next }
-    inb && /^```/ { inb = 0; close(f); next }
-    inb { print > f }' "$TOP/README.md"
+# The documents whose blocks run: README.md, then the doc/*.md files in the order
+# README links them, then any other doc/*.md (alphabetical).  All share one scratch
+# folder, so a later document may use the files an earlier one's blocks wrote.
+RM_DOCS=README.md
+for d in $(grep -o '](doc/[A-Za-z0-9_-]*\.md)' "$TOP/README.md" | sed 's/^](//; s/)$//') \
+         $(cd "$TOP" && ls doc/*.md 2>/dev/null); do
+    case " $RM_DOCS " in *" $d "*) ;; *) [ -f "$TOP/$d" ] && RM_DOCS="$RM_DOCS $d" ;; esac
+done
+
+# Cut each document into blocks: blocks/KKK.NNNNN.sh or .console, KKK the document's
+# place in RM_DOCS, NNNNN the line of the fence; blocks/KKK.name holds its name.
+k=0
+for d in $RM_DOCS; do
+    k=$((k + 1)); kk=$(printf '%03d' "$k")
+    awk -v dir="$RM_DIR/blocks" -v kk="$kk" '
+        !inb && /^```(sh|console)[ \t]*$/ {
+            inb = 1; kind = substr($0, 4); sub(/[ \t]+$/, "", kind)
+            f = sprintf("%s/%s.%05d.%s", dir, kk, NR, kind); printf "" > f; next }
+        !inb && /^```/ { other = !other; next }
+        inb && /^```/ { inb = 0; close(f); next }
+        inb { print > f }' "$TOP/$d"
+    printf '%s\n' "$d" > "$RM_DIR/docname.$kk"
+done
 
 # PATH without any folder that holds a lensmat (an installed one must not hide a
 # bare `lensmat` in README)
@@ -67,12 +81,14 @@ readme_match() {
 
 for b in "$RM_DIR"/blocks/*; do
     [ -e "$b" ] || continue
-    n=$(basename "$b"); line=$(expr "${n%%.*}" + 0); kind=${n#*.}
+    n=$(basename "$b"); kk=${n%%.*}; rest=${n#*.}
+    line=$(expr "${rest%%.*}" + 0); kind=${rest#*.}
+    doc=$(cat "$RM_DIR/docname.$kk")
     if [ "$kind" = sh ]; then
         { cat "$RM_DIR/make.sh"
           sed 's/^[ \t]*make\([ \t]\)/readme_make\1/; s/^[ \t]*make$/readme_make/' "$b"; } \
             > "$RM_DIR/block.sh"
-        check "README.md:$line: the sh block runs" sh -c "cd '$RM_DIR/run' &&
+        check "$doc:$line: the sh block runs" sh -c "cd '$RM_DIR/run' &&
             PATH='$RM_PATH' README_TOP='$TOP' sh -e '$RM_DIR/block.sh'"
     else
         # one command and its shown output at a time
@@ -82,19 +98,19 @@ for b in "$RM_DIR"/blocks/*; do
                      printf "" > f; next }
             f { print > f }' "$b"
         for c in "$RM_DIR"/cmd*; do
-            [ -e "$c" ] || { fail "README.md:$line: a console block without a \$ command"; break; }
+            [ -e "$c" ] || { fail "$doc:$line: a console block without a \$ command"; break; }
             k=${c##*/cmd}; cmd=$(cat "$c")
             disp=$(printf '%s' "$cmd" | tr '\\' '/' | cut -c1-70)   # echo-safe name
             want=0
             case $cmd in *"# exit "[0-9]*) want=${cmd##*# exit } ;; esac
             (cd "$RM_DIR/run" && PATH=$RM_PATH sh -c "$cmd" > "$RM_DIR/got" 2>&1); rc=$?
             if [ "$rc" -ne "$want" ]; then
-                fail "README.md:$line: \$ $disp: exit status $rc, README expects $want"
+                fail "$doc:$line: \$ $disp: exit status $rc, README expects $want"
                 sed 's/^/    /' "$RM_DIR/got" | head -20
             elif readme_match "$RM_DIR/out$k" "$RM_DIR/got" > "$RM_DIR/why"; then
-                pass "README.md:$line: \$ $disp"
+                pass "$doc:$line: \$ $disp"
             else
-                fail "README.md:$line: \$ $disp: output differs"
+                fail "$doc:$line: \$ $disp: output differs"
                 sed 's/^/    /' "$RM_DIR/why"
             fi
         done
@@ -110,3 +126,17 @@ printf 'a\nc\n' > "$RM_DIR/w2"
 if readme_match "$RM_DIR/w2" "$RM_DIR/g1" > /dev/null; then fail "readme test: extra output not caught"
 else pass "readme test: extra output caught"; fi
 check "readme test: bare lensmat is not on PATH" sh -c "cd '$RM_DIR/run' && PATH='$RM_PATH' && ! command -v lensmat"
+
+# README stays what a first hour needs; the reference is in doc/, and every link resolves
+check "README.md is at most 400 lines" sh -c "[ \$(wc -l < '$TOP/README.md') -le 400 ]"
+rm_links() {
+    for d in $RM_DOCS; do
+        dir=$(dirname "$TOP/$d")
+        for l in $(grep -o '](\([A-Za-z0-9_./-]*\))' "$TOP/$d" | sed 's/^](//; s/)$//'); do
+            case $l in http*|\#*) continue ;; esac
+            [ -e "$dir/${l%%#*}" ] || { echo "$d links $l: no such file"; return 1; }
+        done
+    done
+}
+check "README.md and doc/*.md: every relative link names a file" rm_links
+check "README.md links doc/ documents" sh -c "[ \$(echo $RM_DOCS | wc -w) -gt 5 ]"
