@@ -49,7 +49,7 @@ if [ -n "$SSH" ] && [ "$SSH" != : ]; then
 fi
 mkdir -p "$DIR"
 cd "$DIR"
-rm -f eye-*.in eye-*.rec eye-*.txt eye-*.csv eye-*.json eye-*.out study.tsv percentiles.tsv
+rm -f eye-*.in eye-*.rec eye-*.txt eye-*.csv eye-*.json eye-*.out study.tsv percentiles.tsv joblog.txt
 
 # 1. the population: one answers file per eye (awk's generator, seeded)
 awk -v M="$M" -v seed="$SEED" -v pts="$POINTS" -v model="$MODEL" '
@@ -84,7 +84,28 @@ if [ -n "$SSH" ]; then
     set -- "$@" --sshlogin "$SSH" --trc '{.}.rec' --trc '{.}.txt' --trc '{.}.csv' --trc '{.}.json' --trc '{.}.out'
 fi
 t0=$(date +%s.%N)
-ls eye-*.in | parallel "$@" "'$LENSMAT' --cornea-scan {.}.rec < {} > {.}.out 2>&1" || true
+# parallel runs in the background so that a signal reaches this script at once (sh
+# runs a trap only after the foreground command ends); the trap passes SIGTERM on to
+# parallel, which stops its running jobs (each lensmat leaves no half-written file),
+# waits for it and removes this script's own partial tables.
+ls eye-*.in > eyes.list
+parallel "$@" "'$LENSMAT' --cornea-scan {.}.rec < {} > {.}.out 2>&1" < eyes.list &
+par=$!
+study_stop() {
+    trap '' INT TERM HUP
+    kill -TERM "$par" 2> /dev/null || true
+    wait "$par" 2> /dev/null || true   # (set -e: parallel's non-zero status must not end the trap)
+    rm -f eyes.list study.tsv.part percentiles.tsv.part
+    done_n=$(awk 'NR > 1 && $7 == 0' joblog.txt 2> /dev/null | wc -l)
+    echo "$0: interrupted ($1): the running eyes were stopped; $done_n of $M eyes had finished (their files are in $DIR)" >&2
+    exit "$2"
+}
+trap 'study_stop SIGINT 130' INT
+trap 'study_stop SIGTERM 143' TERM
+trap 'study_stop SIGHUP 129' HUP
+wait "$par" || true
+trap - INT TERM HUP
+rm -f eyes.list
 t1=$(date +%s.%N)
 failed=$(awk 'NR > 1 && $7 != 0' joblog.txt | wc -l)
 
