@@ -103,8 +103,14 @@ TEST_BINS += build/fuzz_lens
 
 -include $(wildcard src/*/*.mk)
 
-check: $(TEST_BINS) $(MODULE_TEST_BINS)
+# make check builds in parallel by itself (one job per core) unless the caller gave
+# -j: the test binaries are many independent builds, the tests then run in order.
+NPROC     := $(shell nproc 2> /dev/null || echo 2)
+CHECK_J    = $(if $(filter -j%,$(MAKEFLAGS)),,-j$(NPROC))
+check:
+	@$(MAKE) --no-print-directory $(CHECK_J) check-bins
 	@sh tests/run.sh
+check-bins: $(TEST_BINS) $(MODULE_TEST_BINS)
 
 build/bench/%: tests/bench/%.c | $(DEPS)
 	@mkdir -p $(@D)
@@ -155,6 +161,6 @@ uninstall:
 clean:
 	rm -rf build lensmat example.rec
 
-.PHONY: all check bench fuzz example clean install uninstall
+.PHONY: check-bins all check bench fuzz example clean install uninstall
 .SECONDARY:
 -include $(OBJ:.o=.d) $(SANOBJ:.o=.d)
