@@ -24,6 +24,7 @@ int lm_magnifier(lm_io *io);   const char *lm_magnifier_example(void);
 int lm_microscope(lm_io *io);  const char *lm_microscope_example(void);
 int lm_telescope(lm_io *io);   const char *lm_telescope_example(void);
 int lm_vision(lm_io *io);      const char *lm_vision_example(void);
+int lm_beam(lm_io *io);        const char *lm_beam_example(void);
 int lm_cornea(lm_io *io);      const char *lm_cornea_example(void);
 int lm_cornea_scan(lm_io *io); const char *lm_cornea_scan_example(void);
 int lm_fit(lm_io *io);         const char *lm_fit_example(void);

@@ -464,4 +464,37 @@ typedef struct px_pupil {
 } px_pupil;
 int px_pupil_run(const px_pupil_in *in, px_pupil *out);
 
+/* ---- Gaussian beams (beam.c; section 46) ----
+ * A beam of vacuum wavelength lambda and beam quality M^2 is carried as its reduced
+ * complex parameter qhat = q/n, q = z + i zR in the medium of index n (z: distance
+ * past the waist, zR = pi n w0^2 / (M^2 lambda) the Rayleigh range), so that the
+ * system matrices of this engine (reduced distances, det 1) act on it directly:
+ * qhat' = (A qhat + B) / (C qhat + D).  All lengths in one unit, lambda too.
+ * w is the 1/e^2 intensity radius (of the embedded Gaussian times M). */
+typedef struct px_beam {
+    double qre, qim;           /* qhat = qre + i qim; qim > 0 */
+    double lambda, m2;         /* vacuum wavelength, M^2 >= 1 */
+    double n;                  /* index of the medium the beam is in */
+} px_beam;
+typedef struct px_beam_at {
+    double w;                  /* beam radius here */
+    double r;                  /* wavefront radius (+: diverging, centre left); inf: flat */
+    double z_waist;            /* distance from here to the waist (+: waist right) */
+    double w0;                 /* waist radius */
+    double zr;                 /* Rayleigh range in this medium */
+    double theta;              /* far-field half-angle divergence M^2 lambda/(pi n w0) */
+    double gouy;               /* Gouy phase atan(z/zR) here, radians */
+} px_beam_at;
+/* The beam with waist radius w0 a distance z_past past its waist, in index n;
+ * PX_OK, or PX_BAD for w0, lambda, n <= 0, m2 < 1 or non-finite values. */
+int px_beam_waist(double w0, double z_past, double lambda, double m2, double n,
+                  px_beam *b);
+/* The beam of radius w and wavefront radius r (inf: flat) at a plane; PX_BAD as
+ * above. */
+int px_beam_local(double w, double r, double lambda, double m2, double n, px_beam *b);
+/* Through the matrix m (from the medium b->n into n_out); PX_BAD when the
+ * result is not a beam (the matrix is singular or not finite). */
+int px_beam_apply(px_beam *b, px_mat m, double n_out);
+void px_beam_props(const px_beam *b, px_beam_at *at);
+
 #endif
