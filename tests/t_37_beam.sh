@@ -25,3 +25,25 @@ check "--beam: an element left of the previous one stops a replay at its line" \
     beam_bad 'mm\n632.8\n1\n1\n0.4\n0\nlens\n100\n50\nplane\n90\n' 11
 check "--beam: a lens of focal length 0 stops a replay" beam_bad 'mm\n632.8\n1\n1\n0.4\n0\nlens\n100\n0\n' 9
 check "--beam is listed by --help" sh -c "'$BIN' --help | grep -q -- '--beam'"
+# The cornea as a convex mirror (R 7.8 mm, unfolded: f = -3.9 mm): a 1 mm waist on it
+# leaves a virtual waist where Self's formula puts it, and the beam 100 mm on is the
+# far-field closed form's (an independent awk model)
+beam_cornea() {
+    printf 'mm\n632.8\n1\n1\n1\n0\nmirror\n0\n7.8\nplane\n100\nend\n' > "$BM/c.in"
+    (cd "$BM" && "$BIN" --beam -i c.in c.rec > /dev/null) || return 1
+    awk 'BEGIN { pi = 3.14159265358979; l = 632.8e-6; w0 = 1; f = -3.9
+                 zr = pi * w0 * w0 / l; s = 0
+                 s2 = 1 / (1 / f - 1 / (s + zr * zr / (s - f)))
+                 m = 1 / sqrt((1 - s / f) ^ 2 + (zr / f) ^ 2); w1 = m * w0; zr1 = pi * w1 * w1 / l
+                 w100 = w1 * sqrt(1 + ((100 - s2) / zr1) ^ 2)
+                 printf "%.6g %.6g %.5g\n", s2, w1, w100 }' > "$BM/c.want"
+    got=$(sed -n 's/^After it (index 1): waist w0= \([^ ]*\) at z= \([^,]*\),.*/\2 \1/p' "$BM/c.rec")
+    got="$got $(sed -n 's/^At z= 100: beam radius w= \([^,]*\),.*/\1/p' "$BM/c.rec")"
+    set -- $(cat "$BM/c.want"); zw=$1 w1=$2 w100=$3
+    awk -v g="$got" -v zw="$zw" -v w1="$w1" -v w100="$w100" 'BEGIN {
+        split(g, a, " ")
+        ok = (a[1] - zw) ^ 2 < 1e-10 && ((a[2] - w1) / w1) ^ 2 < 1e-10 && ((a[3] - w100) / w100) ^ 2 < 1e-9
+        if (!ok) printf "got %s, want waist at %s, w0 %s, w(100) %s\n", g, zw, w1, w100
+        exit !ok }'
+}
+check "--beam: the cornea as a convex mirror (R 7.8 mm) against Self's formula and the far field" beam_cornea

@@ -1,6 +1,7 @@
 /* beam.c -- the --beam dialogue: a Gaussian beam (waist, wavelength, M^2) carried
  * through thin lenses, refracting surfaces and planes placed along the axis, its
- * radius, wavefront radius and new waist printed at each (section 46).  Texts in
+ * radius, wavefront radius and new waist printed at each (section 46); mirrors are
+ * unfolded (the cornea of the rig is a convex mirror).  Texts in
  * prompts/beam.txt; arithmetic in the paraxial engine (src/paraxial/beam.c). */
 #include <math.h>
 #include "calcio.h"
@@ -39,7 +40,7 @@ static void say_after(calc *c, double z, const px_beam *b)
 
 int lm_beam(lm_io *io)
 {
-    static const char *const kinds[] = {"lens", "surface", "plane", "end", NULL};
+    static const char *const kinds[] = {"lens", "surface", "mirror", "plane", "end", NULL};
     calc cc = {io, PX_MM, "mm"}, *c = &cc;
     double lnm, m2, n0, w0, zw, zprev;
     px_beam b;
@@ -76,13 +77,14 @@ int lm_beam(lm_io *io)
         int kind;
         double z, f = 0, r = 0, n2 = b.n;
         if ((rc = calc_choice(c, BM(ELEMENT), BM(ELEMENT_WHAT), kinds, &kind))) return rc;
-        if (kind == 3) break;
+        if (kind == 4) break;
         calc_mark(c, &mk);
         if ((rc = calc_num(c, BM(Z), BM(Z_WHAT), 0, &z))) return rc;
         if (kind == 0 && (rc = calc_num(c, BM(F), BM(F_WHAT), LM_ALLOW_INF, &f))) return rc;
         if (kind == 1 && ((rc = calc_num(c, BM(R), BM(R_WHAT), LM_ALLOW_PLANE, &r)) ||
                           (rc = calc_index(c, BM(N), BM(N_WHAT), &n2))))
             return rc;
+        if (kind == 2 && (rc = calc_num(c, BM(RM), BM(R_WHAT), LM_ALLOW_PLANE, &r))) return rc;
         /* the first element may stand before the waist; later ones go left to right */
         const char *why = !first && z < zprev ? BM(Z_BACK) : kind == 0 && f == 0 ? BM(F_ZERO) : NULL;
         if (why) {
@@ -95,9 +97,14 @@ int lm_beam(lm_io *io)
         say_at(c, z, &nb);
         if (kind == 0) m = (px_mat){1, 0, isinf(f) ? 0 : -nb.n / f, 1};
         else if (kind == 1) m = px_refraction(nb.n, n2, r);
-        else m = px_identity();
+        else if (kind == 2) {
+            /* unfolded: a mirror of radius r is a lens of power -2n/r (diverging when
+               convex); the reflected beam stays in the same medium */
+            m = (px_mat){1, 0, isinf(r) ? 0 : 2 * nb.n / r, 1};
+            lm_say(c->io, LM_BOTH, "%s", BM(MIRROR_NOTE));
+        } else m = px_identity();
         if (px_beam_apply(&nb, m, n2) != PX_OK) return calc_fail(c, BM(NOT_BEAM));
-        if (kind != 2) say_after(c, z, &nb);
+        if (kind != 3) say_after(c, z, &nb);
         b = nb;
         zprev = z;
         first = 0;
