@@ -99,12 +99,14 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
     io->rec_name = rec_name;
     io->in = in;
     io->src = in_name;
+    lm_files_reset();       /* one session per process: its own files only */
     if (in) {
         struct stat st;
         if (fstat(fileno(in), &st) == 0 && S_ISREG(st.st_mode)) {
             io->in_known = 1;
             io->in_dev = st.st_dev;
             io->in_ino = st.st_ino;
+            lm_files_answers(in_name && in_name[0] != '<' ? in_name : NULL, &st);
         }
     }
     {
@@ -126,7 +128,8 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
             io->rec_known = 1;
             io->rec_dev = st.st_dev;
             io->rec_ino = st.st_ino;
-        }
+            lm_files_record(rec_name, &st);
+        } else lm_files_record(rec_name, NULL);
     }
     /* Interactive means a person types the answers: standard input is a terminal.
      * Prompts still go to stdout (`lensmat x.rec | tee log` keeps them); readline
@@ -142,23 +145,6 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
     }
     signals_setup();
     io->cur = "";
-    return 0;
-}
-
-int lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap)
-{
-    struct stat st;
-    if (stat(path, &st) != 0) return 0;            /* not there yet: nothing to lose */
-    if (io->in_known && st.st_dev == io->in_dev && st.st_ino == io->in_ino) {
-        snprintf(msg, cap, "%s is the file the answers are read from; refusing to "
-                 "write over it", path);
-        return -1;
-    }
-    if (io->rec_known && st.st_dev == io->rec_dev && st.st_ino == io->rec_ino) {
-        snprintf(msg, cap, "%s is the record file of this session; refusing to write "
-                 "over it", path);
-        return -1;
-    }
     return 0;
 }
 

@@ -88,11 +88,31 @@ int  lm_stop_requested(void);
 int  lm_on_stop(void (*fn)(void *ctx), void *ctx);
 void lm_on_stop_remove(void (*fn)(void *ctx), void *ctx);
 void lm_run_stop_hooks(void);
-/* An output file may not be the answers' file or the record (same device and inode,
- * so links and other spellings count): 0 if path is fine (also when it does not
- * exist yet), else -1 with why in msg.  Every dialogue checks each output with it
- * before opening anything for writing. */
+/* The session's files (files.c).  No output may be a file the session reads (the
+ * answers, lens files, scenes and meshes, rig files, frames) and no input one it
+ * writes (the record, outputs named so far), under any spelling, hard link or
+ * symbolic link (same device and inode; a file not there yet by its resolved path).
+ * lm_check_output: 0 if path may be written (also when it does not exist yet; it is
+ * then an output of the session), else -1 with why in msg.  Every dialogue checks
+ * each output with it before opening anything for writing.  lm_check_input: the
+ * same for a file about to be read (a file-name answer's check calls it first): 0
+ * and registered as an input, or -1 with why. */
 int  lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap);
+int  lm_check_input(const lm_io *io, const char *path, char *msg, size_t cap);
+/* Files a module read for the session (a scene's meshes): registered as inputs
+ * (st: a struct stat, or NULL to stat path). */
+void lm_files_note(int is_input, const char *path, const void *st);
+void lm_files_reset(void);
+void lm_files_answers(const char *path, const void *st);
+void lm_files_record(const char *path, const void *st);
+/* An existing OUTFILE that is no lensmat record (a lens file, scene, rig file,
+ * answers file, binary or other text: the -i forgotten) is refused before anything
+ * is opened: -1 with the message (it names -i when lens_from_input: the dialogue
+ * reads its lens from -i), else 0.  Remove the file first to overwrite it.
+ * lens_from_input 2: a converter whose input is given (-i, or not a terminal): its
+ * OUTFILE is a lens file it wrote before, and may be a lens file. */
+int  lm_outfile_check(const char *path, const char *option, int lens_from_input,
+                      char *msg, size_t cap);
 /* After the last question: warn about answers left unread, on the last line read or
  * on any later one, with that line (replay only). */
 void lm_check_leftover(lm_io *io);

@@ -81,6 +81,7 @@ static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
     dsess *d = ctx;
     struct stat st;
     lm_lens_file_free(&d->lf);
+    if (lm_check_input(d->io, word, msg, cap)) return -1;
     if (lm_read_lens(word, &d->lf, msg, cap)) return -1;
     if (d->lf.nsurf > MAXSURF) {
         snprintf(msg, cap, P(TOO_MANY), word, d->lf.nsurf, MAXSURF);

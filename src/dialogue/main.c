@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include "ask.h"
 #include "dialogues.h"
 #include "engine.h"
@@ -134,6 +135,21 @@ int main(int argc, char **argv)
     if (o.dlg->needs && !lm_engine_present(o.dlg->needs)) {
         fprintf(stderr, P(NEEDS_MODULE), o.dlg->option, o.dlg->needs);
         return 1;
+    }
+    {   /* an OUTFILE that is a lens file or the like: the -i forgotten */
+        static const char *const from_input[] = {"--prescription", "--to-prescription",
+                                                 "--to-zmx", "--to-thickness", NULL};
+        char msg[3000];
+        int k = 0;
+        while (from_input[k] && strcmp(from_input[k], o.dlg->option)) k++;
+        int conv = from_input[k] != NULL;
+        if (conv && !strncmp(o.dlg->option, "--to-", 5) && (o.input || o.example ||
+                                                             !isatty(0)))
+            conv = 2;   /* it writes a lens file: an old OUTFILE is its earlier output */
+        if (lm_outfile_check(o.outfile, o.dlg->option, conv, msg, sizeof msg)) {
+            fprintf(stderr, "lensmat: %s\n", msg);
+            return 1;
+        }
     }
     if (!(in = open_answers(&o, &in_name))) return 1;
     if (lm_io_open(&io, o.outfile, in, in_name, o.original) < 0) {

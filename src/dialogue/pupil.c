@@ -72,11 +72,12 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
     pdlg *d = ctx;
     size_t len;
     char err[LN_ERR_MAX];
-    char *text = slurp(word, &len, msg, cap);
+    char *text;
     ln_lens l;
     ln_notes notes = {0};
     int r, read_ok;
-    if (!text) return 1;
+    if (lm_check_input(d->io, word, msg, cap)) return 1;
+    if (!(text = slurp(word, &len, msg, cap))) return 1;
     if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
     else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
     free(text);

@@ -61,11 +61,24 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
     char err[SC_ERRMAX];
     if (t->have_scene) t->api->free(&t->scene);
     t->have_scene = 0;
+    if (lm_check_input(t->io, word, msg, cap)) return -1;
     if (t->api->load(word, &t->scene, err)) {
         snprintf(msg, cap, "%s", err);
         return -1;
     }
     t->have_scene = 1;
+    /* the meshes and media files it read are the session's inputs too */
+    for (int k = 0; k < t->scene.nsurf; k++) {
+        const char *f[2] = {t->scene.surf[k].mesh_file, t->scene.surf[k].media_file};
+        for (int m = 0; m < 2; m++) {
+            char path[2 * WORD + 2];
+            if (!f[m]) continue;
+            if (f[m][0] == '/' || !t->scene.dir || !t->scene.dir[0])
+                snprintf(path, sizeof path, "%s", f[m]);
+            else snprintf(path, sizeof path, "%s/%s", t->scene.dir, f[m]);
+            lm_files_note(1, path, NULL);
+        }
+    }
     /* its outputs (and the .part files written first) must not be the answers or
      * the record (the scene's own inputs the loader checked) */
     const char *out[3] = {t->scene.out_segments, t->scene.out_hits, t->scene.out_summary};
@@ -425,6 +438,7 @@ static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
     double max;
     int cross;
     lm_lens_file_free(lf);
+    if (lm_check_input(NULL, word, msg, cap)) return -1;
     if (lm_read_lens(word, lf, msg, cap)) return -1;
     if (lf->nsurf > MAXSURF) {
         snprintf(msg, cap, P(RECORD_TOO_MANY), word, lf->nsurf, MAXSURF);
