@@ -96,12 +96,13 @@ void lm_run_stop_hooks(void);
  * then an output of the session), else -1 with why in msg.  Every dialogue checks
  * each output with it before opening anything for writing.  lm_check_input: the
  * same for a file about to be read (a file-name answer's check calls it first): 0
- * and registered as an input, or -1 with why. */
+ * and registered as an input (role: "the lens file", for messages), or -1 with why. */
 int  lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap);
-int  lm_check_input(const lm_io *io, const char *path, char *msg, size_t cap);
+int  lm_check_input(const lm_io *io, const char *path, const char *role, char *msg,
+                    size_t cap);
 /* Files a module read for the session (a scene's meshes): registered as inputs
- * (st: a struct stat, or NULL to stat path). */
-void lm_files_note(int is_input, const char *path, const void *st);
+ * (role: "the mesh file", for messages; st: a struct stat, or NULL to stat path). */
+void lm_files_note(const char *role, const char *path, const void *st);
 void lm_files_reset(void);
 void lm_files_answers(const char *path, const void *st);
 void lm_files_record(const char *path, const void *st);
@@ -109,8 +110,9 @@ void lm_files_record(const char *path, const void *st);
  * answers file, binary or other text: the -i forgotten) is refused before anything
  * is opened: -1 with the message (it names -i when lens_from_input: the dialogue
  * reads its lens from -i), else 0.  Remove the file first to overwrite it.
- * lens_from_input 2: a converter whose input is given (-i, or not a terminal): its
- * OUTFILE is a lens file it wrote before, and may be a lens file. */
+ * lens_from_input 2, 3, 4: --to-zmx, --to-thickness, --to-prescription with their
+ * input given (-i, or not a terminal): an OUTFILE of the kind the converter writes
+ * (.zmx, prescription by thickness, by positions) is its earlier output. */
 int  lm_outfile_check(const char *path, const char *option, int lens_from_input,
                       char *msg, size_t cap);
 /* After the last question: warn about answers left unread, on the last line read or

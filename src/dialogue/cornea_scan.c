@@ -98,7 +98,7 @@ static int check_rig(void *ctx, const char *word, char *msg, size_t cap)
     cs *s = ctx;
     s->have_rig = 0;
     if (!strcmp(word, "-")) return 0;
-    if (lm_check_input(s->cc.io, word, msg, cap)) return -1;
+    if (lm_check_input(s->cc.io, word, "the rig file", msg, cap)) return -1;
     if (s->rg->rig_load(word, &s->rig, msg, cap)) return -1;
     s->have_rig = 1;
     return 0;

@@ -24,6 +24,7 @@ typedef struct fent {
     unsigned long long dev, ino;
     char *canon;                     /* realpath, or realpath(folder)/name */
     char *name;                      /* as given, for messages */
+    const char *role;                /* "the lens file": what the session reads it as */
 } fent;
 
 static fent *ents;
@@ -115,10 +116,13 @@ static const fent *find(const fent *e, unsigned kinds)
     return NULL;
 }
 
-void lm_files_note(int is_input, const char *path, const void *st)
+void lm_files_note(const char *role, const char *path, const void *st)
 {
     fent e;
-    if (describe(&e, is_input ? F_INPUT : F_OUTPUT, path, st) == 0) add(&e);
+    if (describe(&e, F_INPUT, path, st) == 0) {
+        e.role = role;
+        add(&e);
+    }
 }
 
 void lm_files_answers(const char *path, const void *st)
@@ -146,15 +150,19 @@ int lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap)
     else if (f && f->kind == F_RECORD)
         snprintf(msg, cap, "%s is the record file of this session; refusing to write "
                  "over it", path);
+    else if (f && !strcmp(f->name, path))
+        snprintf(msg, cap, "%s is %s this session reads; refusing to write over it",
+                 path, f->role ? f->role : "an input");
     else if (f)
-        snprintf(msg, cap, "%s is %s, a file this session reads; refusing to write "
-                 "over it", path, strcmp(f->name, path) ? f->name : "an input");
+        snprintf(msg, cap, "%s is %s, %s this session reads; refusing to write over it",
+                 path, f->name, f->role ? f->role : "an input");
     if (f) { drop(&e); return -1; }
     add(&e);
     return 0;
 }
 
-int lm_check_input(const lm_io *io, const char *path, char *msg, size_t cap)
+int lm_check_input(const lm_io *io, const char *path, const char *role, char *msg,
+                   size_t cap)
 {
     fent e;
     const fent *f;
@@ -168,6 +176,7 @@ int lm_check_input(const lm_io *io, const char *path, char *msg, size_t cap)
         snprintf(msg, cap, "%s is %s, an output of this session: it cannot be read "
                  "as an input too", path, strcmp(f->name, path) ? f->name : "already");
     if (f) { drop(&e); return -1; }
+    e.role = role;
     add(&e);
     return 0;
 }
@@ -175,7 +184,8 @@ int lm_check_input(const lm_io *io, const char *path, char *msg, size_t cap)
 /* ---- an existing OUTFILE ---------------------------------------------------------
  * What a text is, when it is no lensmat record: NULL for a record (or nothing to
  * lose), else "a lens file" and the like.  A record holds "input:" lines among its
- * prompts; one cut short before its first answer holds a prompt or two. */
+ * prompts; one cut short before its first answer holds prompts only, so any text
+ * that is none of the files below counts as a record. */
 static int starts_word(const char *l, const char *w)
 {
     size_t n = strlen(w);
@@ -195,7 +205,7 @@ static const char *kind_of_text(const char *s, size_t len, int *as_input)
     *as_input = 1;
     if (memchr(s, '\0', len)) return "a binary file (an image, a frame?), not a lensmat record";
     if (ln_is_zmx(s, len)) return "a lens file (.zmx)";
-    if (ln_is_rx_thickness(s, len)) return "a lens file (a prescription)";
+    if (ln_is_rx_thickness(s, len)) return "a lens file (a prescription by thickness)";
     for (const char *l = s; l && l < s + len; l = memchr(l, '\n', (size_t)(s + len - l)),
          l = l ? l + 1 : NULL) {
         const char *p = l + strspn(l, " \t");
@@ -213,9 +223,10 @@ static const char *kind_of_text(const char *s, size_t len, int *as_input)
     if (lens && lens >= scene && lens >= rig) return "a lens file (a prescription)";
     if (scene && scene >= rig) return "a scene file";
     if (rig) return "a rig file";
-    *as_input = 0;
-    if (lines <= 2) return NULL;      /* a record that ended at its first question(s) */
-    return "a text file that is not a lensmat record";
+    /* Other text may be a record that ended before its first answer (prompts only):
+     * it is written over as before. */
+    (void)lines;
+    return NULL;
 }
 
 int lm_outfile_check(const char *path, const char *option, int lens_from_input,
@@ -236,7 +247,10 @@ int lm_outfile_check(const char *path, const char *option, int lens_from_input,
     buf[n] = '\0';
     kind = kind_of_text(buf, n, &as_input);
     /* a converter given its input writes a lens file: an earlier one is its output */
-    if (kind && lens_from_input == 2 && !strncmp(kind, "a lens file", 11)) kind = NULL;
+    if (kind && lens_from_input >= 2 &&
+        !strcmp(kind, lens_from_input == 2 ? "a lens file (.zmx)" : lens_from_input == 3 ?
+                "a lens file (a prescription by thickness)" : "a lens file (a prescription)"))
+        kind = NULL;
     /* an answers file is always read with -i; a lens file by the converters */
     if (kind && as_input && !lens_from_input && strncmp(kind, "an answers", 10))
         as_input = 2;

@@ -145,7 +145,8 @@ int main(int argc, char **argv)
         int conv = from_input[k] != NULL;
         if (conv && !strncmp(o.dlg->option, "--to-", 5) && (o.input || o.example ||
                                                              !isatty(0)))
-            conv = 2;   /* it writes a lens file: an old OUTFILE is its earlier output */
+            conv = o.dlg->option[5] == 'z' ? 2 : o.dlg->option[5] == 't' ? 3 : 4;
+            /* it writes a lens file: an old one of its kind is its earlier output */
         if (lm_outfile_check(o.outfile, o.dlg->option, conv, msg, sizeof msg)) {
             fprintf(stderr, "lensmat: %s\n", msg);
             return 1;

@@ -76,13 +76,14 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
     ln_lens l;
     ln_notes notes = {0};
     int r, read_ok;
-    if (lm_check_input(d->io, word, msg, cap)) return 1;
+    if (lm_check_input(d->io, word, "the lens file", msg, cap)) return 1;
     if (!(text = slurp(word, &len, msg, cap))) return 1;
     if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
     else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
     free(text);
     read_ok = r == LN_OK;
     if (r == LN_OK && ln_check(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
+    if (r == LN_OK && ln_check_shape(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
     if (r == LN_OK && isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_HEIGHT) {
         snprintf(err, sizeof err, "%s: object heights as fields need a finite object "
                  "(the object is at infinity: give field angles)", word);

@@ -76,7 +76,7 @@ static int check_rig(void *ctx, const char *word, char *msg, size_t cap)
 {
     rdlg *d = ctx;
     d->have_rig = 0;
-    if (lm_check_input(d->io, word, msg, cap)) return -1;
+    if (lm_check_input(d->io, word, "the rig file", msg, cap)) return -1;
     if (d->api->rig_load(word, &d->rig, msg, cap)) return -1;
     d->have_rig = 1;
     return 0;

@@ -69,7 +69,7 @@ static int check_read(void *ctx, const char *w, char *msg, size_t cap)
     sdlg *d = ctx;
     d->fa->frame_free(d->f);
     d->f = NULL;
-    if (lm_check_input(d->io, w, msg, cap)) return -1;
+    if (lm_check_input(d->io, w, "the frame file", msg, cap)) return -1;
     if (d->bits) return d->fa->read_raw(w, d->width, d->height, d->bits, &d->f, msg, cap) ? -1 : 0;
     return d->fa->read(w, &d->f, &d->colour, msg, cap) ? -1 : 0;
 }
@@ -192,7 +192,7 @@ static int check_source(void *ctx, const char *w, char *msg, size_t cap)
     sdlg *d = ctx;
     im_source *s;
     int rc;
-    if (!strchr(w, '%') && lm_check_input(d->io, w, msg, cap)) return -1;
+    if (!strchr(w, '%') && lm_check_input(d->io, w, "the frame file", msg, cap)) return -1;
     rc = d->fa->source_open(w, d->width, 0, &s, msg, cap);
     if (rc == IM_OK) { d->fa->source_close(s); return 0; }
     /* A sequence's pattern is checked here; its first number comes next. */

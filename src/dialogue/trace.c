@@ -61,7 +61,7 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
     char err[SC_ERRMAX];
     if (t->have_scene) t->api->free(&t->scene);
     t->have_scene = 0;
-    if (lm_check_input(t->io, word, msg, cap)) return -1;
+    if (lm_check_input(t->io, word, "the scene file", msg, cap)) return -1;
     if (t->api->load(word, &t->scene, err)) {
         snprintf(msg, cap, "%s", err);
         return -1;
@@ -76,7 +76,7 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
             if (f[m][0] == '/' || !t->scene.dir || !t->scene.dir[0])
                 snprintf(path, sizeof path, "%s", f[m]);
             else snprintf(path, sizeof path, "%s/%s", t->scene.dir, f[m]);
-            lm_files_note(1, path, NULL);
+            lm_files_note(m ? "the media file" : "the mesh file", path, NULL);
         }
     }
     /* its outputs (and the .part files written first) must not be the answers or
@@ -438,7 +438,7 @@ static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
     double max;
     int cross;
     lm_lens_file_free(lf);
-    if (lm_check_input(NULL, word, msg, cap)) return -1;
+    if (lm_check_input(NULL, word, "the lens file", msg, cap)) return -1;
     if (lm_read_lens(word, lf, msg, cap)) return -1;
     if (lf->nsurf > MAXSURF) {
         snprintf(msg, cap, P(RECORD_TOO_MANY), word, lf->nsurf, MAXSURF);
