@@ -439,7 +439,7 @@ int lm_draw(lm_io *io)
     return LM_GO;
 }
 
-const char *lm_draw_example(void) { return NULL; }
+const char *lm_draw_example(void) { return P(EXAMPLE); }
 
 /* ---- the --trace dialogue's pictures ---------------------------------------------------- */
 
