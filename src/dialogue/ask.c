@@ -454,6 +454,19 @@ int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
         if (r == -3) return LM_FAIL;
         if (r == 0 && strlen(tok) >= cap) r = -2;
         msg[0] = '\0';
+        if (r == 0 && io->word_alone) {     /* a file name: alone on its line */
+            const char *rest = io->cur;
+            char next[LM_TOKEN_MAX];
+            if (lm_next_token(&rest, next, sizeof next) != 0) {
+                char a[64], b[64];
+                snprintf(a, sizeof a, "%.40s", tok);
+                snprintf(b, sizeof b, "%.40s", next);
+                snprintf(msg, sizeof msg, "'%s' and then '%s' on the same line: a file "
+                         "name that holds a blank must be quoted (\"%s %s\"), and nothing "
+                         "may follow a file name on its line", a, b, a, b);
+                r = -6;
+            }
+        }
         if (r == 0 && check && check(ctx, tok, msg, sizeof msg)) r = -6;
         if (r != 0) {
             if (r == -2) snprintf(msg, sizeof msg, "the answer is too long");
@@ -468,6 +481,17 @@ int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
         show_answer(io, echo);
         return LM_GO;
     }
+}
+
+int lm_ask_file(lm_io *io, const char *out, const char *rec, const char *what,
+                int (*check)(void *ctx, const char *word, char *msg, size_t cap),
+                void *ctx, char *buf, size_t cap)
+{
+    int rc;
+    io->word_alone = 1;
+    rc = lm_ask_word(io, out, rec, what, check, ctx, buf, cap);
+    io->word_alone = 0;
+    return rc;
 }
 
 /* Answers left after the end: on the last line read, or on any later line (a file

@@ -24,6 +24,7 @@ typedef struct lm_io {
     const char *cur;        /* unread part of buf */
     int in_known, rec_known;   /* in_dev/in_ino, rec_dev/rec_ino are valid */
     unsigned long long in_dev, in_ino, rec_dev, rec_ino;
+    int word_alone;         /* lm_ask_file: the word must end its line */
 } lm_io;
 
 /* Output streams for lm_say. */
@@ -73,6 +74,13 @@ int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
  * (terminal: message and ask again; replay: SRC:LINE message, LM_FAIL) and is not
  * echoed, so a record never holds a rejected answer. */
 int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
+                int (*check)(void *ctx, const char *word, char *msg, size_t cap),
+                void *ctx, char *buf, size_t cap);
+/* lm_ask_word for a file name: the name must be the last answer on its line, so
+ * that `my log.txt` typed without quotes is not taken as "my" (and "log.txt" as the
+ * next answer): two words are explained with the quoting rule (terminal: asked
+ * again; replay: SRC:LINE, LM_FAIL). */
+int lm_ask_file(lm_io *io, const char *out, const char *rec, const char *what,
                 int (*check)(void *ctx, const char *word, char *msg, size_t cap),
                 void *ctx, char *buf, size_t cap);
 /* Stopping (SIGINT, SIGTERM, SIGHUP).  A signal while lensmat waits for an answer,

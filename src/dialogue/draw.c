@@ -163,7 +163,7 @@ static int read_lens(dsess *d)
     char *name = d->name;
     double semi[MAXSURF];
     int rc;
-    if ((rc = lm_ask_word(d->io, P(LENS_FILE), P(LENS_FILE), P(LENS_FILE_WHAT),
+    if ((rc = lm_ask_file(d->io, P(LENS_FILE), P(LENS_FILE), P(LENS_FILE_WHAT),
                           check_lens_file, d, name, sizeof d->name)))
         return rc;
     snprintf(q, sizeof q, P(SEMI), d->lf.nsurf);
@@ -360,7 +360,7 @@ static int picture(dsess *d, int what)
     if (what == W_SPOT && d->sc.unit &&
         (rc = lm_ask_number(io, P(WAVELENGTH), P(WAVELENGTH), &wl, &nm)))
         return rc;
-    if ((rc = lm_ask_word(io, P(PICTURE), P(PICTURE), P(PICTURE_WHAT), check_picture, &p, png,
+    if ((rc = lm_ask_file(io, P(PICTURE), P(PICTURE), P(PICTURE_WHAT), check_picture, &p, png,
                           sizeof png)))
         return rc;
     if (need_engines(d, &load_ms, &trace_ms)) return LM_FAIL;

@@ -425,6 +425,45 @@ static int is_prescription(const char *s)
     return 0;
 }
 
+/* A record (input: lines among others) whose first line is not the classic's first
+ * question was made by another dialogue: say which (prompts' record_marks), rather
+ * than fail on its first answer ("'mm' is not a number").  1 with err set, or 0. */
+static int other_record(const char *src, const char *s, char *err, size_t cap)
+{
+    const char *first = s, *marks = PS(RECORD_MARKS);
+    int others = 0;
+    if (strncmp(s, "input:", 6) && !strstr(s, "\ninput:")) return 0;
+    for (const char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL)
+        if (*l && *l != '\n' && *l != '#' && strncmp(l, "input:", 6)) { others = 1; break; }
+    while (*first == '#' || *first == '\n') {       /* comment lines before it */
+        const char *nl = strchr(first, '\n');
+        if (!nl) return 0;
+        first = nl + 1;
+    }
+    if (!others || !strncmp(first, "input:", 6) ||
+        !strncmp(first, PS(CLASSIC_FIRST), strlen(PS(CLASSIC_FIRST))))
+        return 0;
+    for (const char *m = marks; *m; ) {
+        const char *tab = strchr(m, '\t'), *nl = strchr(m, '\n');
+        if (!tab || !nl) break;
+        for (const char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL)
+            if (!strncmp(l, tab + 1, (size_t)(nl - tab - 1))) {
+                char opt[32];
+                snprintf(opt, sizeof opt, "%.*s", (int)(tab - m), m);
+                snprintf(err, cap, PS(OTHER_RECORD), src, opt);
+                return 1;
+            }
+        m = nl + 1;
+    }
+    {
+        char line[80];
+        size_t n = strcspn(first, "\r\n");
+        snprintf(line, sizeof line, "%.*s", (int)(n < 70 ? n : 70), first);
+        snprintf(err, cap, PS(OTHER_RECORD_UNKNOWN), src, line);
+    }
+    return 1;
+}
+
 /* If some line starts with "input:" (a classic record), blank every other line;
  * line numbers stay those of the file. */
 static void keep_input_lines(char *s)
@@ -456,6 +495,7 @@ static int lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, 
         return rc;
     }
     if (nul_check(s, len, src, err, cap)) return LM_FAIL;
+    if (other_record(src, s, err, cap)) return LM_FAIL;
     keep_input_lines(s);
     if (!is_prescription(s)) {
         rc = read_answers(&c, lf);

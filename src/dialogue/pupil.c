@@ -639,7 +639,7 @@ int lm_pupil(lm_io *io)
     d->c.io = io;
     d->c.unit = PX_MM;
     d->c.uname = "mm";
-    rc = lm_ask_word(io, P(FILE), P(FILE), P(FILE_WHAT), check_file, d, name, sizeof name);
+    rc = lm_ask_file(io, P(FILE), P(FILE), P(FILE_WHAT), check_file, d, name, sizeof name);
     if (rc == LM_GO) {
         if (d->notes.s && d->notes.len) {
             char *s = d->notes.s, *e;

@@ -385,7 +385,7 @@ static int open_machine(rdlg *d)
         return rc;
     d->sim = b == 0;
     if (d->sim) {
-        if ((rc = lm_ask_word(d->io, P(SIM_LOG), P(SIM_LOG), P(SIM_LOG_WHAT), check_log, d,
+        if ((rc = lm_ask_file(d->io, P(SIM_LOG), P(SIM_LOG), P(SIM_LOG_WHAT), check_log, d,
                               d->log, sizeof d->log)))
             return rc;
         if (strcmp(d->log, "-")) {
@@ -420,7 +420,7 @@ int lm_rig(lm_io *io)
     d->io = io;
     lm_say(io, LM_BOTH, "%s", P(INTRO));
     if (need_engine(d)) { free(d); return LM_FAIL; }
-    rc = lm_ask_word(io, P(RIG_FILE), P(RIG_FILE), P(RIG_FILE_WHAT), check_rig, d, name,
+    rc = lm_ask_file(io, P(RIG_FILE), P(RIG_FILE), P(RIG_FILE_WHAT), check_rig, d, name,
                      sizeof name);
     if (!rc) {
         const rg_rig *r = &d->rig;

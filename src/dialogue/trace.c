@@ -149,7 +149,7 @@ static int do_scene(tdlg *t)
     int rc;
 
     if (need_engine(t)) return LM_FAIL;
-    if ((rc = lm_ask_word(t->io, P(SCENE_FILE), P(SCENE_FILE), P(SCENE_FILE_WHAT),
+    if ((rc = lm_ask_file(t->io, P(SCENE_FILE), P(SCENE_FILE), P(SCENE_FILE_WHAT),
                           check_scene, t, name, sizeof name)))
         return rc;
     lm_say(t->io, LM_BOTH, P(SCENE_LOADED), sc->name, sc->nsurf, sc->nsource, sc->depth,
@@ -505,7 +505,7 @@ static int do_record(tdlg *t)
     double semi;
     int rc;
 
-    if ((rc = lm_ask_word(io, P(RECORD_FILE), P(RECORD_FILE), P(RECORD_FILE_WHAT),
+    if ((rc = lm_ask_file(io, P(RECORD_FILE), P(RECORD_FILE), P(RECORD_FILE_WHAT),
                           check_lens_file, &lf, name, sizeof name)) ||
         (rc = ask_semi_all(t, &lf, &semi)))
         goto out;
