@@ -1,0 +1,63 @@
+# t_54_consistency.sh -- what a user notices across dialogues (doc/files.md): a file
+# name typed with a blank and no quotes is refused with the quoting rule (replay:
+# FILE:LINE, exit 2; the record holds no half of it); a record of another dialogue
+# given where a lens is read says which dialogue made it; make example builds the
+# engine modules a first --trace needs.
+CS=$WORK/cs54
+cs_setup() { rm -rf "$CS"; mkdir -p "$CS"; cp "$TOP/doc/pupil-triplet.rx" "$CS/my lens.rx";
+             cp "$TOP/doc/pupil-triplet.rx" "$CS/my"; }
+two_words() {   # OPTION ANSWERS-BEFORE...: the file question gets `my lens.rx`
+    opt=$1; shift
+    cs_setup
+    (cd "$CS" && { [ $# -eq 0 ] || printf '%s\n' "$@"; printf 'my lens.rx\n'; } > a.in &&
+     "$ASAN" "$opt" -i a.in r.rec > out 2> err); rc=$?
+    [ $rc -eq 2 ] || { echo "exit $rc"; cat "$CS/err"; return 1; }
+    grep -qF "a.in:$(($# + 1)): " "$CS/err" &&
+        grep -qF "'my' and then 'lens.rx' on the same line: a file name that holds a blank must be quoted (\"my lens.rx\")" "$CS/err" ||
+        { cat "$CS/err"; return 1; }
+    ! grep -q '^input: my$' "$CS/r.rec"
+}
+check "--pupil: an unquoted 'my lens.rx' is refused with the quoting rule" two_words --pupil
+check "--draw: the same at its lens-file question" two_words --draw
+check "--trace: the same at its scene question" two_words --trace scene
+quoted_ok() {
+    cs_setup
+    (cd "$CS" && printf '"my lens.rx"\ngrid\n12\ny\n5\n' > a.in && "$BIN" --pupil -i a.in r.rec > out 2> err) ||
+        { cat "$CS/err"; return 1; }
+    grep -qF 'input: "my lens.rx"' "$CS/r.rec"
+}
+check "--pupil: the quoted \"my lens.rx\" is read" quoted_ok
+# a record of another dialogue where a lens is asked
+other_record() {   # DIALOGUE-OF-THE-RECORD READER ANSWERS-AFTER
+    cs_setup
+    (cd "$CS" && "$BIN" "$1" --example other.rec > /dev/null 2>&1 &&
+     printf 'other.rec\n' > a.in && "$BIN" "$2" -i a.in r.rec > out 2> err); rc=$?
+    [ $rc -eq 2 ] || { echo "exit $rc"; cat "$CS/err"; return 1; }
+    grep -qF "a.in:1: the lens file: other.rec: this is a record of lensmat $1, not of the classic dialogue" "$CS/err" ||
+        { cat "$CS/err"; return 1; }
+}
+check "--draw given a --thick record: says --thick made it" other_record --thick --draw
+check "--draw given a --colour record: says --colour made it" other_record --colour --draw
+other_record_prescription() {
+    cs_setup
+    (cd "$CS" && "$BIN" --thin --example other.rec > /dev/null 2>&1 &&
+     "$BIN" --to-prescription -i other.rec r.rx > out 2> err); rc=$?
+    [ $rc -eq 2 ] && grep -qF "other.rec: this is a record of lensmat --thin" "$CS/err"
+}
+check "--to-prescription -i a --thin record: says --thin made it" other_record_prescription
+classic_record_still_read() {
+    cs_setup
+    (cd "$CS" && "$BIN" --example c.rec > /dev/null && "$BIN" --to-prescription -i c.rec c.rx > /dev/null 2> err &&
+     grep -q '^index ' c.rx) || { cat "$CS/err"; return 1; }
+}
+check "a classic record is still read as a lens" classic_record_still_read
+
+# make example: builds the modules (a dry run lists them in its recipe)
+make_example_modules() {
+    make -n -C "$TOP" example 2> /dev/null > "$CS/make.n"
+    for m in trace imaging fit; do
+        grep -q "build/lib/lensmat-$m.so" "$CS/make.n" || { echo "make example does not build lensmat-$m.so"; return 1; }
+    done
+}
+cs_setup
+check "make example builds the engine modules (trace, imaging, fit), not only ./lensmat" make_example_modules
