@@ -61,3 +61,19 @@ make_example_modules() {
 }
 cs_setup
 check "make example builds the engine modules (trace, imaging, fit), not only ./lensmat" make_example_modules
+
+# one reader: an answers file mixing input: lines and plain answers replays in the
+# classic dialogue and is read by every lens reader (--to-thickness, --to-prescription)
+mixed_answers() {
+    cs_setup
+    (cd "$CS" && "$BIN" --example c.rec > /dev/null &&
+     grep input: c.rec | sed 's/^input: //' | awk 'NR % 2 == 0 { print "input: " $0; next } { print }' > mixed.in &&
+     grep -q '^input: ' mixed.in && grep -qv '^input: ' mixed.in &&
+     "$BIN" -i mixed.in c2.rec > /dev/null && cmp c.rec c2.rec &&
+     "$BIN" --to-prescription -i c.rec want.rx > /dev/null 2>&1 &&
+     "$BIN" --to-prescription -i mixed.in got.rx > /dev/null 2> err && cmp want.rx got.rx &&
+     "$BIN" --to-thickness -i c.rec want.t > /dev/null 2>&1 &&
+     "$BIN" --to-thickness -i mixed.in got.t > /dev/null 2>> err && cmp want.t got.t) ||
+        { cat "$CS/err"; return 1; }
+}
+check "an answers file mixing input: lines and plain answers: one reader everywhere" mixed_answers

@@ -428,19 +428,34 @@ static int is_prescription(const char *s)
 /* A record (input: lines among others) whose first line is not the classic's first
  * question was made by another dialogue: say which (prompts' record_marks), rather
  * than fail on its first answer ("'mm' is not a number").  1 with err set, or 0. */
+/* Is s a record (prompts with input: lines), rather than answers (input: lines and
+ * plain answers, read alike, as a dialogue replays them)?  A record's first line is
+ * a prompt; an answers file's first answer, the nearpoint, is a number.  *first:
+ * the first line that is not a comment. */
+static int is_record(const char *s, const char **first)
+{
+    const char *f = s, *p;
+    char tok[LM_TOKEN_MAX];
+    double v;
+    if (strncmp(s, "input:", 6) && !strstr(s, "\ninput:")) return 0;
+    for (;;) {                                       /* comment and blank lines */
+        const char *b = f + strspn(f, " \t\r");
+        const char *nl;
+        if (*b != '#' && *b != '\n') break;
+        if (!(nl = strchr(f, '\n'))) return 0;
+        f = nl + 1;
+    }
+    *first = f;
+    p = f + strspn(f, " \t");
+    if (!strncmp(p, "input:", 6) || !*p) return 0;
+    if (lm_next_token(&p, tok, sizeof tok) <= 0) return 0;
+    return lm_parse_number(tok, &v) != LM_NUM_OK && lm_parse_number(tok, &v) != LM_NUM_PLANE;
+}
+
 static int other_record(const char *src, const char *s, char *err, size_t cap)
 {
     const char *first = s, *marks = PS(RECORD_MARKS);
-    int others = 0;
-    if (strncmp(s, "input:", 6) && !strstr(s, "\ninput:")) return 0;
-    for (const char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL)
-        if (*l && *l != '\n' && *l != '#' && strncmp(l, "input:", 6)) { others = 1; break; }
-    while (*first == '#' || *first == '\n') {       /* comment lines before it */
-        const char *nl = strchr(first, '\n');
-        if (!nl) return 0;
-        first = nl + 1;
-    }
-    if (!others || !strncmp(first, "input:", 6) ||
+    if (!is_record(s, &first) ||
         !strncmp(first, PS(CLASSIC_FIRST), strlen(PS(CLASSIC_FIRST))))
         return 0;
     for (const char *m = marks; *m; ) {
@@ -464,11 +479,12 @@ static int other_record(const char *src, const char *s, char *err, size_t cap)
     return 1;
 }
 
-/* If some line starts with "input:" (a classic record), blank every other line;
+/* In a record (is_record: prompts and "input:" lines), blank every other line;
  * line numbers stay those of the file. */
 static void keep_input_lines(char *s)
 {
-    if (strncmp(s, "input:", 6) && !strstr(s, "\ninput:")) return;
+    const char *first;
+    if (!is_record(s, &first)) return;      /* answers: every line, as a replay reads */
     for (char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL)
         if (strncmp(l, "input:", 6)) memset(l, ' ', strcspn(l, "\n"));
 }
