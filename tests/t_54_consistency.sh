@@ -77,3 +77,30 @@ mixed_answers() {
         { cat "$CS/err"; return 1; }
 }
 check "an answers file mixing input: lines and plain answers: one reader everywhere" mixed_answers
+
+# air: 1.000293 in the classic dialogue (and the calculations, positions
+# prescriptions), 1 in lens files by thickness, .zmx and the catalogue (--colour,
+# --pupil); each says which applies where air is accepted
+air_classic() {
+    cs_setup
+    (cd "$CS" && printf '25\nair\n1\n0\n1.5\nn\n' > a.in && "$BIN" -i a.in a.rec > a.out 2>/dev/null)
+    grep -qF '(air: index 1.000293, air at 589 nm, as this dialogue and positions prescriptions take it; lens files by thickness, .zmx and --colour take air as 1)' "$CS/a.rec" &&
+        grep -qF '(air: index 1.000293' "$CS/a.out" &&
+        grep -q '^input: air$' "$CS/a.rec" &&
+        grep input: "$CS/a.rec" > "$CS/a2.in" && (cd "$CS" && "$BIN" -i a2.in a2.rec > /dev/null 2>&1); cmp "$CS/a.rec" "$CS/a2.rec"
+}
+check "air in the classic dialogue: 1.000293, and it says lens files take 1" air_classic
+air_numbers_unchanged() {   # a numeric answer's bytes are those of golden/
+    cs_setup
+    (cd "$CS" && "$BIN" -i "$GOLDEN/cases/convex_thin_doc.in" c.rec > c.out) && cmp "$CS/c.rec" "$GOLDEN/cases/convex_thin_doc.rec"
+}
+check "air: numeric classic sessions keep golden/'s bytes" air_numbers_unchanged
+air_colour_pupil() {
+    cs_setup
+    (cd "$CS" && "$BIN" --colour --example co.rec > /dev/null && "$BIN" --pupil --example p.rec > /dev/null 2>&1 ||
+        { cd "$CS" && ln -s "$TOP/doc" doc && "$BIN" --pupil --example p.rec > /dev/null; })
+    grep -qF "(air: index 1, the glass catalogue's AIR, as in lens files; the classic dialogue's air is 1.000293)" "$CS/co.rec" &&
+        grep -qF "Air: index 1 (in lens files indices are relative to air, as in OpticStudio; the classic dialogue's air is 1.000293)" "$CS/p.rec" &&
+        grep -q 'indices: air 1.000000 ' "$CS/co.rec"
+}
+check "air in --colour and --pupil: 1, and each says so" air_colour_pupil

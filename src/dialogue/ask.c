@@ -346,7 +346,11 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
             if (k == 1 && lambda == 0) {               /* a medium's name */
                 lm_say(io, LM_REC, "input: %s\n", echo);
                 show_answer(io, echo);
-                lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
+                if (!strcmp(echo, "air"))   /* two airs in lensmat: say which this is */
+                    lm_say(io, LM_BOTH, "(air: index %.7g, air at 589 nm, as this dialogue "
+                           "and positions prescriptions take it; lens files by thickness, "
+                           ".zmx and --colour take air as 1)\n", *v);
+                else lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
                 return LM_GO;
             }
             if (k == 1) {                              /* a glass at a wavelength */

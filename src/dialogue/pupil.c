@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include "calcio.h"
 #include "dialogues.h"
 #include "engine.h"
@@ -602,6 +603,12 @@ static int compute(pdlg *d)
     calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
              l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
              l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
+    {   /* air in a lens file is 1, not the classic's 1.000293: say which applies */
+        int air = !l->obj_glass[0] || !strcasecmp(l->obj_glass, "air");
+        for (int i = 0; i < l->nsurf; i++)
+            air |= !l->surf[i].glass[0] || !strcasecmp(l->surf[i].glass, "air");
+        if (air) calc_say(&d->c, "%s", P(AIR_NOTE));
+    }
     if (l->surf[l->nsurf - 1].t > 0) {
         z_image = zl + l->surf[l->nsurf - 1].t;
         calc_say(&d->c, P(IMAGE_FILE), z_image, d->c.uname);
