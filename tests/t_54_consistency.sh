@@ -104,3 +104,18 @@ air_colour_pupil() {
         grep -q 'indices: air 1.000000 ' "$CS/co.rec"
 }
 check "air in --colour and --pupil: 1, and each says so" air_colour_pupil
+
+# --to-zmx / --to-thickness of a typed classic session: a named glass keeps its name
+# (and so its dispersion), thicknesses are the typed positions' exact differences
+# (doc/triplet.rx's positions: 10.26623 - 9.2666 = 0.99963, not 0.9996299999999998)
+typed_triplet() {
+    cs_setup
+    printf '25\n1\n22.01359\n0\nN-SK16\ny\n-435.76044\n3.25896\n1\ny\n-22.21328\n9.2666\nF2\ny\n20.29192\n10.26623\n1\ny\n79.6836\n15.01664\nN-SK16\ny\n-18.39533\n17.96872\n1\nn\n-1000\nn\n' > "$CS/tri.in"
+    (cd "$CS" && "$BIN" -i tri.in tri.rec > /dev/null && "$BIN" --to-thickness -i tri.rec tri.rx &&
+     "$BIN" --to-zmx -i tri.rec tri.zmx) 2> "$CS/err" || { cat "$CS/err"; return 1; }
+    grep -q '^-22.21328  *0.99963  *F2$' "$CS/tri.rx" && grep -q '^22.01359  *3.25896  *N-SK16$' "$CS/tri.rx" &&
+        ! grep -q '99999\|00000000' "$CS/tri.rx" || { cat "$CS/tri.rx"; return 1; }
+    grep -q '^  GLAS F2 ' "$CS/tri.zmx" && grep -q '^  DISZ 0.99963' "$CS/tri.zmx" &&
+        ! grep -q 'GLAS ___BLANK 1 0 1.62' "$CS/tri.zmx" || { grep 'GLAS\|DISZ' "$CS/tri.zmx"; return 1; }
+}
+check "--to-thickness, --to-zmx of a typed session: glass names kept, thicknesses as typed" typed_triplet

@@ -302,6 +302,7 @@ typedef struct cursor {
     long line;
     char *err;
     size_t errcap;
+    char last[LM_TOKEN_MAX];  /* the last token num() read */
 } cursor;
 
 static int fail_at(cursor *c, const char *what, const char *fmt, const char *tok)
@@ -348,6 +349,7 @@ static int num(cursor *c, const char *what, unsigned flags, double min, double *
     char tok[LM_TOKEN_MAX];
     enum lm_num_status st;
     if (token(c, what, tok)) return LM_FAIL;
+    memcpy(c->last, tok, sizeof c->last);
     st = (flags & LM_INDEX) ? lm_parse_index(tok, v) : lm_parse_number(tok, v);
     if (st == LM_NUM_PLANE && (flags & LM_ALLOW_PLANE)) { *v = INFINITY; return LM_GO; }
     if (st != LM_NUM_OK) {
@@ -359,6 +361,21 @@ static int num(cursor *c, const char *what, unsigned flags, double min, double *
     if ((flags & LM_NONNEG) && *v < 0) return fail_at(c, what, PS(A_NONNEG), tok);
     if ((flags & LM_AT_LEAST) && *v < min) return fail_at(c, what, PS(A_LEFT), tok);
     if ((flags & LM_ALLOW_PLANE) && *v == 0) *v = INFINITY;
+    return LM_GO;
+}
+
+/* An index answer: num's checks, and the glass it names (a catalogue or model glass
+ * without "@": the classic takes it at d, as a lens model does at its primary d),
+ * so that a converted lens keeps the glass, not only its number. */
+static int index_answer(cursor *c, const char *what, double *v, char *glass, size_t cap)
+{
+    char echo[LM_TOKEN_MAX], why[300];
+    double l, n;
+    glass[0] = '\0';
+    if (num(c, what, LM_POSITIVE | LM_INDEX, 0, v)) return LM_FAIL;
+    if (lm_parse_number(c->last, &n) == LM_NUM_SYNTAX && !strchr(c->last, '@') &&
+        lm_index_name(c->last, &n, echo, sizeof echo, &l, why, sizeof why) == 1 && l > 0)
+        snprintf(glass, cap, "%.63s", echo);
     return LM_GO;
 }
 
@@ -382,22 +399,24 @@ static void *grow(void *a, int n, size_t size)
 static int read_answers(cursor *c, lm_lens_file *lf)
 {
     double s[3], z, *no;
+    char glass[64];
     lm_lens_surface *ns;
     char tok[LM_TOKEN_MAX];
     int more;
     if (num(c, PS(W_NEARPOINT), LM_NONNEG, 0, &lf->nearpoint) ||
-        num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &lf->n_object))
+        index_answer(c, PS(W_INDEX), &lf->n_object, lf->obj_glass, sizeof lf->obj_glass))
         return LM_FAIL;
     do {
         if (num(c, PS(W_RADIUS), LM_ALLOW_PLANE, 0, &s[0]) ||
             num(c, PS(W_LOCATION), lf->nsurf ? LM_AT_LEAST : 0,
                 lf->nsurf ? lf->surf[lf->nsurf - 1].z : 0, &s[1]) ||
-            num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &s[2]) ||
+            index_answer(c, PS(W_INDEX), &s[2], glass, sizeof glass) ||
             yn(c, PS(W_ANOTHER_SURFACE), &more))
             return LM_FAIL;
         if (!(ns = grow(lf->surf, lf->nsurf + 1, sizeof *ns))) return fail_at(c, "", "%s", PS(A_MEMORY));
         lf->surf = ns;
-        ns[lf->nsurf++] = (lm_lens_surface){s[0], s[1], s[2]};
+        ns[lf->nsurf] = (lm_lens_surface){s[0], s[1], s[2], ""};
+        memcpy(ns[lf->nsurf++].glass, glass, sizeof glass);
     } while (more);
     do {
         if (num(c, PS(W_OBJECT), 0, 0, &z) || yn(c, PS(W_ANOTHER_OBJECT), &more)) return LM_FAIL;
@@ -494,7 +513,7 @@ static void keep_input_lines(char *s)
 static int lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, char *err,
                         size_t cap, int quiet)
 {
-    cursor c = {src, s, "", 0, err, cap};
+    cursor c = {src, s, "", 0, err, cap, ""};
     char asrc[600], *ans;
     size_t alen;
     rx r;
