@@ -119,3 +119,28 @@ typed_triplet() {
         ! grep -q 'GLAS ___BLANK 1 0 1.62' "$CS/tri.zmx" || { grep 'GLAS\|DISZ' "$CS/tri.zmx"; return 1; }
 }
 check "--to-thickness, --to-zmx of a typed session: glass names kept, thicknesses as typed" typed_triplet
+
+# on a terminal: `my lens.rx` unquoted is explained and asked again, never recorded
+two_words_tty() {
+    cs_setup
+    python3 - "$BIN" "$CS" "$TOP/tests" <<'PYEOF'
+import os, sys
+bin_, d = sys.argv[1:3]
+sys.path.insert(0, sys.argv[3])
+from ptydrive import drive
+rc, out = drive([bin_, "--pupil", "t.rec"],
+                [b"my lens.rx\n", b"\"my lens.rx\"\n", b"grid\n", b"4\n", b"n\n"],
+                cwd=d, home=d, timeout=60)
+rec = open(os.path.join(d, "t.rec")).read()
+fails = []
+if rc != 0: fails.append("exit %d" % rc)
+if "must be quoted (\"my lens.rx\")" not in out or "please answer again" not in out:
+    fails.append("no re-ask with the quoting rule")
+if "input: my\n" in rec: fails.append("half of the name was recorded")
+if "input: \"my lens.rx\"" not in rec: fails.append("the quoted name was not read")
+print("\n".join(fails) or "ok", out[-800:] if fails else "")
+sys.exit(1 if fails else 0)
+PYEOF
+}
+command -v python3 > /dev/null &&
+    check "--pupil on a terminal: 'my lens.rx' unquoted is asked again with the quoting rule" two_words_tty
