@@ -118,8 +118,8 @@ static int check_log(void *ctx, const char *word, char *msg, size_t cap)
     if (!strcmp(word, "-")) return 0;
     for (int i = 0; i < 2; i++) {
         snprintf(name, sizeof name, "%s%s", word, ext[i]);
-        if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
         if (same_file(name, s->rig.path)) { snprintf(msg, cap, CS(LOG_IS_RIG), name); return -1; }
+        if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
     }
     return 0;
 }

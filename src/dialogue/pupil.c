@@ -600,15 +600,15 @@ static int compute(pdlg *d)
         if (fabs(l->field[i].y) > fabs(fbig)) fbig = l->field[i].y;
     if (isinf(l->object)) snprintf(ob, sizeof ob, "%s", P(OBJ_INF));
     else snprintf(ob, sizeof ob, P(OBJ_AT), l->object, d->c.uname);
-    calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
-             l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
-             l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
     {   /* air in a lens file is 1, not the classic's 1.000293: say which applies */
         int air = !l->obj_glass[0] || !strcasecmp(l->obj_glass, "air");
         for (int i = 0; i < l->nsurf; i++)
             air |= !l->surf[i].glass[0] || !strcasecmp(l->surf[i].glass, "air");
         if (air) calc_say(&d->c, "%s", P(AIR_NOTE));
     }
+    calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
+             l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
+             l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
     if (l->surf[l->nsurf - 1].t > 0) {
         z_image = zl + l->surf[l->nsurf - 1].t;
         calc_say(&d->c, P(IMAGE_FILE), z_image, d->c.uname);

@@ -97,8 +97,8 @@ static int check_log(void *ctx, const char *word, char *msg, size_t cap)
     /* the log, the file it grows in and the shared state: none may be an input */
     for (int i = 0; i < 4; i++) {
         snprintf(name, sizeof name, "%s%s", word, ext[i]);
-        if (lm_check_output(d->io, name, msg, cap)) return -1;
         if (same_file(name, d->rig.path)) { snprintf(msg, cap, P(LOG_IS_RIG), name); return -1; }
+        if (lm_check_output(d->io, name, msg, cap)) return -1;
     }
     return 0;
 }
