@@ -5,6 +5,8 @@
 # each side, 2 * sag = 2 gives 20 - sqrt(400 - h^2) = 1); a semi-diameter 25 on a
 # sphere of radius 20 has no zone to stand on.  --pupil (lens file, FILE:LINE of the
 # surface) and --draw (the semi-diameters' answer, FILE:LINE of the answer).
+unit "$TOP/build/obj/unit_lens_shape"    # closed forms: sphere-sphere, sphere-plane
+unit "$TOP/build/asan/unit_lens_shape"
 LV=$WORK/lv56
 lv_setup() {
     rm -rf "$LV"; mkdir -p "$LV"
