@@ -131,7 +131,11 @@ fuzz: build/fuzz_answers build/fuzz_lens
 	build/fuzz_lens -max_total_time=$${FUZZ_SECONDS:-600} build/fuzz-lens-corpus \
 	    tests/fuzz-lens
 
+# The set-up command: ./lensmat and every engine module whose libraries are there
+# (make -k: a module that cannot be built is skipped; its dialogues say so).
+EXAMPLE_MODULES = $(sort $(filter build/lib/lensmat-%.so,$(MODULE_TEST_BINS) $(MODULE_BENCH_BINS)))
 example: lensmat
+	-$(MAKE) -k $(EXAMPLE_MODULES) || echo "make example: a module could not be built; the dialogues that need it will say so"
 	./lensmat --example example.rec
 
 # Installing: PREFIX/bin/lensmat finds its modules in PREFIX/lib/lensmat (engine.c
@@ -141,6 +145,10 @@ BINDIR  := $(PREFIX)/bin
 MODDIR  := $(PREFIX)/lib/lensmat
 MANDIR  := $(PREFIX)/share/man/man1
 DOCDIR  := $(PREFIX)/share/doc/lensmat
+# The examples' data files, under their names in the tree (main.c finds them in
+# EXEDIR/../share/lensmat when they are not in the current folder).
+DATADIR := $(PREFIX)/share/lensmat
+EXAMPLE_DATA := doc/triplet.rx doc/pupil-triplet.rx golden/rig/example.rig
 install: all
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(MODDIR) $(DESTDIR)$(MANDIR) $(DESTDIR)$(DOCDIR)
 	install -m 755 lensmat $(DESTDIR)$(BINDIR)/lensmat
@@ -151,12 +159,16 @@ install: all
 	install -d $(DESTDIR)$(DOCDIR)/doc/img
 	install -m 644 doc/*.md $(DESTDIR)$(DOCDIR)/doc/
 	install -m 644 doc/img/*.png $(DESTDIR)$(DOCDIR)/doc/img/
+	for f in $(EXAMPLE_DATA); do install -d $(DESTDIR)$(DATADIR)/$${f%/*} && \
+	    install -m 644 $$f $(DESTDIR)$(DATADIR)/$$f || exit 1; done
 uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/lensmat $(DESTDIR)$(MODDIR)/lensmat-*.so \
 	    $(DESTDIR)$(MANDIR)/lensmat.1 $(DESTDIR)$(DOCDIR)/README.md
 	rm -f $(DESTDIR)$(DOCDIR)/doc/*.md $(DESTDIR)$(DOCDIR)/doc/img/*.png
+	for f in $(EXAMPLE_DATA); do rm -f $(DESTDIR)$(DATADIR)/$$f; done
 	-rmdir $(DESTDIR)$(DOCDIR)/doc/img $(DESTDIR)$(DOCDIR)/doc $(DESTDIR)$(MODDIR) \
-	    $(DESTDIR)$(DOCDIR) 2> /dev/null
+	    $(DESTDIR)$(DOCDIR) $(DESTDIR)$(DATADIR)/doc \
+	    $(DESTDIR)$(DATADIR)/golden/rig $(DESTDIR)$(DATADIR)/golden $(DESTDIR)$(DATADIR) 2> /dev/null
 
 clean:
 	rm -rf build lensmat example.rec

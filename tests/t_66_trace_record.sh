@@ -115,7 +115,7 @@ check "trace record bad: a prescription line" rr_bad bad.lens '# a lens\n3 0 1.5
 check "trace record bad: a prescription with a negative index" rr_bad neg.lens 'index -1\n3 0 1.5\n' \
     "neg.lens:1: the index must be greater than 0"
 rr_other() { cp "$RW/d/r.rec" "$RW/bad/trace.rec" &&
-    rr_bad trace.rec '' "trace.rec:6: the eye nearpoint: 'record': not a number"; }
+    rr_bad trace.rec '' "trace.rec: this is a record of lensmat --trace, not of the classic dialogue"; }
 check "trace record bad: the record of another dialogue (--trace's own)" rr_other
 check "trace record bad: a missing file" rr_bad nosuch.rec '' "nosuch.rec: cannot open"
 rr_dir() { mkdir -p "$RW/bad/adir" && rr_bad adir '' "adir: not a regular file"; }

@@ -36,5 +36,23 @@ uninstall_tree() {
 }
 check "make install DESTDIR PREFIX: binary, modules, man page, README" install_tree
 check "installed lensmat runs from another folder; --trace and --fit load installed modules" installed_runs
+# the examples' data are installed (PREFIX/share/lensmat) and found from any folder
+installed_examples() (
+    B=$DEST$PFX/bin/lensmat
+    cd "$I/elsewhere" || return 1
+    for f in doc/triplet.rx doc/pupil-triplet.rx golden/rig/example.rig; do
+        cmp "$DEST$PFX/share/lensmat/$f" "$TOP/$f" || return 1; done
+    env -u LENSMAT_LIBDIR "$B" --pupil --example p.rec > p.out 2> p.err || { cat p.err; return 1; }
+    grep -q "^input: $DEST$PFX/bin/../share/lensmat/doc/pupil-triplet.rx" p.rec || return 1
+    grep -q 'efl 50' p.rec || { head p.rec; return 1; }
+    env -u LENSMAT_LIBDIR "$B" --rig --example r.rec > r.out 2> r.err || { cat r.err; return 1; }
+    grep -q "share/lensmat/golden/rig/example.rig" r.rec || return 1
+    env -u LENSMAT_LIBDIR "$B" --draw --example d.rec > d.out 2> d.err || { cat d.err; return 1; }
+    [ -s triplet-layout.png ] && [ -s triplet-layout.svg ] || return 1
+    # the recorded answers replay to the same record, here too
+    grep input: p.rec > p.in && env -u LENSMAT_LIBDIR "$B" --pupil -i p.in p2.rec > /dev/null &&
+        cmp p.rec p2.rec
+)
+check "the installed --pupil, --rig and --draw examples run from another folder" installed_examples
 check "the installed man page renders" man_page
 check "make uninstall removes every installed file" uninstall_tree

@@ -99,12 +99,14 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
     io->rec_name = rec_name;
     io->in = in;
     io->src = in_name;
+    lm_files_reset();       /* one session per process: its own files only */
     if (in) {
         struct stat st;
         if (fstat(fileno(in), &st) == 0 && S_ISREG(st.st_mode)) {
             io->in_known = 1;
             io->in_dev = st.st_dev;
             io->in_ino = st.st_ino;
+            lm_files_answers(in_name && in_name[0] != '<' ? in_name : NULL, &st);
         }
     }
     {
@@ -126,7 +128,8 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
             io->rec_known = 1;
             io->rec_dev = st.st_dev;
             io->rec_ino = st.st_ino;
-        }
+            lm_files_record(rec_name, &st);
+        } else lm_files_record(rec_name, NULL);
     }
     /* Interactive means a person types the answers: standard input is a terminal.
      * Prompts still go to stdout (`lensmat x.rec | tee log` keeps them); readline
@@ -142,23 +145,6 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
     }
     signals_setup();
     io->cur = "";
-    return 0;
-}
-
-int lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap)
-{
-    struct stat st;
-    if (stat(path, &st) != 0) return 0;            /* not there yet: nothing to lose */
-    if (io->in_known && st.st_dev == io->in_dev && st.st_ino == io->in_ino) {
-        snprintf(msg, cap, "%s is the file the answers are read from; refusing to "
-                 "write over it", path);
-        return -1;
-    }
-    if (io->rec_known && st.st_dev == io->rec_dev && st.st_ino == io->rec_ino) {
-        snprintf(msg, cap, "%s is the record file of this session; refusing to write "
-                 "over it", path);
-        return -1;
-    }
     return 0;
 }
 
@@ -360,7 +346,11 @@ int lm_ask_number(lm_io *io, const char *out, const char *rec, const lm_numspec 
             if (k == 1 && lambda == 0) {               /* a medium's name */
                 lm_say(io, LM_REC, "input: %s\n", echo);
                 show_answer(io, echo);
-                lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
+                if (!strcmp(echo, "air"))   /* two airs in lensmat: say which this is */
+                    lm_say(io, LM_BOTH, "(air: index %.7g, air at 589 nm, as this dialogue "
+                           "and positions prescriptions take it; lens files by thickness, "
+                           ".zmx and --colour take air as 1)\n", *v);
+                else lm_say(io, LM_BOTH, "(%s: index %g)\n", echo, *v);
                 return LM_GO;
             }
             if (k == 1) {                              /* a glass at a wavelength */
@@ -468,6 +458,19 @@ int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
         if (r == -3) return LM_FAIL;
         if (r == 0 && strlen(tok) >= cap) r = -2;
         msg[0] = '\0';
+        if (r == 0 && io->word_alone) {     /* a file name: alone on its line */
+            const char *rest = io->cur;
+            char next[LM_TOKEN_MAX];
+            if (lm_next_token(&rest, next, sizeof next) != 0) {
+                char a[64], b[64];
+                snprintf(a, sizeof a, "%.40s", tok);
+                snprintf(b, sizeof b, "%.40s", next);
+                snprintf(msg, sizeof msg, "'%s' and then '%s' on the same line: a file "
+                         "name that holds a blank must be quoted (\"%s %s\"), and nothing "
+                         "may follow a file name on its line", a, b, a, b);
+                r = -6;
+            }
+        }
         if (r == 0 && check && check(ctx, tok, msg, sizeof msg)) r = -6;
         if (r != 0) {
             if (r == -2) snprintf(msg, sizeof msg, "the answer is too long");
@@ -482,6 +485,17 @@ int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
         show_answer(io, echo);
         return LM_GO;
     }
+}
+
+int lm_ask_file(lm_io *io, const char *out, const char *rec, const char *what,
+                int (*check)(void *ctx, const char *word, char *msg, size_t cap),
+                void *ctx, char *buf, size_t cap)
+{
+    int rc;
+    io->word_alone = 1;
+    rc = lm_ask_word(io, out, rec, what, check, ctx, buf, cap);
+    io->word_alone = 0;
+    return rc;
 }
 
 /* Answers left after the end: on the last line read, or on any later line (a file

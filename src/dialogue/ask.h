@@ -24,6 +24,7 @@ typedef struct lm_io {
     const char *cur;        /* unread part of buf */
     int in_known, rec_known;   /* in_dev/in_ino, rec_dev/rec_ino are valid */
     unsigned long long in_dev, in_ino, rec_dev, rec_ino;
+    int word_alone;         /* lm_ask_file: the word must end its line */
 } lm_io;
 
 /* Output streams for lm_say. */
@@ -75,6 +76,13 @@ int lm_ask_choice(lm_io *io, const char *out, const char *rec, const char *what,
 int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
                 int (*check)(void *ctx, const char *word, char *msg, size_t cap),
                 void *ctx, char *buf, size_t cap);
+/* lm_ask_word for a file name: the name must be the last answer on its line, so
+ * that `my log.txt` typed without quotes is not taken as "my" (and "log.txt" as the
+ * next answer): two words are explained with the quoting rule (terminal: asked
+ * again; replay: SRC:LINE, LM_FAIL). */
+int lm_ask_file(lm_io *io, const char *out, const char *rec, const char *what,
+                int (*check)(void *ctx, const char *word, char *msg, size_t cap),
+                void *ctx, char *buf, size_t cap);
 /* Stopping (SIGINT, SIGTERM, SIGHUP).  A signal while lensmat waits for an answer,
  * or a second signal, runs the stop hooks and exits with 128+N at once.  During a
  * computation it only sets the stop flag: every long operation polls
@@ -88,11 +96,33 @@ int  lm_stop_requested(void);
 int  lm_on_stop(void (*fn)(void *ctx), void *ctx);
 void lm_on_stop_remove(void (*fn)(void *ctx), void *ctx);
 void lm_run_stop_hooks(void);
-/* An output file may not be the answers' file or the record (same device and inode,
- * so links and other spellings count): 0 if path is fine (also when it does not
- * exist yet), else -1 with why in msg.  Every dialogue checks each output with it
- * before opening anything for writing. */
+/* The session's files (files.c).  No output may be a file the session reads (the
+ * answers, lens files, scenes and meshes, rig files, frames) and no input one it
+ * writes (the record, outputs named so far), under any spelling, hard link or
+ * symbolic link (same device and inode; a file not there yet by its resolved path).
+ * lm_check_output: 0 if path may be written (also when it does not exist yet; it is
+ * then an output of the session), else -1 with why in msg.  Every dialogue checks
+ * each output with it before opening anything for writing.  lm_check_input: the
+ * same for a file about to be read (a file-name answer's check calls it first): 0
+ * and registered as an input (role: "the lens file", for messages), or -1 with why. */
 int  lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap);
+int  lm_check_input(const lm_io *io, const char *path, const char *role, char *msg,
+                    size_t cap);
+/* Files a module read for the session (a scene's meshes): registered as inputs
+ * (role: "the mesh file", for messages; st: a struct stat, or NULL to stat path). */
+void lm_files_note(const char *role, const char *path, const void *st);
+void lm_files_reset(void);
+void lm_files_answers(const char *path, const void *st);
+void lm_files_record(const char *path, const void *st);
+/* An existing OUTFILE that is no lensmat record (a lens file, scene, rig file,
+ * answers file, binary or other text: the -i forgotten) is refused before anything
+ * is opened: -1 with the message (it names -i when lens_from_input: the dialogue
+ * reads its lens from -i), else 0.  Remove the file first to overwrite it.
+ * lens_from_input 2, 3, 4: --to-zmx, --to-thickness, --to-prescription with their
+ * input given (-i, or not a terminal): an OUTFILE of the kind the converter writes
+ * (.zmx, prescription by thickness, by positions) is its earlier output. */
+int  lm_outfile_check(const char *path, const char *option, int lens_from_input,
+                      char *msg, size_t cap);
 /* After the last question: warn about answers left unread, on the last line read or
  * on any later one, with that line (replay only). */
 void lm_check_leftover(lm_io *io);

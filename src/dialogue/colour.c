@@ -60,6 +60,13 @@ static int check_glass(void *ctx, const char *w, char *msg, size_t cap)
     return 0;
 }
 
+/* "air" here is the catalogue's AIR, index 1, not the classic's 1.000293: say so. */
+static int air_note(calc *c, const char *glass)
+{
+    if (!strcasecmp(glass, "air")) calc_say(c, "%s", CO(AIR_NOTE));
+    return LM_GO;
+}
+
 static int ask_count(calc *c, const char *q, const char *what, const char *bad, int max,
                      int *k)
 {
@@ -152,6 +159,7 @@ int lm_colour(lm_io *io)
     }
     if ((rc = lm_ask_word(io, CO(OBJECT), CO(OBJECT), CO(OBJECT_WHAT), check_glass, &s,
                           obj, sizeof obj)) ||
+        (rc = air_note(c, obj)) ||
         (rc = ask_count(c, CO(NSURF), CO(NSURF_WHAT), CO(NSURF_BAD), MAXSURF, &nsurf)))
         return rc;
     for (int i = 0; i < nsurf; i++) {
@@ -162,7 +170,7 @@ int lm_colour(lm_io *io)
         surf[i].r = rad;
         q1(q, sizeof q, CO(GLASS), i + 1, 0);
         if ((rc = lm_ask_word(io, q, q, CO(GLASS_WHAT), check_glass, &s, glass[i],
-                              sizeof glass[i])))
+                              sizeof glass[i])) || (rc = air_note(c, glass[i])))
             return rc;
         surf[i].glass = glass[i];
         if (i + 1 < nsurf) {

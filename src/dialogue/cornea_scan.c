@@ -98,6 +98,7 @@ static int check_rig(void *ctx, const char *word, char *msg, size_t cap)
     cs *s = ctx;
     s->have_rig = 0;
     if (!strcmp(word, "-")) return 0;
+    if (lm_check_input(s->cc.io, word, "the rig file", msg, cap)) return -1;
     if (s->rg->rig_load(word, &s->rig, msg, cap)) return -1;
     s->have_rig = 1;
     return 0;
@@ -117,8 +118,8 @@ static int check_log(void *ctx, const char *word, char *msg, size_t cap)
     if (!strcmp(word, "-")) return 0;
     for (int i = 0; i < 2; i++) {
         snprintf(name, sizeof name, "%s%s", word, ext[i]);
-        if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
         if (same_file(name, s->rig.path)) { snprintf(msg, cap, CS(LOG_IS_RIG), name); return -1; }
+        if (lm_check_output(s->cc.io, name, msg, cap)) return -1;
     }
     return 0;
 }
@@ -287,13 +288,13 @@ int lm_cornea_scan(lm_io *io)
     double np, zone, R = 7.8, Q = 0, cyl = 0, axis = 0, dx = 0, dy = 0, tx = 0, ty = 0,
            noise = 0, pitch, seed = 0, w = 0, h = 0, ms = 0;
     if ((rc = calc_choice(c, CS(MODEL), CS(MODEL_WHAT), models, &model)) ||
-        (rc = lm_ask_word(io, CS(RIG_FILE), CS(RIG_FILE), CS(RIG_FILE_WHAT), check_rig, s,
+        (rc = lm_ask_file(io, CS(RIG_FILE), CS(RIG_FILE), CS(RIG_FILE_WHAT), check_rig, s,
                           s->rigname, sizeof s->rigname)))
         goto out;
     if (s->have_rig) {
         if ((rc = calc_choice(c, CS(CHIP), CS(CHIP_WHAT), chips, &chip))) goto out;
         if ((chip == 1 &&
-             (rc = lm_ask_word(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
+             (rc = lm_ask_file(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
                                s->log, sizeof s->log))) ||
             (chip >= 1 &&
              (rc = ranged(c, CS(EXPOSE), CS(EXPOSE_WHAT), CS(EXPOSE_RANGE),
@@ -306,7 +307,7 @@ int lm_cornea_scan(lm_io *io)
         (rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source)))
         goto out;
     if (source == CL_SRC_CAMERA &&
-        (rc = lm_ask_word(io, CS(CAMERA), CS(CAMERA), CS(CAMERA_WHAT), NULL, NULL, s->camera,
+        (rc = lm_ask_file(io, CS(CAMERA), CS(CAMERA), CS(CAMERA_WHAT), NULL, NULL, s->camera,
                           sizeof s->camera)))
         goto out;
     if (source != CL_SRC_CAMERA &&      /* a real eye is what the camera sees */
@@ -327,7 +328,7 @@ int lm_cornea_scan(lm_io *io)
     if (source == CL_SRC_FRAMES &&
         ((rc = ranged(c, CS(WIDTH), CS(WIDTH_WHAT), CS(PX_RANGE), 16, 4096, 1, &w)) ||
          (rc = ranged(c, CS(HEIGHT), CS(HEIGHT_WHAT), CS(PX_RANGE), 16, 4096, 1, &h)) ||
-         (rc = lm_ask_word(io, CS(SAVE), CS(SAVE), CS(SAVE_WHAT), check_save, s, s->save,
+         (rc = lm_ask_file(io, CS(SAVE), CS(SAVE), CS(SAVE_WHAT), check_save, s, s->save,
                            sizeof s->save))))
         goto out;
     cn_bump cone = {0, 0, 0, 0};       /* a cone on the synthetic eye (not a camera's) */
@@ -343,7 +344,7 @@ int lm_cornea_scan(lm_io *io)
     double cone_um = cone.h;
     cone.h *= 1e-3;                    /* um -> mm */
     int maps = 0;
-    if ((rc = lm_ask_word(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), check_report, s,
+    if ((rc = lm_ask_file(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), check_report, s,
                           s->report, sizeof s->report)) ||
         (strcmp(s->report, "-") && (rc = calc_yn(c, CS(MAPS), CS(MAPS_WHAT), &maps))))
         goto out;

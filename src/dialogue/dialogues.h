@@ -37,9 +37,15 @@ int lm_pupil(lm_io *io);        const char *lm_pupil_example(void);    /* pupil.
 /* A lens read from a file (prescription.c): a classic record, its grep'd or plain
  * answers, or a prescription file.  lm_read_lens: LM_GO, or LM_FAIL with
  * "FILE[:LINE]: why" in err (nothing printed); free with lm_lens_file_free. */
-typedef struct lm_lens_surface { double radius, z, n_right; } lm_lens_surface; /* plane: inf */
+/* glass: the catalogue or model glass the index was named by ("N-SK16",
+ * "1.5168/64.17"; taken at d), "" when it was a number or a medium's constant. */
+typedef struct lm_lens_surface {
+    double radius, z, n_right;         /* plane: inf */
+    char glass[64];
+} lm_lens_surface;
 typedef struct lm_lens_file {
     double nearpoint, n_object;        /* n_object: index left of the first surface */
+    char obj_glass[64];                /* as lm_lens_surface.glass */
     int nsurf, nobj;
     lm_lens_surface *surf;
     double *obj;                       /* the object planes' locations */

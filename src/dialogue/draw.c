@@ -15,6 +15,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "ask.h"
+#include "../lens/lens.h"
 #include "dialogues.h"
 #include "draw.h"
 #include "drawcalc.h"
@@ -81,6 +82,7 @@ static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
     dsess *d = ctx;
     struct stat st;
     lm_lens_file_free(&d->lf);
+    if (lm_check_input(d->io, word, "the lens file", msg, cap)) return -1;
     if (lm_read_lens(word, &d->lf, msg, cap)) return -1;
     if (d->lf.nsurf > MAXSURF) {
         snprintf(msg, cap, P(TOO_MANY), word, d->lf.nsurf, MAXSURF);
@@ -93,13 +95,6 @@ static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
         d->lens_ino = st.st_ino;
     }
     return 0;
-}
-
-/* The largest semi-diameter surface i allows (a sphere ends at |radius|). */
-static double semi_max(const dsess *d, int i)
-{
-    double r = d->lf.surf[i].radius;
-    return isfinite(r) && r != 0 ? fabs(r) : INFINITY;
 }
 
 /* "8" or "8,8,5.5,...": into out[] (nsurf values); 0 or -1 with why in msg. */
@@ -121,11 +116,22 @@ static int parse_semis(dsess *d, const char *word, double *out, char *msg, size_
     }
     if (k == 1) for (int i = 1; i < n; i++) out[i] = out[0];
     else if (k != n) goto bad;
-    for (int i = 0; i < n; i++)
-        if (out[i] > semi_max(d, i)) {
-            snprintf(msg, cap, P(SEMI_BIG), word, i + 1, d->lf.surf[i].radius, semi_max(d, i));
+    {   /* a zone the sphere has not, neighbours that cross: the lens model's check */
+        ln_surface sf[MAXSURF];
+        double z[MAXSURF];
+        char why[LN_ERR_MAX];
+        int bad;
+        memset(sf, 0, sizeof sf);
+        for (int i = 0; i < n; i++) {
+            ln_set_radius(&sf[i], d->lf.surf[i].radius);
+            sf[i].semi = out[i];
+            z[i] = d->lf.surf[i].z;
+        }
+        if (ln_shape_check(sf, z, n, &bad, why, sizeof why) != LN_OK) {
+            snprintf(msg, cap, "'%s': %s", word, why);
             return -1;
         }
+    }
     return 0;
 bad:
     snprintf(msg, cap, P(SEMI_BAD), word, n);
@@ -157,7 +163,7 @@ static int read_lens(dsess *d)
     char *name = d->name;
     double semi[MAXSURF];
     int rc;
-    if ((rc = lm_ask_word(d->io, P(LENS_FILE), P(LENS_FILE), P(LENS_FILE_WHAT),
+    if ((rc = lm_ask_file(d->io, P(LENS_FILE), P(LENS_FILE), P(LENS_FILE_WHAT),
                           check_lens_file, d, name, sizeof d->name)))
         return rc;
     snprintf(q, sizeof q, P(SEMI), d->lf.nsurf);
@@ -354,7 +360,7 @@ static int picture(dsess *d, int what)
     if (what == W_SPOT && d->sc.unit &&
         (rc = lm_ask_number(io, P(WAVELENGTH), P(WAVELENGTH), &wl, &nm)))
         return rc;
-    if ((rc = lm_ask_word(io, P(PICTURE), P(PICTURE), P(PICTURE_WHAT), check_picture, &p, png,
+    if ((rc = lm_ask_file(io, P(PICTURE), P(PICTURE), P(PICTURE_WHAT), check_picture, &p, png,
                           sizeof png)))
         return rc;
     if (need_engines(d, &load_ms, &trace_ms)) return LM_FAIL;
@@ -433,7 +439,7 @@ int lm_draw(lm_io *io)
     return LM_GO;
 }
 
-const char *lm_draw_example(void) { return NULL; }
+const char *lm_draw_example(void) { return P(EXAMPLE); }
 
 /* ---- the --trace dialogue's pictures ---------------------------------------------------- */
 

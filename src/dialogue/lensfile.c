@@ -225,23 +225,56 @@ static char *slurp_all(FILE *in, const char *src, size_t *len, char *err, size_t
     return s;
 }
 
+/* Digits after the point of v's shortest decimal (the answer as it was typed);
+ * -1 when it has an exponent or is not finite. */
+static int decimals(double v)
+{
+    char b[40];
+    const char *dot;
+    ln_format(v, b, sizeof b);
+    if (!isfinite(v) || strpbrk(b, "eE")) return -1;
+    dot = strchr(b, '.');
+    return dot ? (int)strlen(dot + 1) : 0;
+}
+
+/* b - a as the decimal the typed a and b make (positions 9.2666 and 10.26623 are
+ * 0.99963 apart, not 0.9996299999999998): the difference rounded to the longer of
+ * their decimals, which is exact for decimal answers. */
+static double decimal_diff(double a, double b)
+{
+    int da = decimals(a), db = decimals(b), d = da > db ? da : db;
+    char t[64];
+    if (da < 0 || db < 0 || d > 17) return b - a;
+    snprintf(t, sizeof t, "%.*f", d, b - a);
+    return strtod(t, NULL);
+}
+
+/* The medium of a classic answer in the model: the glass it named (kept, so a
+ * converted lens keeps its dispersion), else its number ("" for 1: air). */
+static void classic_glass(double n, const char *glass, char *out, size_t cap)
+{
+    if (glass[0]) snprintf(out, cap, "%s", glass);
+    else if (n != 1) ln_format(n, out, cap);
+    else out[0] = '\0';
+}
+
 /* A lens of the classic kind (radii, positions, indices) as a model. */
 static int model_of_classic(const lm_lens_file *lf, ln_lens *l)
 {
     double z0 = lf->nsurf ? lf->surf[0].z : 0;
     ln_init(l);
     l->nearpoint = lf->nearpoint;
-    if (lf->n_object != 1) ln_format(lf->n_object, l->obj_glass, sizeof l->obj_glass);
+    classic_glass(lf->n_object, lf->obj_glass, l->obj_glass, sizeof l->obj_glass);
     for (int i = 0; i < lf->nsurf; i++) {
         ln_surface *s = ln_add_surface(l);
         if (!s) return LM_FAIL;
         ln_set_radius(s, lf->surf[i].radius);
-        if (lf->surf[i].n_right != 1) ln_format(lf->surf[i].n_right, s->glass, sizeof s->glass);
-        s->t = i + 1 < lf->nsurf ? lf->surf[i + 1].z - lf->surf[i].z : 0;
+        classic_glass(lf->surf[i].n_right, lf->surf[i].glass, s->glass, sizeof s->glass);
+        s->t = i + 1 < lf->nsurf ? decimal_diff(lf->surf[i].z, lf->surf[i + 1].z) : 0;
     }
     for (int i = 0; i < lf->nobj; i++)
-        if (ln_add_plane(l, lf->obj[i] - z0)) return LM_FAIL;
-    l->object = lf->nobj ? z0 - lf->obj[0] : INFINITY;
+        if (ln_add_plane(l, decimal_diff(z0, lf->obj[i]))) return LM_FAIL;
+    l->object = lf->nobj ? decimal_diff(lf->obj[0], z0) : INFINITY;
     return LM_GO;
 }
 

@@ -3,9 +3,11 @@
  * a terminal, a replay file or the embedded example; the record file), run it, and
  * turn its outcome into the exit status. */
 #include <errno.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include "ask.h"
 #include "dialogues.h"
 #include "engine.h"
@@ -90,7 +92,53 @@ static int parse_args(int argc, char **argv, options *o)
     return -1;
 }
 
+/* An example's data files (doc/triplet.rx, golden/rig/example.rig) are installed
+ * data: a relative name in an example's answers that is not there from the current
+ * folder is taken from beside lensmat (the build tree) or from EXEDIR/../share/lensmat
+ * (make install), where the modules are found too.  The answers then name it by that
+ * path.  Returns a malloc'd text, or NULL (out of memory). */
+static char *example_text(const char *ex)
+{
+    char exe[4096], path[8192], *out, *slash;
+    size_t cap = strlen(ex) * 2 + 4096, n = 0;
+    ssize_t k = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (!(out = malloc(cap))) return NULL;
+    exe[k > 0 ? k : 0] = '\0';
+    if ((slash = strrchr(exe, '/'))) *slash = '\0';
+    for (const char *p = ex; *p; ) {
+        size_t len = strcspn(p, "\n");
+        int done = 0;
+        if (len && len < 1024 && p[0] != '/' && memchr(p, '/', len) && exe[0]) {
+            char name[1024];
+            memcpy(name, p, len);
+            name[len] = '\0';
+            if (access(name, R_OK) != 0) {
+                static const char *const dirs[] = {"", "/../share/lensmat"};
+                for (size_t i = 0; i < 2 && !done; i++) {
+                    snprintf(path, sizeof path, "%s%s/%s", exe, dirs[i], name);
+                    if (access(path, R_OK) == 0 && !strpbrk(path, " \t\"'\\#") &&
+                        n + strlen(path) + 2 < cap) {
+                        memcpy(out + n, path, strlen(path));
+                        n += strlen(path);
+                        done = 1;
+                    }
+                }
+            }
+        }
+        if (!done) {
+            if (n + len + 2 >= cap) break;
+            memcpy(out + n, p, len);
+            n += len;
+        }
+        p += len;
+        if (*p == '\n') { out[n++] = '\n'; p++; }
+    }
+    out[n] = '\0';
+    return out;
+}
+
 /* Where the answers come from: the embedded example, a file, or stdin. */
+static char *example_buf;       /* the example's text, while the session reads it */
 static FILE *open_answers(const options *o, const char **name)
 {
     FILE *f;
@@ -99,7 +147,8 @@ static FILE *open_answers(const options *o, const char **name)
         const char *ex = o->dlg->example ? o->dlg->example() : NULL;
         if (!ex) { fprintf(stderr, P(NO_EXAMPLE), o->dlg->option); return NULL; }
         *name = "<example>";
-        return fmemopen((void *)ex, strlen(ex), "r");
+        if (!(example_buf = example_text(ex))) return NULL;
+        return fmemopen(example_buf, strlen(example_buf), "r");
     }
     if (!o->input) { *name = "<stdin>"; return stdin; }
     *name = o->input;
@@ -135,6 +184,22 @@ int main(int argc, char **argv)
         fprintf(stderr, P(NEEDS_MODULE), o.dlg->option, o.dlg->needs);
         return 1;
     }
+    {   /* an OUTFILE that is a lens file or the like: the -i forgotten */
+        static const char *const from_input[] = {"--prescription", "--to-prescription",
+                                                 "--to-zmx", "--to-thickness", NULL};
+        char msg[3000];
+        int k = 0;
+        while (from_input[k] && strcmp(from_input[k], o.dlg->option)) k++;
+        int conv = from_input[k] != NULL;
+        if (conv && !strncmp(o.dlg->option, "--to-", 5) && (o.input || o.example ||
+                                                             !isatty(0)))
+            conv = o.dlg->option[5] == 'z' ? 2 : o.dlg->option[5] == 't' ? 3 : 4;
+            /* it writes a lens file: an old one of its kind is its earlier output */
+        if (lm_outfile_check(o.outfile, o.dlg->option, conv, msg, sizeof msg)) {
+            fprintf(stderr, "lensmat: %s\n", msg);
+            return 1;
+        }
+    }
     if (!(in = open_answers(&o, &in_name))) return 1;
     if (lm_io_open(&io, o.outfile, in, in_name, o.original) < 0) {
         if (in != stdin) fclose(in);
@@ -144,6 +209,7 @@ int main(int argc, char **argv)
     rc = o.dlg->run(&io);
     if (lm_io_close(&io) < 0 && rc == LM_GO) rc = LM_FAIL;
     if (in != stdin) fclose(in);
+    free(example_buf);
     if (lm_stop_requested()) {
         lm_run_stop_hooks();
         return 128 + lm_stop_requested();

@@ -302,6 +302,7 @@ typedef struct cursor {
     long line;
     char *err;
     size_t errcap;
+    char last[LM_TOKEN_MAX];  /* the last token num() read */
 } cursor;
 
 static int fail_at(cursor *c, const char *what, const char *fmt, const char *tok)
@@ -348,6 +349,7 @@ static int num(cursor *c, const char *what, unsigned flags, double min, double *
     char tok[LM_TOKEN_MAX];
     enum lm_num_status st;
     if (token(c, what, tok)) return LM_FAIL;
+    memcpy(c->last, tok, sizeof c->last);
     st = (flags & LM_INDEX) ? lm_parse_index(tok, v) : lm_parse_number(tok, v);
     if (st == LM_NUM_PLANE && (flags & LM_ALLOW_PLANE)) { *v = INFINITY; return LM_GO; }
     if (st != LM_NUM_OK) {
@@ -359,6 +361,21 @@ static int num(cursor *c, const char *what, unsigned flags, double min, double *
     if ((flags & LM_NONNEG) && *v < 0) return fail_at(c, what, PS(A_NONNEG), tok);
     if ((flags & LM_AT_LEAST) && *v < min) return fail_at(c, what, PS(A_LEFT), tok);
     if ((flags & LM_ALLOW_PLANE) && *v == 0) *v = INFINITY;
+    return LM_GO;
+}
+
+/* An index answer: num's checks, and the glass it names (a catalogue or model glass
+ * without "@": the classic takes it at d, as a lens model does at its primary d),
+ * so that a converted lens keeps the glass, not only its number. */
+static int index_answer(cursor *c, const char *what, double *v, char *glass, size_t cap)
+{
+    char echo[LM_TOKEN_MAX], why[300];
+    double l, n;
+    glass[0] = '\0';
+    if (num(c, what, LM_POSITIVE | LM_INDEX, 0, v)) return LM_FAIL;
+    if (lm_parse_number(c->last, &n) == LM_NUM_SYNTAX && !strchr(c->last, '@') &&
+        lm_index_name(c->last, &n, echo, sizeof echo, &l, why, sizeof why) == 1 && l > 0)
+        snprintf(glass, cap, "%.63s", echo);
     return LM_GO;
 }
 
@@ -382,22 +399,24 @@ static void *grow(void *a, int n, size_t size)
 static int read_answers(cursor *c, lm_lens_file *lf)
 {
     double s[3], z, *no;
+    char glass[64];
     lm_lens_surface *ns;
     char tok[LM_TOKEN_MAX];
     int more;
     if (num(c, PS(W_NEARPOINT), LM_NONNEG, 0, &lf->nearpoint) ||
-        num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &lf->n_object))
+        index_answer(c, PS(W_INDEX), &lf->n_object, lf->obj_glass, sizeof lf->obj_glass))
         return LM_FAIL;
     do {
         if (num(c, PS(W_RADIUS), LM_ALLOW_PLANE, 0, &s[0]) ||
             num(c, PS(W_LOCATION), lf->nsurf ? LM_AT_LEAST : 0,
                 lf->nsurf ? lf->surf[lf->nsurf - 1].z : 0, &s[1]) ||
-            num(c, PS(W_INDEX), LM_POSITIVE | LM_INDEX, 0, &s[2]) ||
+            index_answer(c, PS(W_INDEX), &s[2], glass, sizeof glass) ||
             yn(c, PS(W_ANOTHER_SURFACE), &more))
             return LM_FAIL;
         if (!(ns = grow(lf->surf, lf->nsurf + 1, sizeof *ns))) return fail_at(c, "", "%s", PS(A_MEMORY));
         lf->surf = ns;
-        ns[lf->nsurf++] = (lm_lens_surface){s[0], s[1], s[2]};
+        ns[lf->nsurf] = (lm_lens_surface){s[0], s[1], s[2], ""};
+        memcpy(ns[lf->nsurf++].glass, glass, sizeof glass);
     } while (more);
     do {
         if (num(c, PS(W_OBJECT), 0, 0, &z) || yn(c, PS(W_ANOTHER_OBJECT), &more)) return LM_FAIL;
@@ -425,11 +444,66 @@ static int is_prescription(const char *s)
     return 0;
 }
 
-/* If some line starts with "input:" (a classic record), blank every other line;
+/* A record (input: lines among others) whose first line is not the classic's first
+ * question was made by another dialogue: say which (prompts' record_marks), rather
+ * than fail on its first answer ("'mm' is not a number").  1 with err set, or 0. */
+/* Is s a record (prompts with input: lines), rather than answers (input: lines and
+ * plain answers, read alike, as a dialogue replays them)?  A record's first line is
+ * a prompt; an answers file's first answer, the nearpoint, is a number.  *first:
+ * the first line that is not a comment. */
+static int is_record(const char *s, const char **first)
+{
+    const char *f = s, *p;
+    char tok[LM_TOKEN_MAX];
+    double v;
+    if (strncmp(s, "input:", 6) && !strstr(s, "\ninput:")) return 0;
+    for (;;) {                                       /* comment and blank lines */
+        const char *b = f + strspn(f, " \t\r");
+        const char *nl;
+        if (*b != '#' && *b != '\n') break;
+        if (!(nl = strchr(f, '\n'))) return 0;
+        f = nl + 1;
+    }
+    *first = f;
+    p = f + strspn(f, " \t");
+    if (!strncmp(p, "input:", 6) || !*p) return 0;
+    if (lm_next_token(&p, tok, sizeof tok) <= 0) return 0;
+    return lm_parse_number(tok, &v) != LM_NUM_OK && lm_parse_number(tok, &v) != LM_NUM_PLANE;
+}
+
+static int other_record(const char *src, const char *s, char *err, size_t cap)
+{
+    const char *first = s, *marks = PS(RECORD_MARKS);
+    if (!is_record(s, &first) ||
+        !strncmp(first, PS(CLASSIC_FIRST), strlen(PS(CLASSIC_FIRST))))
+        return 0;
+    for (const char *m = marks; *m; ) {
+        const char *tab = strchr(m, '\t'), *nl = strchr(m, '\n');
+        if (!tab || !nl) break;
+        for (const char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL)
+            if (!strncmp(l, tab + 1, (size_t)(nl - tab - 1))) {
+                char opt[32];
+                snprintf(opt, sizeof opt, "%.*s", (int)(tab - m), m);
+                snprintf(err, cap, PS(OTHER_RECORD), src, opt);
+                return 1;
+            }
+        m = nl + 1;
+    }
+    {
+        char line[80];
+        size_t n = strcspn(first, "\r\n");
+        snprintf(line, sizeof line, "%.*s", (int)(n < 70 ? n : 70), first);
+        snprintf(err, cap, PS(OTHER_RECORD_UNKNOWN), src, line);
+    }
+    return 1;
+}
+
+/* In a record (is_record: prompts and "input:" lines), blank every other line;
  * line numbers stay those of the file. */
 static void keep_input_lines(char *s)
 {
-    if (strncmp(s, "input:", 6) && !strstr(s, "\ninput:")) return;
+    const char *first;
+    if (!is_record(s, &first)) return;      /* answers: every line, as a replay reads */
     for (char *l = s; l; l = strchr(l, '\n'), l = l ? l + 1 : NULL)
         if (strncmp(l, "input:", 6)) memset(l, ' ', strcspn(l, "\n"));
 }
@@ -439,7 +513,7 @@ static void keep_input_lines(char *s)
 static int lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, char *err,
                         size_t cap, int quiet)
 {
-    cursor c = {src, s, "", 0, err, cap};
+    cursor c = {src, s, "", 0, err, cap, ""};
     char asrc[600], *ans;
     size_t alen;
     rx r;
@@ -456,6 +530,7 @@ static int lens_of_text(const char *src, char *s, size_t len, lm_lens_file *lf, 
         return rc;
     }
     if (nul_check(s, len, src, err, cap)) return LM_FAIL;
+    if (other_record(src, s, err, cap)) return LM_FAIL;
     keep_input_lines(s);
     if (!is_prescription(s)) {
         rc = read_answers(&c, lf);

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include "calcio.h"
 #include "dialogues.h"
 #include "engine.h"
@@ -72,16 +73,18 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
     pdlg *d = ctx;
     size_t len;
     char err[LN_ERR_MAX];
-    char *text = slurp(word, &len, msg, cap);
+    char *text;
     ln_lens l;
     ln_notes notes = {0};
     int r, read_ok;
-    if (!text) return 1;
+    if (lm_check_input(d->io, word, "the lens file", msg, cap)) return 1;
+    if (!(text = slurp(word, &len, msg, cap))) return 1;
     if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
     else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
     free(text);
     read_ok = r == LN_OK;
     if (r == LN_OK && ln_check(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
+    if (r == LN_OK && ln_check_shape(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
     if (r == LN_OK && isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_HEIGHT) {
         snprintf(err, sizeof err, "%s: object heights as fields need a finite object "
                  "(the object is at infinity: give field angles)", word);
@@ -597,6 +600,12 @@ static int compute(pdlg *d)
         if (fabs(l->field[i].y) > fabs(fbig)) fbig = l->field[i].y;
     if (isinf(l->object)) snprintf(ob, sizeof ob, "%s", P(OBJ_INF));
     else snprintf(ob, sizeof ob, P(OBJ_AT), l->object, d->c.uname);
+    {   /* air in a lens file is 1, not the classic's 1.000293: say which applies */
+        int air = !l->obj_glass[0] || !strcasecmp(l->obj_glass, "air");
+        for (int i = 0; i < l->nsurf; i++)
+            air |= !l->surf[i].glass[0] || !strcasecmp(l->surf[i].glass, "air");
+        if (air) calc_say(&d->c, "%s", P(AIR_NOTE));
+    }
     calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
              l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
              l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
@@ -637,7 +646,7 @@ int lm_pupil(lm_io *io)
     d->c.io = io;
     d->c.unit = PX_MM;
     d->c.uname = "mm";
-    rc = lm_ask_word(io, P(FILE), P(FILE), P(FILE_WHAT), check_file, d, name, sizeof name);
+    rc = lm_ask_file(io, P(FILE), P(FILE), P(FILE_WHAT), check_file, d, name, sizeof name);
     if (rc == LM_GO) {
         if (d->notes.s && d->notes.len) {
             char *s = d->notes.s, *e;

@@ -76,6 +76,7 @@ static int check_rig(void *ctx, const char *word, char *msg, size_t cap)
 {
     rdlg *d = ctx;
     d->have_rig = 0;
+    if (lm_check_input(d->io, word, "the rig file", msg, cap)) return -1;
     if (d->api->rig_load(word, &d->rig, msg, cap)) return -1;
     d->have_rig = 1;
     return 0;
@@ -96,8 +97,8 @@ static int check_log(void *ctx, const char *word, char *msg, size_t cap)
     /* the log, the file it grows in and the shared state: none may be an input */
     for (int i = 0; i < 4; i++) {
         snprintf(name, sizeof name, "%s%s", word, ext[i]);
-        if (lm_check_output(d->io, name, msg, cap)) return -1;
         if (same_file(name, d->rig.path)) { snprintf(msg, cap, P(LOG_IS_RIG), name); return -1; }
+        if (lm_check_output(d->io, name, msg, cap)) return -1;
     }
     return 0;
 }
@@ -384,7 +385,7 @@ static int open_machine(rdlg *d)
         return rc;
     d->sim = b == 0;
     if (d->sim) {
-        if ((rc = lm_ask_word(d->io, P(SIM_LOG), P(SIM_LOG), P(SIM_LOG_WHAT), check_log, d,
+        if ((rc = lm_ask_file(d->io, P(SIM_LOG), P(SIM_LOG), P(SIM_LOG_WHAT), check_log, d,
                               d->log, sizeof d->log)))
             return rc;
         if (strcmp(d->log, "-")) {
@@ -419,7 +420,7 @@ int lm_rig(lm_io *io)
     d->io = io;
     lm_say(io, LM_BOTH, "%s", P(INTRO));
     if (need_engine(d)) { free(d); return LM_FAIL; }
-    rc = lm_ask_word(io, P(RIG_FILE), P(RIG_FILE), P(RIG_FILE_WHAT), check_rig, d, name,
+    rc = lm_ask_file(io, P(RIG_FILE), P(RIG_FILE), P(RIG_FILE_WHAT), check_rig, d, name,
                      sizeof name);
     if (!rc) {
         const rg_rig *r = &d->rig;

@@ -69,6 +69,7 @@ static int check_read(void *ctx, const char *w, char *msg, size_t cap)
     sdlg *d = ctx;
     d->fa->frame_free(d->f);
     d->f = NULL;
+    if (lm_check_input(d->io, w, "the frame file", msg, cap)) return -1;
     if (d->bits) return d->fa->read_raw(w, d->width, d->height, d->bits, &d->f, msg, cap) ? -1 : 0;
     return d->fa->read(w, &d->f, &d->colour, msg, cap) ? -1 : 0;
 }
@@ -117,7 +118,7 @@ static int synthesise(sdlg *d)
     }
     if ((rc = lm_ask_yn(d->io, P(SAVE), P(SAVE), P(SAVE_WHAT), &save))) return rc;
     if (save) {
-        if ((rc = lm_ask_word(d->io, P(SAVE_FILE), P(SAVE_FILE), P(SAVE_FILE_WHAT), check_write,
+        if ((rc = lm_ask_file(d->io, P(SAVE_FILE), P(SAVE_FILE), P(SAVE_FILE_WHAT), check_write,
                               d, name, sizeof name)))
             return rc;
         lm_say(d->io, LM_BOTH, P(SAVED), name);
@@ -190,7 +191,9 @@ static int check_source(void *ctx, const char *w, char *msg, size_t cap)
 {
     sdlg *d = ctx;
     im_source *s;
-    int rc = d->fa->source_open(w, d->width, 0, &s, msg, cap);
+    int rc;
+    if (!strchr(w, '%') && lm_check_input(d->io, w, "the frame file", msg, cap)) return -1;
+    rc = d->fa->source_open(w, d->width, 0, &s, msg, cap);
     if (rc == IM_OK) { d->fa->source_close(s); return 0; }
     /* A sequence's pattern is checked here; its first number comes next. */
     return rc == IM_EIO && strchr(w, '%') && !d->width ? 0 : -1;
@@ -219,7 +222,7 @@ static int stream(sdlg *d)
     im_centroider *c;
     int rc, n = 0, more = 0;
     d->width = 0;
-    if ((rc = lm_ask_word(d->io, P(STREAM), P(STREAM), P(STREAM_WHAT), check_source, d,
+    if ((rc = lm_ask_file(d->io, P(STREAM), P(STREAM), P(STREAM_WHAT), check_source, d,
                           name, sizeof name)))
         return rc;
     if (strchr(name, '%')) {
@@ -293,7 +296,7 @@ int lm_spot(lm_io *io)
         d.bits = 0;
         if ((rc = lm_ask_choice(io, P(SOURCE), P(SOURCE), P(SOURCE_WHAT), src, &k))) break;
         if (k == 0) {
-            rc = lm_ask_word(io, P(FILE), P(FILE), P(FILE_WHAT), check_read, &d, name, sizeof name);
+            rc = lm_ask_file(io, P(FILE), P(FILE), P(FILE_WHAT), check_read, &d, name, sizeof name);
         } else if (k == 1) {
             long w, h;
             int bits;
@@ -301,7 +304,7 @@ int lm_spot(lm_io *io)
                 !(rc = ask_int(&d, P(HEIGHT), P(HEIGHT_WHAT), 1, 16384, &h)) &&
                 !(rc = ask_bits(&d, &bits))) {
                 d.width = (int)w; d.height = (int)h; d.bits = bits;
-                rc = lm_ask_word(io, P(RAW_FILE), P(RAW_FILE), P(FILE_WHAT), check_read, &d,
+                rc = lm_ask_file(io, P(RAW_FILE), P(RAW_FILE), P(FILE_WHAT), check_read, &d,
                                  name, sizeof name);
             }
         } else if (k == 2) {

@@ -61,11 +61,24 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
     char err[SC_ERRMAX];
     if (t->have_scene) t->api->free(&t->scene);
     t->have_scene = 0;
+    if (lm_check_input(t->io, word, "the scene file", msg, cap)) return -1;
     if (t->api->load(word, &t->scene, err)) {
         snprintf(msg, cap, "%s", err);
         return -1;
     }
     t->have_scene = 1;
+    /* the meshes and media files it read are the session's inputs too */
+    for (int k = 0; k < t->scene.nsurf; k++) {
+        const char *f[2] = {t->scene.surf[k].mesh_file, t->scene.surf[k].media_file};
+        for (int m = 0; m < 2; m++) {
+            char path[2 * WORD + 2];
+            if (!f[m]) continue;
+            if (f[m][0] == '/' || !t->scene.dir || !t->scene.dir[0])
+                snprintf(path, sizeof path, "%s", f[m]);
+            else snprintf(path, sizeof path, "%s/%s", t->scene.dir, f[m]);
+            lm_files_note(m ? "the media file" : "the mesh file", path, NULL);
+        }
+    }
     /* its outputs (and the .part files written first) must not be the answers or
      * the record (the scene's own inputs the loader checked) */
     const char *out[3] = {t->scene.out_segments, t->scene.out_hits, t->scene.out_summary};
@@ -136,7 +149,7 @@ static int do_scene(tdlg *t)
     int rc;
 
     if (need_engine(t)) return LM_FAIL;
-    if ((rc = lm_ask_word(t->io, P(SCENE_FILE), P(SCENE_FILE), P(SCENE_FILE_WHAT),
+    if ((rc = lm_ask_file(t->io, P(SCENE_FILE), P(SCENE_FILE), P(SCENE_FILE_WHAT),
                           check_scene, t, name, sizeof name)))
         return rc;
     lm_say(t->io, LM_BOTH, P(SCENE_LOADED), sc->name, sc->nsurf, sc->nsource, sc->depth,
@@ -425,6 +438,7 @@ static int check_lens_file(void *ctx, const char *word, char *msg, size_t cap)
     double max;
     int cross;
     lm_lens_file_free(lf);
+    if (lm_check_input(NULL, word, "the lens file", msg, cap)) return -1;
     if (lm_read_lens(word, lf, msg, cap)) return -1;
     if (lf->nsurf > MAXSURF) {
         snprintf(msg, cap, P(RECORD_TOO_MANY), word, lf->nsurf, MAXSURF);
@@ -491,7 +505,7 @@ static int do_record(tdlg *t)
     double semi;
     int rc;
 
-    if ((rc = lm_ask_word(io, P(RECORD_FILE), P(RECORD_FILE), P(RECORD_FILE_WHAT),
+    if ((rc = lm_ask_file(io, P(RECORD_FILE), P(RECORD_FILE), P(RECORD_FILE_WHAT),
                           check_lens_file, &lf, name, sizeof name)) ||
         (rc = ask_semi_all(t, &lf, &semi)))
         goto out;

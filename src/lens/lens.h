@@ -124,6 +124,19 @@ double ln_sag(const ln_surface *s, double h);
  * (the surface's line, when it has one) in err. */
 int ln_check(const ln_lens *l, const char *src, char *err, size_t cap);
 
+/* Can the lens be made (lens_shape.c): each surface reaches its semi-diameter
+ * (semi <= |radius| on a sphere) and no two neighbouring surfaces cross inside the
+ * zone both cover.  ln_shape_check: surfaces s[0..n-1] with their vertices at z[]
+ * (semi 0: not given, not checked); LN_OK, or LN_BAD with why (no file name) and
+ * *bad the surface whose answer makes it impossible (the later of two that cross).
+ * ln_check_shape: the same for a lens, "SRC:LINE: why" in err.  Every dialogue that
+ * traces a lens with its semi-diameters checks it with one of them where the lens
+ * or its semi-diameters are entered (a reader does not: a .zmx's automatic DIAM
+ * may reach past an edge, and converting such a file loses nothing). */
+int ln_shape_check(const ln_surface *s, const double *z, int n, int *bad, char *why,
+                   size_t cap);
+int ln_check_shape(const ln_lens *l, const char *src, char *err, size_t cap);
+
 /* ---- the paraxial engine (lens_paraxial.c) ---------------------------------------
  * The lens as px_csurf surfaces (radius, thickness, glass) for px_colour_run and
  * px_seidel_run (out: nsurf of them): glass strings point into the lens, or (air
