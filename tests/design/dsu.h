@@ -30,7 +30,7 @@ static ds_problem *dsu_problem(const char *text, char *err, size_t cap)
     return p;
 }
 
-static char *dsu_slurp(const char *path)
+static inline char *dsu_slurp(const char *path)
 {
     FILE *f = fopen(path, "rb");
     if (!f) return NULL;
