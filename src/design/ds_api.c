@@ -52,7 +52,8 @@ static int merit(ds_problem *p, double *m, char *err, size_t cap)
 static void op_info(const ds_problem *p, int i, ds_op_info *out)
 {
     static const char *const k[] = {"efl", "bfd", "totr", "rms", "dist", "axcl", "spha",
-                                    "ct", "et", "glassmap"};
+                                    "ct", "et", "glassmap", "coma", "asti", "fcur", "sdis",
+                                    "lacl"};
     const ds_op *o = &p->op[i];
     double W = 0, d = o->value - o->target;
     char extra[64] = "";

@@ -17,7 +17,7 @@
 
 enum { DV_C, DV_T, DV_K, DV_A, DV_ND, DV_VD };
 enum { DO_EFL, DO_BFD, DO_TOTR, DO_RMS, DO_DIST, DO_AXCL, DO_SPHA, DO_CT, DO_ET,
-       DO_GMAP };
+       DO_GMAP, DO_COMA, DO_ASTI, DO_FCUR, DO_SDIS, DO_LACL };
 enum { DT_R, DT_T, DT_N, DT_K };
 
 typedef struct ds_var {

@@ -273,16 +273,22 @@ int ds_eval(ds_problem *p, double *f, char *why, size_t cap)
             o->value = w[ks].p.z_img - w[kl].p.z_img;
             break;
         }
-        case DO_SPHA: {
+        case DO_SPHA: case DO_COMA: case DO_ASTI: case DO_FCUR: case DO_SDIS:
+        case DO_LACL: {
+            /* Welford's Seidel sums (paraxial engine), marginal ray at the entrance
+             * pupil's rim, chief ray at the largest field through the stop's centre */
             px_seidel sd;
-            if (!isinf(l->object)) { snprintf(why, cap, "spha needs the object at infinity"); return -1; }
+            if (!isinf(l->object)) { snprintf(why, cap, "the Seidel operands need the object at infinity"); return -1; }
             if (px_seidel_run_stop(w[0].cs, l->nsurf, w[0].names[0], w[0].p.r_ep,
                                    tan(fmax(fmax_deg, 1) * DEG), l->stop < 0 ? 0 : l->stop,
                                    &sd) != PX_OK) {
                 snprintf(why, cap, "the Seidel sums cannot be formed");
                 return -1;
             }
-            o->value = sd.total.s1;
+            const px_seidel_sums *t = &sd.total;
+            o->value = o->kind == DO_SPHA ? t->s1 : o->kind == DO_COMA ? t->s2 :
+                       o->kind == DO_ASTI ? t->s3 : o->kind == DO_FCUR ? t->s4 :
+                       o->kind == DO_SDIS ? t->s5 : t->c2;
             break;
         }
         case DO_GMAP: {

@@ -171,7 +171,8 @@ static int op_kind(const char *k)
         {"efl", DO_EFL}, {"effl", DO_EFL}, {"bfd", DO_BFD}, {"bfl", DO_BFD},
         {"totr", DO_TOTR}, {"rms", DO_RMS}, {"rsce", DO_RMS}, {"dist", DO_DIST},
         {"axcl", DO_AXCL}, {"spha", DO_SPHA}, {"ct", DO_CT}, {"ctva", DO_CT},
-        {"et", DO_ET}, {"etva", DO_ET}, {NULL, 0}};
+        {"et", DO_ET}, {"etva", DO_ET}, {"coma", DO_COMA}, {"asti", DO_ASTI},
+        {"fcur", DO_FCUR}, {"sdis", DO_SDIS}, {"lacl", DO_LACL}, {NULL, 0}};
     for (int i = 0; names[i].n; i++)
         if (!strcasecmp(k, names[i].n)) return names[i].k;
     return -1;
@@ -190,7 +191,8 @@ static int line_op(rdr *r, char **t, int n, int bound)
     if (n < 3) return BAD("%s OPERAND VALUE [field F|all] [wave W|all] [surface S] "
                           "[weight W]", t[0]);
     if ((o.kind = op_kind(t[1])) < 0)
-        return BAD("'%s' is not an operand (efl bfd totr rms dist axcl spha ct et)", t[1]);
+        return BAD("'%s' is not an operand (efl bfd totr rms dist axcl spha coma asti fcur "
+                   "sdis lacl ct et)", t[1]);
     if (!num(t[2], &o.target)) return BAD("'%s' is not a number", t[2]);
     for (int i = 3; i < n; i += 2) {
         if (i + 1 >= n) return BAD("'%s' wants a value after it", t[i]);
