@@ -53,13 +53,13 @@ static void op_info(const ds_problem *p, int i, ds_op_info *out)
 {
     static const char *const k[] = {"efl", "bfd", "totr", "rms", "dist", "axcl", "spha",
                                     "ct", "et", "glassmap", "coma", "asti", "fcur", "sdis",
-                                    "lacl"};
+                                    "lacl", "rmsw"};
     const ds_op *o = &p->op[i];
     double W = 0, d = o->value - o->target;
     char extra[64] = "";
     memset(out, 0, sizeof *out);
     for (int j = 0; j < p->nop; j++) W += p->op[j].weight;
-    if (o->kind == DO_RMS || o->kind == DO_DIST) {
+    if (o->kind == DO_RMS || o->kind == DO_DIST || o->kind == DO_RMSW) {
         if (o->wave >= 0) snprintf(extra, sizeof extra, " field %d wave %d", o->field + 1, o->wave + 1);
         else snprintf(extra, sizeof extra, " field %d", o->field + 1);
     } else if (o->kind == DO_CT || o->kind == DO_ET || o->kind == DO_GMAP) {

@@ -17,7 +17,7 @@
 
 enum { DV_C, DV_T, DV_K, DV_A, DV_ND, DV_VD };
 enum { DO_EFL, DO_BFD, DO_TOTR, DO_RMS, DO_DIST, DO_AXCL, DO_SPHA, DO_CT, DO_ET,
-       DO_GMAP, DO_COMA, DO_ASTI, DO_FCUR, DO_SDIS, DO_LACL };
+       DO_GMAP, DO_COMA, DO_ASTI, DO_FCUR, DO_SDIS, DO_LACL, DO_RMSW };
 enum { DT_R, DT_T, DT_N, DT_K };
 
 typedef struct ds_var {
@@ -92,6 +92,10 @@ double ds_merit_of(const ds_problem *p, const double *f);
 int ds_field_rays(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, double *pts,
                   double *dirs, double *wt, int cap);
 double ds_image_z(const ln_lens *l, const ds_wl *prim);
+/* The wavefront of field fi (waves, piston not removed) at every wavelength of w:
+ * count, -1 on a failed ray (or no exit pupil), -2 when stopped. */
+int ds_field_wave(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, double *wv,
+                  double *wt, int cap);
 /* ds_opt.c */
 int ds_optimise(ds_problem *p, int max_iter, int (*progress)(void *, const ds_step *),
                 int (*stop)(void *), void *ctx, ds_opt_result *res, char *err, size_t cap);

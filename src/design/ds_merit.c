@@ -179,6 +179,65 @@ int ds_field_rays(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
     return fails ? -1 : n;
 }
 
+static double unit_mm(const char *u)
+{
+    return !strcmp(u, "cm") ? 10 : !strcmp(u, "m") ? 1000 : !strcmp(u, "in") ? 25.4 : 1;
+}
+
+/* The optical path of ray r to the reference sphere (centre c, radius R; sign: which
+ * of its two crossings), counted from the object point, or for an object at infinity
+ * from the incoming plane wavefront through the origin (Welford's W, as --pupil). */
+static double sphere_path(const trace_aim_ray *r, int inf, double n0, double ni,
+                          const double c[3], double R, double sign)
+{
+    double o = r->opl, pc[3], b, cc, disc;
+    if (inf) o += n0 * (r->o[0] * r->d[0] + r->o[1] * r->d[1] + r->o[2] * r->d[2]);
+    for (int k = 0; k < 3; k++) pc[k] = r->img[k] - c[k];
+    b = r->img_dir[0] * pc[0] + r->img_dir[1] * pc[1] + r->img_dir[2] * pc[2];
+    cc = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2] - R * R;
+    disc = b * b - cc;
+    if (disc < 0) return NAN;
+    return o - ni * (b + sign * sqrt(disc));
+}
+
+int ds_field_wave(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, double *wv,
+                  double *wt, int cap)
+{
+    const ln_lens *l = &p->lens;
+    const ln_field *f = &l->field[fi];
+    int sym = f->x == 0, n = 0, inf = isinf(l->object);
+    double wsum = 0, um = 1e-3 / unit_mm(l->unit);
+    for (int k = 0; k < nwl; k++) wsum += l->nwl ? l->wl_weight[k] : 1;
+    for (int k = 0; k < nwl; k++) {
+        ds_wl *x = &w[k];
+        trace_aim_ray ch, r;
+        double wk = (l->nwl ? l->wl_weight[k] : 1) / wsum, lam = x->lambda * um;
+        x->rx.z_image = z_image;
+        if (aim(p, x, f, 0, 0, &ch) || !isfinite(x->p.z_xp) || !(ch.img_dir[2] > 0)) return -1;
+        /* the sphere: centred on the chief ray's image point, through its crossing of
+         * the paraxial exit pupil's plane */
+        double t = (x->p.z_xp - ch.img[2]) / ch.img_dir[2], R = fabs(t), sign = t < 0 ? 1 : -1;
+        double n0 = x->n[0], ni = x->n[l->nsurf];
+        if (!(R > 0)) return -1;
+        double w0 = sphere_path(&ch, inf, n0, ni, ch.img, R, sign);
+        for (int i = 0; i < p->rings; i++)
+            for (int j = 0; j < p->arms; j++) {
+                double a = (j + 0.5) * 2 * 3.14159265358979323846 / p->arms, rho = sqrt(p->ru[i]);
+                double px = rho * sin(a), py = rho * cos(a), q = wk * p->rw[i] / p->arms;
+                if (sym && px < 0) continue;
+                if (n + 2 > cap) return -1;
+                if (aim(p, x, f, px, py, &r)) return -1;
+                double v = (w0 - sphere_path(&r, inf, n0, ni, ch.img, R, sign)) / lam;
+                if (!isfinite(v)) return -1;
+                wv[n] = v;
+                wt[n++] = q;
+                if (sym) { wv[n] = v; wt[n++] = q; }
+            }
+        if (p->stop && p->stop(p->stop_ctx)) { p->stopped = 1; return -2; }
+    }
+    return n;
+}
+
 /* Distance of (vd/100, nd) outside the glass map (0 inside). */
 static double outside_hull(const ds_problem *p, double nd, double vd)
 {
@@ -207,6 +266,8 @@ static long op_nres(const ds_problem *p, const ds_op *o)
 {
     if (o->kind == DO_RMS && o->bound == 0 && o->target == 0)
         return 2L * p->rings * p->arms * op_nwl(p, o);
+    if (o->kind == DO_RMSW && o->bound == 0 && o->target == 0)
+        return (long)p->rings * p->arms * op_nwl(p, o);
     return 1;
 }
 
@@ -309,6 +370,35 @@ int ds_eval(ds_problem *p, double *f, char *why, size_t cap)
             if (aim(p, &w[0], fl, 0, 0, &r)) o->value = 100;
             else o->value = rp > 0 ? 100 * (hypot(r.img[0], r.img[1]) - rp) / rp : 0;
             break;
+        }
+        case DO_RMSW: {
+            /* RMS wavefront (waves) about its mean: residuals sqrt(w q / W) (W_k - mean) */
+            int k0 = o->wave < 0 ? 0 : o->wave, nk = op_nwl(p, o), cap2 = DS_MAXRING * DS_MAXARM * 2;
+            double wv[2 * DS_MAXRING * DS_MAXARM], wt[2 * DS_MAXRING * DS_MAXARM], m = 0, q = 0, r2 = 0;
+            long nr = op_nres(p, o);
+            int n = ds_field_wave(p, w + k0, nk, o->field, zi, wv, wt, cap2);
+            if (n == -2) return 1;
+            if (n < 0) {
+                o->value = 10;                 /* ten waves: a penalty, not a stop */
+                if (f) for (long j = 0; j < nr; j++) f[at + j] = sw * o->value / sqrt((double)nr);
+                at += nr;
+                continue;
+            }
+            for (int j = 0; j < n; j++) { m += wt[j] * wv[j]; q += wt[j]; }
+            m /= q;
+            for (int j = 0; j < n; j++) {
+                double d = wv[j] - m;
+                r2 += wt[j] * d * d;
+                if (f && nr > 1) f[at + j] = sw * sqrt(wt[j] / q) * d;
+            }
+            o->value = sqrt(r2 / q);
+            if (f && nr > 1) {
+                for (long j = n; j < nr; j++) f[at + j] = 0;
+                at += nr;
+            } else if (f) {
+                f[at++] = sw * scalar_res(o);
+            }
+            continue;
         }
         case DO_RMS: {
             int k0 = o->wave < 0 ? 0 : o->wave, nk = op_nwl(p, o);

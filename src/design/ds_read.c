@@ -172,7 +172,8 @@ static int op_kind(const char *k)
         {"totr", DO_TOTR}, {"rms", DO_RMS}, {"rsce", DO_RMS}, {"dist", DO_DIST},
         {"axcl", DO_AXCL}, {"spha", DO_SPHA}, {"ct", DO_CT}, {"ctva", DO_CT},
         {"et", DO_ET}, {"etva", DO_ET}, {"coma", DO_COMA}, {"asti", DO_ASTI},
-        {"fcur", DO_FCUR}, {"sdis", DO_SDIS}, {"lacl", DO_LACL}, {NULL, 0}};
+        {"fcur", DO_FCUR}, {"sdis", DO_SDIS}, {"lacl", DO_LACL}, {"rmsw", DO_RMSW},
+        {"rwre", DO_RMSW}, {NULL, 0}};
     for (int i = 0; names[i].n; i++)
         if (!strcasecmp(k, names[i].n)) return names[i].k;
     return -1;
@@ -191,8 +192,8 @@ static int line_op(rdr *r, char **t, int n, int bound)
     if (n < 3) return BAD("%s OPERAND VALUE [field F|all] [wave W|all] [surface S] "
                           "[weight W]", t[0]);
     if ((o.kind = op_kind(t[1])) < 0)
-        return BAD("'%s' is not an operand (efl bfd totr rms dist axcl spha coma asti fcur "
-                   "sdis lacl ct et)", t[1]);
+        return BAD("'%s' is not an operand (efl bfd totr rms rmsw dist axcl spha coma asti "
+                   "fcur sdis lacl ct et)", t[1]);
     if (!num(t[2], &o.target)) return BAD("'%s' is not a number", t[2]);
     for (int i = 3; i < n; i += 2) {
         if (i + 1 >= n) return BAD("'%s' wants a value after it", t[i]);
@@ -227,7 +228,7 @@ static int line_op(rdr *r, char **t, int n, int bound)
         if (!(p->lens.surf[o.surf].semi > 0) && !(p->lens.surf[o.surf + 1].semi > 0))
             return BAD("et: surfaces %d and %d have no semi-diameter", o.surf + 1, o.surf + 2);
     }
-    if (o.kind == DO_RMS || o.kind == DO_DIST) {
+    if (o.kind == DO_RMS || o.kind == DO_DIST || o.kind == DO_RMSW) {
         if (!p->lens.nfield) return BAD("%s needs the lens's fields (a field line)", t[1]);
         if (p->lens.ap_kind == LN_AP_NONE)
             return BAD("%s needs the lens's aperture (epd, fnum or na)", t[1]);

@@ -29,16 +29,19 @@ static void singlet(const char *op, double tol)
     char text[2048], err[DS_ERR_MAX];
     ds_opt_result r;
     double n = 1.5, q0 = 2 * (n * n - 1) / (n + 2), c1, c2;
-    /* start: equi-convex f ~ 100 */
+    int sp = !strcmp(op, "spha"), rw = !strcmp(op, "rmsw");
+    /* start: equi-convex f ~ 100; rms: the image plane free; spha, rmsw: at the
+     * paraxial focus (thickness 0 after the last surface) */
     snprintf(text, sizeof text,
              "thickness\nwavelengths d\nepd %s\nfield angle 0\n"
              "100 %s 1.5 stop\n-100 %s air\n"
              "vary c 1\nvary c 2\n%s"
              "target efl 100 weight 1\n%s\n",
-             !strcmp(op, "spha") ? "20" : "5", !strcmp(op, "spha") ? "0.01" : "0.3",
-             !strcmp(op, "spha") ? "0" : "100", !strcmp(op, "spha") ? "" : "vary t 2\n",
-             !strcmp(op, "spha") ? "target spha 0 weight 1" :
-                                   "target rms 0 field 1 weight 1\ndesign rings 6 arms 6");
+             sp ? "20" : "5", sp ? "0.01" : "0.3", sp || rw ? "0" : "100",
+             sp || rw ? "" : "vary t 2\n",
+             sp ? "target spha 0 weight 1" :
+             rw ? "target rmsw 0 field 1 weight 1\ndesign rings 6 arms 6" :
+                  "target rms 0 field 1 weight 1\ndesign rings 6 arms 6");
     ds_problem *p = dsu_problem(text, err, sizeof err);
     CHECK(p != NULL, "singlet (%s) read: %s", op, p ? "" : err);
     if (!p) return;
@@ -117,6 +120,28 @@ static void quadrature(void)
     free(s);
 }
 
+/* The RMS wavefront of pure third-order spherical aberration at the paraxial focus:
+ * W = W040 rho^4 with W040 = SI/8 (Welford), piston removed: RMS = W040 sqrt(1/5 -
+ * 1/9) = W040 sqrt(4/45).  An f/20 singlet, where the fifth order is ~1e-3 of it. */
+static void wavefront(void)
+{
+    char err[DS_ERR_MAX];
+    const char *text = "thickness\nwavelengths d\nepd 5\nfield angle 0\n58.33 0.3 1.5 stop\n"
+                       "-350 0 air\ntarget spha 0\ntarget rmsw 0 field 1\ndesign rings 8 arms 6\n";
+    ds_problem *p = dsu_problem(text, err, sizeof err);
+    CHECK(p != NULL, "wavefront singlet read: %s", p ? "" : err);
+    if (!p) return;
+    double m;
+    ds_op_info si, w;
+    CHECK(ds->merit(p, &m, err, sizeof err) == DS_OK, "wavefront singlet merit");
+    ds->op_info(p, 0, &si);
+    ds->op_info(p, 1, &w);
+    double pred = sqrt(4.0 / 45) * fabs(si.value) / 8 / 0.5875618e-3;
+    CHECK(fabs(w.value / pred - 1) < 0.01, "RMS wavefront %.6g waves, third order SI/8 sqrt(4/45) "
+          "= %.6g waves (ratio %.5f)", w.value, pred, w.value / pred);
+    ds->free(p);
+}
+
 static void refusals(void)
 {
     char err[DS_ERR_MAX];
@@ -143,6 +168,8 @@ int main(void)
     achromat();
     singlet("spha", 1e-4);
     singlet("rms", 3e-3);
+    singlet("rmsw", 3e-3);
+    wavefront();
     quadrature();
     return unit_failed();
 }
