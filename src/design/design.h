@@ -73,12 +73,16 @@ typedef struct ds_crit {
                                   centroid, after the back-focus compensator */
     double efl, bfd;           /* paraxial, primary wavelength */
     double focus;              /* the compensator's image-plane shift */
+    double wave;               /* with ds_tol_opts.wave: RMS wavefront (waves, piston
+                                  removed; field-weighted quadratic mean, every
+                                  wavelength) on the compensated image plane; else NaN */
     int ok;                    /* 0: a ray failed (missed, TIR): rms is NaN */
 } ds_crit;
 typedef struct ds_tol_opts {
     int dist;                  /* 0 uniform in [-d, d], 1 Gaussian sigma d/2 cut at +-d */
     int compensate;            /* 1: back focus refocused for the least rms */
     double limit;              /* yield: rms <= limit (lens units); 0: none */
+    int wave;                  /* 1: also the RMS wavefront (ds_crit.wave) */
 } ds_tol_opts;
 
 typedef struct ds_api {

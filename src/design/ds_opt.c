@@ -34,6 +34,38 @@ double ds_get_var(const ds_problem *p, int i)
     }
 }
 
+/* Keep a model glass on the glass map (the catalogue's convex hull in (Vd/100, nd)):
+ * a hard bound, as a designer's model-glass limits are.  axis 1: only nd moves
+ * (clamped to the hull's span at this Vd), 0: only Vd, 2: both (nearest point). */
+static void on_map(const ds_problem *p, double *nd, double *vd, int axis)
+{
+    const double *h = p->hull;
+    double x = *vd / 100, y = *nd, lo = INFINITY, hi = -INFINITY, bx = x, by = y, best = INFINITY;
+    int inside = p->nhull >= 3;
+    if (p->nhull < 3) return;
+    for (int i = 0; i < p->nhull; i++) {
+        const double *a = h + 2 * i, *b = h + 2 * ((i + 1) % p->nhull);
+        double ex = b[0] - a[0], ey = b[1] - a[1];
+        if (ex * (y - a[1]) - ey * (x - a[0]) < 0) inside = 0;
+        /* the edge's crossing of the line nd = y (axis 0) or Vd = x (axis 1) */
+        double u0 = axis == 1 ? a[0] : a[1], u1 = axis == 1 ? b[0] : b[1], u = axis == 1 ? x : y;
+        if ((u0 <= u && u <= u1) || (u1 <= u && u <= u0)) {
+            double t = u1 != u0 ? (u - u0) / (u1 - u0) : 0;
+            double v = axis == 1 ? a[1] + t * ey : a[0] + t * ex;
+            lo = fmin(lo, v);
+            hi = fmax(hi, v);
+        }
+        double L2 = ex * ex + ey * ey, t = L2 > 0 ? ((x - a[0]) * ex + (y - a[1]) * ey) / L2 : 0;
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        double px = a[0] + t * ex, py = a[1] + t * ey, d = hypot(x - px, y - py);
+        if (d < best) { best = d; bx = px; by = py; }
+    }
+    if (inside) return;
+    if (axis == 1 && lo <= hi) *nd = fmin(fmax(y, lo), hi);
+    else if (axis == 0 && lo <= hi) *vd = 100 * fmin(fmax(x, lo), hi);
+    else { *nd = by; *vd = 100 * bx; }
+}
+
 void ds_set_var(ds_problem *p, int i, double x)
 {
     const ds_var *v = &p->var[i];
@@ -47,6 +79,13 @@ void ds_set_var(ds_problem *p, int i, double x)
     default:
         sscanf(s->glass, "%lf/%lf", &nd, &vd);
         if (v->kind == DV_ND) nd = x; else vd = x;
+        {
+            int both = 0;
+            for (int j = 0; j < p->nvar; j++)
+                if (j != i && p->var[j].surf == v->surf &&
+                    (p->var[j].kind == DV_ND || p->var[j].kind == DV_VD)) both = 1;
+            on_map(p, &nd, &vd, both ? 2 : v->kind == DV_ND ? 1 : 0);
+        }
         /* the model glass's formula holds inside these (px_glass_model) */
         nd = fmin(fmax(nd, 1.0001), 2.9999);
         vd = fmin(fmax(vd, 5), 150);

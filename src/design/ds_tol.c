@@ -29,7 +29,7 @@ static int crit(ds_problem *p, const ds_tol_opts *o, ds_crit *c)
     char why[256];
     double zi, zlast = 0, sab = 0, sbb = 0, wsum = 0;
     memset(c, 0, sizeof *c);
-    c->rms = c->efl = c->bfd = NAN;
+    c->rms = c->efl = c->bfd = c->wave = NAN;
     if (ds_setup(p, l, w, nwl, why, sizeof why)) return DS_OK;
     for (int i = 0; i < N; i++) zlast += l->surf[i].t;
     zi = ds_image_z(l, &w[0]);
@@ -73,6 +73,20 @@ static int crit(ds_problem *p, const ds_tol_opts *o, ds_crit *c)
     c->rms = wsum > 0 ? sqrt(r2 / wsum) : NAN;
     c->focus = dz;
     c->ok = 1;
+    if (o->wave) {
+        double v2 = 0;
+        for (int f = 0; f < l->nfield; f++) {
+            double fw = l->field[f].weight > 0 ? l->field[f].weight : 0, m = 0, q = 0, s2 = 0;
+            int n = ds_field_wave(p, w, nwl, f, zi + dz, pts, wt, MAXRAY);
+            if (n == -2) return DS_STOPPED;
+            if (n < 0) { c->ok = 0; return DS_OK; }
+            for (int j = 0; j < n; j++) { m += wt[j] * pts[j]; q += wt[j]; }
+            m /= q;
+            for (int j = 0; j < n; j++) s2 += wt[j] * (pts[j] - m) * (pts[j] - m);
+            v2 += fw * s2 / q;
+        }
+        c->wave = wsum > 0 ? sqrt(v2 / wsum) : NAN;
+    }
     return DS_OK;
 }
 

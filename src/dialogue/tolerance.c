@@ -84,8 +84,9 @@ static int sens(tdlg *d)
     ds_problem *p = d->f.p;
     ds_crit n, a, b;
     double ve = 0, vb = 0, k = d->o.dist ? 0.25 * 0.7737413 : 1.0 / 3;
+    d->o.wave = 1;
     if (ds->tol_nominal(p, &d->o, &n) == DS_STOPPED) return LM_FAIL;
-    calc_say(&d->c, P(NOMINAL), n.rms * d->um, n.efl, n.bfd, lm_clean(d->io, n.focus));
+    calc_say(&d->c, P(NOMINAL), n.rms * d->um, n.wave, n.efl, n.bfd, lm_clean(d->io, n.focus));
     calc_say(&d->c, "%s", P(SENS_HEAD));
     for (int i = 0; i < ds->ntol(p); i++) {
         ds_tol_info t;
@@ -95,8 +96,8 @@ static int sens(tdlg *d)
             ds->tol_one(p, &d->o, i, 1, &b) == DS_STOPPED)
             return LM_FAIL;
         if (!a.ok || !b.ok) { calc_say(&d->c, P(SENS_FAIL), t.name, t.delta, t.line); continue; }
-        calc_say(&d->c, P(SENS_ROW), t.name, t.delta, a.rms * d->um, b.rms * d->um, a.efl, b.efl,
-                 a.bfd, b.bfd, t.line);
+        calc_say(&d->c, P(SENS_ROW), t.name, t.delta, a.rms * d->um, b.rms * d->um, a.wave,
+                 b.wave, a.efl, b.efl, a.bfd, b.bfd, t.line);
         /* the half-difference is the linear change at +delta; its variance factor
          * that of the distribution over [-delta, delta] in delta^2 */
         ve += k * pow((b.efl - a.efl) / 2, 2);

@@ -142,6 +142,63 @@ static void wavefront(void)
     ds->free(p);
 }
 
+/* A plano-convex lens, plane side to a collimated beam: the beam meets the curved exit
+ * surface undeviated and is focused without aberration by a hyperboloid of conic
+ * k = -n^2 (the Cartesian oval from glass into air).  Varying k alone (image at the
+ * paraxial focus) must find it; an even asphere on the sphere instead must find the
+ * hyperboloid's r^4 term, a4 = k c^3 / 8 (with a6 free to take the next order). */
+static void conic(void)
+{
+    char err[DS_ERR_MAX];
+    const char *tk = "thickness\nwavelengths d\nepd 10\nfield angle 0\nplane 4 1.5 stop\n"
+                     "-25 0 air\nvary k 2\ntarget rms 0 field 1\ndesign rings 6 arms 6\n";
+    const char *ta = "thickness\nwavelengths d\nepd 4\nfield angle 0\nplane 4 1.5 stop\n"
+                     "-25 0 air\nvary a4 2\nvary a6 2\ntarget rms 0 field 1\ndesign rings 8 arms 6\n";
+    ds_opt_result r;
+    ds_var_info v;
+    ds_problem *p = dsu_problem(tk, err, sizeof err);
+    CHECK(p != NULL, "plano-hyperbolic read: %s", p ? "" : err);
+    if (!p) return;
+    ds->optimise(p, 200, NULL, NULL, NULL, &r, err, sizeof err);
+    ds->var_info(p, 0, &v);
+    CHECK(fabs(v.value + 2.25) < 1e-6 && r.merit < 1e-9, "conic found %.9f, -n^2 = -2.25 "
+          "(merit %.3g)", v.value, r.merit);
+    ds->free(p);
+    p = dsu_problem(ta, err, sizeof err);
+    CHECK(p != NULL, "aspheric read: %s", p ? "" : err);
+    if (!p) return;
+    ds->optimise(p, 200, NULL, NULL, NULL, &r, err, sizeof err);
+    ds->var_info(p, 0, &v);
+    double c = -1 / 25.0, a4 = -2.25 * c * c * c / 8;
+    CHECK(fabs(v.value / a4 - 1) < 0.01, "a4 found %.6g, the hyperboloid's k c^3/8 = %.6g "
+          "(merit %.3g -> %.3g)", v.value, a4, r.merit0, r.merit);
+    ds->free(p);
+}
+
+/* A model glass pushed off the glass map: efl 10 from R +-50 needs nd 3.5; the
+ * glass map (the convex hull of the catalogue's glasses) holds nd at its edge for
+ * Vd 64.17: on the map, and below 2.1 (no crown of Vd 64 in any catalogue comes near). */
+static void glassmap(void)
+{
+    char err[DS_ERR_MAX];
+    const char *t = "thickness\nwavelengths d\nepd 2\nfield angle 0\n50 3 1.5168/64.17 stop\n"
+                    "-50 0 air\nvary nd 1\ntarget efl 10\n";
+    ds_opt_result r;
+    ds_var_info v;
+    ds_op_info g;
+    double m;
+    ds_problem *p = dsu_problem(t, err, sizeof err);
+    CHECK(p != NULL, "glass map read: %s", p ? "" : err);
+    if (!p) return;
+    ds->optimise(p, 300, NULL, NULL, NULL, &r, err, sizeof err);
+    ds->merit(p, &m, err, sizeof err);
+    ds->var_info(p, 0, &v);
+    ds->op_info(p, 0, &g);
+    CHECK(!strcmp(g.name, "max glassmap surface 1") && g.value < 2e-3 && v.value > 1.6 && v.value < 2.1,
+          "nd %.5f at Vd 64.17: %.2g outside the catalogue's glass map (%s)", v.value, g.value, g.name);
+    ds->free(p);
+}
+
 static void refusals(void)
 {
     char err[DS_ERR_MAX];
@@ -170,6 +227,8 @@ int main(void)
     singlet("rms", 3e-3);
     singlet("rmsw", 3e-3);
     wavefront();
+    conic();
+    glassmap();
     quadrature();
     return unit_failed();
 }
