@@ -108,3 +108,15 @@ check "--optimise: SIGTERM mid-run stops, says so, exit 143, writes nothing" opt
 check "--optimise and --tolerance are in --help and the man page" sh -c "
     '$BIN' --help | grep -q -- '--optimise' && '$BIN' --help | grep -q -- '--tolerance' &&
     grep -q 'optimise' '$TOP/doc/lensmat.1' && grep -q 'tolerance' '$TOP/doc/lensmat.1'"
+
+# The distortion operand against --pupil's own chief-ray distortion (src/dialogue/
+# pupil.c: its own aiming request and paraxial image height) for Sasian's triplet at
+# 14.14 and 20 degrees, d: the same 4 digits.
+check "--optimise: dist operand = --pupil's real chief-ray distortion (triplet, 2 fields)" sh -c "
+    cd '$WORK/op' && sed '/^vary\|^target\|^min/d' doc/design/sasian-triplet.rx > plain.rx &&
+    printf 'plain.rx\nhex\n4\nn\n' > pp.in && '$BIN' --pupil -i pp.in pp.rec > /dev/null &&
+    { cat plain.rx; printf 'vary t 6\ntarget dist 0 field 2\ntarget dist 0 field 3\n'; } > dd.rx &&
+    printf 'dd.rx\n-\n1\ndd-out.rx\n' > dd.in && '$BIN' --optimise -i dd.in dd.rec > /dev/null &&
+    a=\$(awk '/^Wavelength 587/ { on = 1 } /^Wavelength 486/ { on = 0 } on && /distortion -?[0-9]/ { sub(/.*distortion /, \"\"); sub(/ %.*/, \"\"); printf \"%.4g \", \$0 }' pp.rec | cut -d' ' -f1-2) &&
+    b=\$(awk '/operands \\(target/ { on = 1 } /^  iteration/ { on = 0 } on && \$1 == \"dist\" { printf \"%.4g \", \$6 }' dd.rec | sed 's/ \$//') &&
+    [ -n \"\$a\" ] && [ \"\$a\" = \"\$b\" ] || { echo \"pupil '\$a' design '\$b'\"; exit 1; }"

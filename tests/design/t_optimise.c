@@ -199,6 +199,26 @@ static void glassmap(void)
     ds->free(p);
 }
 
+/* Edge and centre thickness against the sphere's sag at the semi-diameter, done
+ * here: R +-50, semi 10: t - 2 (50 - sqrt(2500 - 100)). */
+static void thickness_ops(void)
+{
+    char err[DS_ERR_MAX];
+    const char *t = "thickness\nepd 2\n50 5 1.5 semi 10\n-50 0 air semi 8\n"
+                    "target et 0 surface 1\ntarget ct 0 surface 1\n";
+    double m;
+    ds_op_info a, b;
+    ds_problem *p = dsu_problem(t, err, sizeof err);
+    CHECK(p != NULL, "et/ct read: %s", p ? "" : err);
+    if (!p) return;
+    ds->merit(p, &m, err, sizeof err);
+    ds->op_info(p, 0, &a);
+    ds->op_info(p, 1, &b);
+    double et = 5 - 2 * (50 - sqrt(2500.0 - 100));
+    CHECK(fabs(a.value - et) < 1e-12 && b.value == 5, "et %.15g (sags: %.15g), ct %g", a.value, et, b.value);
+    ds->free(p);
+}
+
 static void refusals(void)
 {
     char err[DS_ERR_MAX];
@@ -229,6 +249,7 @@ int main(void)
     wavefront();
     conic();
     glassmap();
+    thickness_ops();
     quadrature();
     return unit_failed();
 }
