@@ -89,9 +89,11 @@ static void op_info(const ds_problem *p, int i, ds_op_info *out)
 static void describe(const ds_problem *p, char *buf, size_t cap)
 {
     snprintf(buf, cap, "Gaussian quadrature pupil: %d ring%s x %d arm%s (%d rays per field "
-             "and wavelength, the x > 0 half traced for fields in y), rays aimed at the "
-             "stop, no vignetting; method %s", p->rings, p->rings == 1 ? "" : "s", p->arms,
+             "and wavelength, the x > 0 half traced for fields in y), %s, no vignetting; "
+             "method %s", p->rings, p->rings == 1 ? "" : "s", p->arms,
              p->arms == 1 ? "" : "s", p->rings * p->arms,
+             p->aim_paraxial ? "rays sent at the paraxial entrance pupil" :
+                               "rays aimed at the stop",
              p->method ? "Levenberg-Marquardt with geodesic acceleration" :
                          "Levenberg-Marquardt");
 }
