@@ -124,6 +124,7 @@ typedef struct ds_api {
      * run.  The problem's lens is restored after. */
     int (*tol_mc)(ds_problem *p, const ds_tol_opts *o, uint64_t seed, long k, ds_crit *c);
     void (*tol_defaults)(const ds_problem *p, ds_tol_opts *o);   /* the file's tolopt */
+    const char *(*unit)(const ds_problem *p);    /* the lens's length unit ("mm") */
 } ds_api;
 
 typedef const ds_api *(*ds_get_api_fn)(int abi);

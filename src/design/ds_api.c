@@ -116,10 +116,11 @@ static char *write_lens(const ds_problem *p)
 }
 
 static void tol_defaults(const ds_problem *p, ds_tol_opts *o) { *o = p->topt; }
+static const char *unit(const ds_problem *p) { return p->lens.unit[0] ? p->lens.unit : "mm"; }
 
 static const ds_api api = {
     DS_ABI, ds_read, ds_free, nvar, nop, ntol, var_info, tol_info, merit, op_info,
-    describe, ds_optimise, write_lens, ds_tol_nominal, ds_tol_one, ds_tol_mc, tol_defaults,
+    describe, ds_optimise, write_lens, ds_tol_nominal, ds_tol_one, ds_tol_mc, tol_defaults, unit,
 };
 
 __attribute__((visibility("default"))) const ds_api *ds_get_api(int abi)

@@ -274,7 +274,7 @@ int lm_tolerance(lm_io *io)
     if (rc == LM_GO) rc = calc_choice(&d->c, P(KIND), P(KIND_WHAT), kinds, &kind);
     if (rc == LM_GO) {
         d->ds->tol_defaults(d->f.p, &d->o);
-        d->um = 1000;
+        d->um = unit_um(d->ds->unit(d->f.p));
         int nt = d->ds->ntol(d->f.p);
         calc_say(&d->c, P(HEAD), d->f.lens, nt, nt == 1 ? "" : "s",
                  d->o.compensate ? "back focus" : "none");
@@ -284,7 +284,6 @@ int lm_tolerance(lm_io *io)
     }
     if (rc == LM_GO) rc = calc_done(&d->c);
     if (d->f.p) d->ds->free(d->f.p);
-    (void)unit_um;
     return rc;
 }
 const char *lm_tolerance_example(void) { return P(EXAMPLE); }
