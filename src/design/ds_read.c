@@ -157,7 +157,7 @@ static int line_vary(rdr *r, char **t, int n)
         memset(o, 0, sizeof *o);
         o->kind = DO_GMAP;
         o->bound = -1;
-        o->weight = 100;
+        o->weight = 0;                 /* a hard bound (ds_opt.c): shown, never weighed */
         o->surf = s;
         o->line = r->line;
         return DS_OK;
@@ -492,6 +492,11 @@ int ds_read(const char *lens_text, size_t lens_len, const char *lens_src,
     if (rc == DS_OK && merit_text)
         rc = read_lines(p, merit_text, merit_len, merit_src, 0, err, cap);
     if (rc == DS_OK && ln_check(&p->lens, lens_src, err, cap) != LN_OK) rc = DS_BAD;
+    if (rc == DS_OK && p->rings * p->arms * (p->lens.nwl ? p->lens.nwl : 1) >
+                           2 * DS_MAXRING * DS_MAXARM)
+        rc = fail(err, cap, merit_src ? merit_src : lens_src, 0, "%d rings x %d arms x %d "
+                  "wavelengths: at most %d rays a field", p->rings, p->arms,
+                  p->lens.nwl ? p->lens.nwl : 1, 2 * DS_MAXRING * DS_MAXARM);
     if (rc == DS_OK && ln_copy(&p->base, &p->lens) != LN_OK)
         rc = fail(err, cap, lens_src, 0, "out of memory");
     if (rc != DS_OK) {

@@ -85,7 +85,7 @@ static int run(odlg *d)
     calc_say(&d->c, P(SAMPLING), desc);
     if (ds->merit(p, &m, err, sizeof err) != DS_OK) {
         calc_say(&d->c, P(REFUSED), err);
-        fprintf(stderr, "lensmat: %s\n", err);
+        fprintf(stderr, P(ERR), err);
         return LM_FAIL;
     }
     calc_say(&d->c, "%s", P(VAR_HEAD));
@@ -95,12 +95,12 @@ static int run(odlg *d)
     int rc = ds->optimise(p, d->iters, progress, stop, d, &r, err, sizeof err);
     if (rc == DS_STOPPED || lm_stop_requested()) {
         calc_say(&d->c, "%s", P(STOPPED));
-        fprintf(stderr, "lensmat: stopped: nothing written\n");
+        fprintf(stderr, "%s", P(STOPPED_ERR));
         return LM_FAIL;
     }
     if (rc != DS_OK) {
         calc_say(&d->c, P(REFUSED), err);
-        fprintf(stderr, "lensmat: %s\n", err);
+        fprintf(stderr, P(ERR), err);
         return LM_FAIL;
     }
     calc_say(&d->c, P(METHOD), r.method);
@@ -117,7 +117,7 @@ static int run(odlg *d)
     if (dz_write(d->out, text, strlen(text), err, sizeof err)) {
         free(text);
         calc_say(&d->c, P(REFUSED), err);
-        fprintf(stderr, "lensmat: %s\n", err);
+        fprintf(stderr, P(ERR), err);
         return LM_FAIL;
     }
     free(text);

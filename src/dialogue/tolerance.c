@@ -145,7 +145,7 @@ static int summary(tdlg *d, const char *src, const char *text, double limit_um)
                 char m[512];
                 snprintf(m, sizeof m, P(BAD_TABLE), src, line);
                 calc_say(&d->c, P(REFUSED), m);
-                fprintf(stderr, "lensmat: %s\n", m);
+                fprintf(stderr, P(ERR), m);
                 free(rms);
                 return LM_FAIL;
             }
@@ -215,7 +215,7 @@ static int mc(tdlg *d)
         if (lm_stop_requested() || ds->tol_mc(p, &d->o, seed, k, &c) == DS_STOPPED) {
             free(tab);
             calc_say(&d->c, "%s", P(STOPPED));
-            fprintf(stderr, "lensmat: stopped: nothing written\n");
+            fprintf(stderr, "%s", P(STOPPED_ERR));
             return LM_FAIL;
         }
         char r[32];
@@ -230,7 +230,7 @@ static int mc(tdlg *d)
         char err[512];
         if (dz_write(out, tab, len, err, sizeof err)) {
             calc_say(&d->c, P(REFUSED), err);
-            fprintf(stderr, "lensmat: %s\n", err);
+            fprintf(stderr, P(ERR), err);
             rc = LM_FAIL;
         } else {
             calc_say(&d->c, P(WROTE), out);
@@ -242,7 +242,7 @@ static int mc(tdlg *d)
 
 static int table(tdlg *d)
 {
-    char name[4096], msg[512];
+    char name[4096], msg[4700];
     double limit;
     size_t len;
     int rc;
@@ -251,8 +251,14 @@ static int table(tdlg *d)
         (rc = calc_num(&d->c, P(LIMIT), P(LIMIT_WHAT), LM_NONNEG, &limit)))
         return rc;
     char *text = dz_slurp(name, &len, msg, sizeof msg);
-    if (!text) { calc_say(&d->c, P(REFUSED), msg); return LM_FAIL; }
-    if (memchr(text, '\0', len)) { free(text); calc_say(&d->c, P(REFUSED), "a NUL byte"); return LM_FAIL; }
+    if (!text) { calc_say(&d->c, P(REFUSED), msg); fprintf(stderr, P(ERR), msg); return LM_FAIL; }
+    if (memchr(text, '\0', len)) {
+        snprintf(msg, sizeof msg, P(NUL), name);
+        free(text);
+        calc_say(&d->c, P(REFUSED), msg);
+        fprintf(stderr, P(ERR), msg);
+        return LM_FAIL;
+    }
     rc = summary(d, name, text, limit);
     free(text);
     return rc;
