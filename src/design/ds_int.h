@@ -49,6 +49,7 @@ typedef struct ds_wl {
     trace_rx rx;
     trace_rx_surface surf[DS_MAXSURF];
     double s;                  /* primary stop radius / this wavelength's */
+    int index;                 /* which of the lens's wavelengths */
 } ds_wl;
 
 struct ds_problem {
@@ -73,6 +74,13 @@ struct ds_problem {
     void *stop_ctx;
     long evals;
     int stopped;
+    /* Warm starts while optimising: each aimed ray's last solution (2 unknowns) and
+     * whether it holds one, per field, wavelength and pupil point (+1: the chief
+     * ray).  Off for tolerancing, where lens k must not depend on lens k - 1. */
+    int warm;
+    double *guess;
+    unsigned char *gok;
+    size_t nguess;
 };
 
 /* ds_read.c */

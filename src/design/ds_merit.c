@@ -39,6 +39,7 @@ int ds_setup(ds_problem *p, const ln_lens *l, ds_wl *w, int nwl, char *why, size
         ds_wl *x = &w[k];
         double z = 0;
         x->lambda = l->nwl ? l->wl[k] : ln_primary(l);
+        x->index = k;
         if (index_at(p, l, -1, x->lambda, &x->n[0], why, cap)) return -1;
         snprintf(x->names[0], sizeof x->names[0], "%.17g", x->n[0]);
         memset(x->surf, 0, sizeof(trace_rx_surface) * (size_t)l->nsurf);
@@ -97,8 +98,40 @@ double ds_image_z(const ln_lens *l, const ds_wl *prim)
     return prim->p.z_img;
 }
 
-static int aim(const ds_problem *p, const ds_wl *w, const ln_field *f, double px, double py,
-               trace_aim_ray *out)
+static int aim_from(const ds_problem *p, const ds_wl *w, const ln_field *f, double px,
+                    double py, const double *g, trace_aim_ray *out);
+
+/* Slot of pupil point `pt` (rings * arms: the chief ray) of field fi at w. */
+static long slot(const ds_problem *p, const ds_wl *w, int fi, int pt)
+{
+    int nwl = p->lens.nwl ? p->lens.nwl : 1;
+    return ((long)fi * nwl + w->index) * (p->rings * p->arms + 1) + pt;
+}
+
+/* Aim one ray; while optimising, from the solution the same ray had at the last
+ * evaluation (the lens moved little: one Newton step instead of three or four), and
+ * from the paraxial guess again if that fails. */
+static int aim_at(ds_problem *p, const ds_wl *w, int fi, int pt, double px, double py,
+                  trace_aim_ray *out)
+{
+    const ln_field *f = &p->lens.field[fi];
+    long k = slot(p, w, fi, pt);
+    int warm = p->warm && !p->aim_paraxial && k >= 0 && (size_t)k < p->nguess;
+    if (warm && p->gok[k] && aim_from(p, w, f, px, py, p->guess + 2 * k, out) == 0) {
+        p->guess[2 * k] = out->v[0];
+        p->guess[2 * k + 1] = out->v[1];
+        return 0;
+    }
+    int rc = aim_from(p, w, f, px, py, NULL, out);
+    if (warm) {
+        p->gok[k] = rc == 0;
+        if (rc == 0) { p->guess[2 * k] = out->v[0]; p->guess[2 * k + 1] = out->v[1]; }
+    }
+    return rc;
+}
+
+static int aim_from(const ds_problem *p, const ds_wl *w, const ln_field *f, double px,
+                    double py, const double *g, trace_aim_ray *out)
 {
     const px_pupil *pp = &w->p;
     trace_aim_req rq;
@@ -133,6 +166,7 @@ static int aim(const ds_problem *p, const ds_wl *w, const ln_field *f, double px
         if (p->tr->rx_trace(&w->rx, o, d, NULL, out, err, sizeof err) != TRACE_OK) return -1;
         return out->status == TRACE_AIM_OK ? 0 : -1;
     }
+    if (g) { rq.guess[0] = g[0]; rq.guess[1] = g[1]; }
     if (p->tr->rx_aim(&w->rx, &rq, out, err, sizeof err) != TRACE_OK) return -1;
     return out->status == TRACE_AIM_OK ? 0 : -1;
 }
@@ -155,7 +189,7 @@ int ds_field_rays(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
                 trace_aim_ray r;
                 if (sym && px < 0) continue;
                 if (n + 2 > cap) return -1;
-                if (aim(p, &w[k], f, px, py, &r)) {
+                if (aim_at(p, &w[k], fi, i * p->arms + j, px, py, &r)) {
                     fails++;
                     continue;
                 }
@@ -213,7 +247,9 @@ int ds_field_wave(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
         trace_aim_ray ch, r;
         double wk = (l->nwl ? l->wl_weight[k] : 1) / wsum, lam = x->lambda * um;
         x->rx.z_image = z_image;
-        if (aim(p, x, f, 0, 0, &ch) || !isfinite(x->p.z_xp) || !(ch.img_dir[2] > 0)) return -1;
+        if (aim_at(p, x, fi, p->rings * p->arms, 0, 0, &ch) || !isfinite(x->p.z_xp) ||
+            !(ch.img_dir[2] > 0))
+            return -1;
         /* the sphere: centred on the chief ray's image point, through its crossing of
          * the paraxial exit pupil's plane */
         double t = (x->p.z_xp - ch.img[2]) / ch.img_dir[2], R = fabs(t), sign = t < 0 ? 1 : -1;
@@ -226,7 +262,7 @@ int ds_field_wave(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
                 double px = rho * sin(a), py = rho * cos(a), q = wk * p->rw[i] / p->arms;
                 if (sym && px < 0) continue;
                 if (n + 2 > cap) return -1;
-                if (aim(p, x, f, px, py, &r)) return -1;
+                if (aim_at(p, x, fi, i * p->arms + j, px, py, &r)) return -1;
                 double v = (w0 - sphere_path(&r, inf, n0, ni, ch.img, R, sign)) / lam;
                 if (!isfinite(v)) return -1;
                 wv[n] = v;
@@ -367,7 +403,7 @@ int ds_eval(ds_problem *p, double *f, char *why, size_t cap)
             double unit = pp->yb[N] + pp->ub[N + 1] * (zi - pp->z[N]);
             double rp = hypot(fx * unit, fy * unit);
             w[0].rx.z_image = zi;
-            if (aim(p, &w[0], fl, 0, 0, &r)) o->value = 100;
+            if (aim_at(p, &w[0], o->field, p->rings * p->arms, 0, 0, &r)) o->value = 100;
             else o->value = rp > 0 ? 100 * (hypot(r.img[0], r.img[1]) - rp) / rp : 0;
             break;
         }

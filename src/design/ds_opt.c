@@ -163,6 +163,18 @@ int ds_optimise(ds_problem *p, int max_iter, int (*progress)(void *, const ds_st
         return DS_NOMEM;
     }
     for (size_t i = 0; i < nv; i++) gsl_vector_set(x, i, ds_get_var(p, (int)i) / p->var[i].scale);
+    /* warm starts of the ray aiming, from nothing at every optimisation (so a replay,
+     * which runs the same evaluations, aims every ray the same) */
+    {
+        size_t ng = (size_t)p->lens.nfield * (size_t)(p->lens.nwl ? p->lens.nwl : 1) *
+                    (size_t)(p->rings * p->arms + 1);
+        free(p->guess);
+        free(p->gok);
+        p->guess = malloc(sizeof(double) * 2 * (ng ? ng : 1));
+        p->gok = calloc(ng ? ng : 1, 1);
+        p->nguess = p->guess && p->gok ? ng : 0;
+        p->warm = p->nguess > 0;
+    }
     int e = ds_eval(p, f0->data, why, sizeof why);
     if (e) {
         gsl_vector_free(x); gsl_vector_free(f0); gsl_vector_free(xbest);
@@ -235,6 +247,7 @@ done:
     for (size_t i = 0; i < nv; i++)
         ds_set_var(p, (int)i, gsl_vector_get(xbest, i) * p->var[i].scale);
     p->stop = NULL;
+    p->warm = 0;
     if (rc == DS_OK || rc == DS_STOPPED) {
         int e2 = ds_eval(p, NULL, why, sizeof why);
         (void)e2;

@@ -519,5 +519,7 @@ void ds_free(ds_problem *p)
     ln_free(&p->lens);
     ln_free(&p->base);
     free(p->merit_lines);
+    free(p->guess);
+    free(p->gok);
     free(p);
 }
