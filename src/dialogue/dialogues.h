@@ -33,6 +33,8 @@ int lm_to_prescription(lm_io *io); const char *lm_to_prescription_example(void);
 int lm_spot(lm_io *io);        const char *lm_spot_example(void);   /* spot.c: --spot */
 int lm_colour(lm_io *io);       const char *lm_colour_example(void);   /* colour.c */
 int lm_pupil(lm_io *io);        const char *lm_pupil_example(void);    /* pupil.c */
+int lm_optimise(lm_io *io);     const char *lm_optimise_example(void); /* optimise.c */
+int lm_tolerance(lm_io *io);    const char *lm_tolerance_example(void); /* tolerance.c */
 
 /* A lens read from a file (prescription.c): a classic record, its grep'd or plain
  * answers, or a prescription file.  lm_read_lens: LM_GO, or LM_FAIL with

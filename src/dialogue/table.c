@@ -50,6 +50,10 @@ const lm_dialogue lm_dialogues[] = {
      lm_pupil, lm_pupil_example, "trace", 0},
     {"--beam", "Gaussian beam: waist, M^2, through lenses and surfaces (ABCD; section 46)",
      lm_beam, lm_beam_example, NULL, 0},
+    {"--optimise", "damped least squares on a lens file's vary/target lines: the optimised prescription",
+     lm_optimise, lm_optimise_example, "design", 0},
+    {"--tolerance", "a lens file's tolerances: sensitivities, Monte Carlo of built lenses, yield",
+     lm_tolerance, lm_tolerance_example, "design", 0},
 };
 const size_t lm_ndialogues = sizeof lm_dialogues / sizeof lm_dialogues[0];
 
