@@ -260,7 +260,7 @@ static void zmx_notes(void)
 {
     const char *t = "VERS 1\nMODE SEQ\nUNIT MM\nFTYP 2 0 1 1 0 0 0\nWAVL 0.55\n"
                     "SURF 0\n  DISZ 100\nSURF 1\n  TYPE TOROIDAL\n  CURV 0.02\n  DISZ 5\n"
-                    "  GLAS N-SF11 0 0 1.78472 25.68 0 0\nSURF 2\n  TYPE EVENASPH\n  CURV -0.01\n"
+                    "  GLAS LM-NOGLASS1 0 0 1.78472 25.68 0 0\nSURF 2\n  TYPE EVENASPH\n  CURV -0.01\n"
                     "  PARM 2 1e-6\n  PARM 9 1\n  DISZ 40\nSURF 3\n";
     ln_lens l;
     ln_notes notes = {0};
@@ -270,7 +270,7 @@ static void zmx_notes(void)
     if (!rc) {
         CHECK(notes.s && strstr(notes.s, "n.zmx:9: surface 1: type TOROIDAL is not supported"),
               "the toroid is noted with its line");
-        CHECK(notes.s && strstr(notes.s, "n.zmx:12: glass N-SF11 is not in lensmat's catalogue"),
+        CHECK(notes.s && strstr(notes.s, "n.zmx:12: glass LM-NOGLASS1 is not in lensmat's catalogue"),
               "the unknown glass is noted with its line");
         CHECK(notes.s && strstr(notes.s, "n.zmx:4: FTYP 2"), "image-height fields are noted");
         CHECK(notes.s && strstr(notes.s, "n.zmx:17: surface 2: PARM 9"), "PARM 9 is noted");

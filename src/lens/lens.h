@@ -25,6 +25,7 @@ enum { LN_OK = 0, LN_BAD = 2, LN_NOMEM = 3 };
 #define LN_ASPH_MAX 8       /* even aspheric terms r^2 ... r^16 (.zmx EVENASPH PARM 1-8) */
 #define LN_WL_MAX 24        /* wavelengths (OpticStudio's limit) */
 #define LN_FIELD_MAX 64     /* fields */
+#define LN_CAT_MAX 8        /* glass catalogues a file selects */
 
 enum { LN_STANDARD = 0,     /* sphere or conic (conic 0: sphere) */
        LN_EVENASPH = 1 };   /* conic plus sum asph[i] r^(2i+2) */
@@ -90,6 +91,11 @@ typedef struct ln_lens {
     int field_kind;                /* LN_FIELD_* */
     int nfield;
     ln_field field[LN_FIELD_MAX];
+    /* The glass catalogues the file selects, in the order glasses are looked up
+     * (.zmx GCAT, a prescription's `catalog` line); ncat 0: none selected (the
+     * built-in catalogue first, then every AGF catalogue available). */
+    int ncat;
+    char catalogs[LN_CAT_MAX][LN_NAME_MAX];
 } ln_lens;
 
 /* An empty lens (no surfaces, object at infinity in air, no stop, no wavelength,
@@ -151,6 +157,16 @@ double ln_paraxial_curvature(const ln_surface *s);
  * between others...). */
 typedef struct ln_notes { char *s; size_t len, cap; int n; } ln_notes;
 void ln_notes_free(ln_notes *n);
+
+/* How a reader takes a glass name (lens_glass.c): the catalogue entry for it -- in
+ * the catalogues the lens selects (l->catalogs, in order; "LENSMAT" is the built-in
+ * one), else the built-in catalogue and then every AGF catalogue available --, or
+ * for a former name (BK7) its successor (N-BK7), noted.  out (LN_NAME_MAX) gets the
+ * spelling the lens stores: the built-in catalogue's name, or "CATALOG:NAME" for an
+ * AGF catalogue's glass.  A name several catalogues hold is noted with the one taken.
+ * 1 when found, 0 when no catalogue has it (out untouched). */
+int ln_glass_lookup(const ln_lens *l, const char *name, char *out, ln_notes *notes,
+                    const char *src, long line);
 
 /* A lensmat prescription by thickness (rx.c; the format in README "Prescription
  * files").  text: the whole file (len bytes, NULs refused), src: its name for

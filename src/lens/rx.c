@@ -87,6 +87,12 @@ static int set_glass(rd *r, const char *tok, char *out)
     if (strlen(tok) >= LN_NAME_MAX) return bad(r, "glass name '%.40s...' too long", tok);
     strcpy(out, tok);
     ln_glass_spelling(out);
+    if (ln_parse_number(out, 0, &(double){0}) || strchr(out, '/')) return LN_OK;
+    if (ln_glass_lookup(r->l, tok, out, r->notes, r->src, r->line)) return LN_OK;
+    if (px_medium_index(tok) > 0)             /* crown, flint, water...: the seed's media */
+        ln_note(r->notes, r->src, r->line, "%s is not in the glass catalogues: taken as "
+                "the medium's constant index %.6g at every wavelength (no dispersion)",
+                tok, px_medium_index(tok));
     return LN_OK;
 }
 
@@ -299,6 +305,20 @@ static int keyword(rd *r, char **tok, int n)
             if (!strcmp(tok[1], units[i])) { strcpy(l->unit, units[i]); return LN_OK; }
         return bad(r, "unit '%s': mm, cm, m or in", tok[1]);
     }
+    if (!strcmp(k, "catalog")) {              /* catalog SCHOTT OHARA ...: lookup order */
+        if (n < 2) return bad(r, "catalog NAME...: the glass catalogues to look glasses up "
+                              "in, in order (LENSMAT: the built-in one)");
+        if (l->ncat) return bad(r, "catalog given twice");
+        if (n - 1 > LN_CAT_MAX) return bad(r, "catalog: at most %d catalogues", LN_CAT_MAX);
+        for (int i = 1; i < n; i++) {
+            if (strcasecmp(tok[i], "LENSMAT") && !px_glass_cat_find(tok[i]))
+                return bad(r, "catalog %s: no such glass catalogue (no %s.agf in "
+                           "$LENSMAT_GLASS_PATH, data/agf/ or ../shared/glass/; LENSMAT is "
+                           "the built-in one)", tok[i], tok[i]);
+            snprintf(l->catalogs[l->ncat++], LN_NAME_MAX, "%s", tok[i]);
+        }
+        return LN_OK;
+    }
     if (!strcmp(k, "wlweights"))
         return weights(r, "wlweights", tok + 1, n - 1, &r->have_wlw, &r->nwlw,
                        l->wl_weight, sizeof l->wl_weight[0]);
@@ -338,7 +358,7 @@ static int is_keyword(const char *k)
 {
     static const char *const keys[] = {"object", "thickness", "nearpoint", "index",
         "wavelength", "wavelengths", "unit", "wlweights", "fieldweights", "epd", "fnum",
-        "na", "field", "image", "title"};
+        "na", "field", "image", "title", "catalog"};
     for (size_t i = 0; i < sizeof keys / sizeof *keys; i++)
         if (!strcmp(k, keys[i])) return 1;
     return 0;
@@ -480,6 +500,14 @@ char *ln_write_rx(const ln_lens *l)
                   "V, a2..a16 V (even asphere), nd V vd V, stop\nthickness\n");
     if (l->title[0]) ln_buf_printf(&b, "title %s\n", l->title);
     if (strcmp(l->unit, "mm") && l->unit[0]) ln_buf_printf(&b, "unit %s\n", l->unit);
+    {   /* the selected catalogues this machine has (a .zmx's GCAT may name others:
+         * its glasses are stored by name, CATALOG:NAME when an AGF file gave them) */
+        int k = 0;
+        for (int i = 0; i < l->ncat; i++)
+            if (!strcasecmp(l->catalogs[i], "LENSMAT") || px_glass_cat_find(l->catalogs[i]))
+                ln_buf_printf(&b, "%s %s", k++ ? "" : "catalog", l->catalogs[i]);
+        if (k) ln_buf_printf(&b, "\n");
+    }
     if (l->nearpoint != 25) { ln_format(l->nearpoint, a, sizeof a); ln_buf_printf(&b, "nearpoint %s\n", a); }
     if (l->nwl) {
         ln_buf_printf(&b, "wavelengths");

@@ -11,63 +11,12 @@
 #include <string.h>
 #include <strings.h>
 #include "lens_text.h"
+#include "common/lm_text.h"
 #include "paraxial/paraxial.h"
 
-/* ---- decoding ------------------------------------------------------------------ */
+/* ---- decoding: src/common/lm_text.h (UTF-16, UTF-8, Latin-1 into UTF-8) ------- */
 
-static size_t put_utf8(char *o, unsigned cp)
-{
-    if (cp < 0x80) { o[0] = (char)cp; return 1; }
-    if (cp < 0x800) { o[0] = (char)(0xc0 | cp >> 6); o[1] = (char)(0x80 | (cp & 63)); return 2; }
-    if (cp < 0x10000) {
-        o[0] = (char)(0xe0 | cp >> 12); o[1] = (char)(0x80 | ((cp >> 6) & 63));
-        o[2] = (char)(0x80 | (cp & 63));
-        return 3;
-    }
-    o[0] = (char)(0xf0 | cp >> 18); o[1] = (char)(0x80 | ((cp >> 12) & 63));
-    o[2] = (char)(0x80 | ((cp >> 6) & 63)); o[3] = (char)(0x80 | (cp & 63));
-    return 4;
-}
-
-/* The text as NUL-terminated UTF-8 (malloc'd; *n its length): UTF-16LE/BE by their
- * byte-order mark, or without one when the first bytes are ASCII with NULs beside
- * them; anything else is taken byte for byte (a UTF-8 mark dropped).  A NUL in the
- * decoded text becomes a blank (the line still reads).  NULL: out of memory. */
-static char *decode(const char *text, size_t len, size_t *n)
-{
-    const unsigned char *u = (const unsigned char *)text;
-    int be = -1;
-    size_t i = 0, k = 0;
-    char *o;
-    if (len >= 2 && u[0] == 0xff && u[1] == 0xfe) { be = 0; i = 2; }
-    else if (len >= 2 && u[0] == 0xfe && u[1] == 0xff) { be = 1; i = 2; }
-    else if (len >= 4 && u[0] && !u[1] && u[2] && !u[3]) be = 0;
-    else if (len >= 4 && !u[0] && u[1] && !u[2] && u[3]) be = 1;
-    if (be < 0) {
-        if (len >= 3 && !memcmp(text, "\xef\xbb\xbf", 3)) i = 3;
-        if (!(o = malloc(len - i + 1))) return NULL;
-        for (; i < len; i++) o[k++] = text[i] ? text[i] : ' ';
-        o[k] = '\0';
-        *n = k;
-        return o;
-    }
-    if (!(o = malloc((len / 2) * 3 + 4))) return NULL;   /* a unit is at most 3 bytes */
-    for (; i + 1 < len; i += 2) {
-        unsigned cp = be ? (unsigned)(u[i] << 8 | u[i + 1]) : (unsigned)(u[i + 1] << 8 | u[i]);
-        if (cp >= 0xd800 && cp < 0xdc00 && i + 3 < len) {          /* a surrogate pair */
-            unsigned lo = be ? (unsigned)(u[i + 2] << 8 | u[i + 3]) : (unsigned)(u[i + 3] << 8 | u[i + 2]);
-            if (lo >= 0xdc00 && lo < 0xe000) {
-                cp = 0x10000 + ((cp - 0xd800) << 10) + (lo - 0xdc00);
-                i += 2;
-            } else cp = '?';
-        } else if (cp >= 0xd800 && cp < 0xe000) cp = '?';
-        if (cp == 0) cp = ' ';
-        k += put_utf8(o + k, cp);
-    }
-    o[k] = '\0';
-    *n = k;
-    return o;
-}
+static char *decode(const char *text, size_t len, size_t *n) { return lm_text_utf8(text, len, n); }
 
 /* ---- reading --------------------------------------------------------------------- */
 
@@ -162,7 +111,7 @@ static const char *const aliases[][3] = {
 static int glass(zr *r, zsurf *z, char **tok, int n)
 {
     double nd = 0, vd = 0, idx;
-    const px_glass_rec *g;
+    int placeholder;
     const char *name = tok[1];
     if (n < 2) return zbad(r, "GLAS: a glass name is missing");
     z->s.nd = z->s.vd = 0;                  /* a second GLAS line replaces the first */
@@ -199,15 +148,30 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
             r->aliased |= 1u << i;
             name = aliases[i][1];
         }
-    if ((g = px_glass_find(name))) { snprintf(z->s.glass, LN_NAME_MAX, "%s", g->name); return LN_OK; }
+    /* OpticStudio writes nd 1.5, Vd 40 -- its model-glass defaults -- for a glass the
+     * exporting machine's catalogues lacked: not the glass's data */
+    placeholder = n >= 6 && nd == 1.5 && vd == 40;
+    if (ln_glass_lookup(r->l, name, z->s.glass, r->notes, r->src, r->line)) {
+        if (placeholder)
+            ln_note(r->notes, r->src, r->line, "glass %s: the file's nd 1.5, Vd 40 are "
+                    "OpticStudio's placeholder (the exporting machine lacked the glass): "
+                    "the catalogue's %s is used", tok[1], z->s.glass);
+        return LN_OK;
+    }
     if (ln_parse_number(name, 0, &idx)) {   /* an index as a name: its shortest spelling */
         if (px_glass_index(name, PX_LAMBDA_D, &idx) == PX_OK) {
             ln_format(idx, z->s.glass, LN_NAME_MAX);
+            ln_note(r->notes, r->src, r->line, "glass %s: a constant index %s at every "
+                    "wavelength (no dispersion)", name, z->s.glass);
             return LN_OK;
         }
     } else if (px_glass_index(name, PX_LAMBDA_D, &idx) == PX_OK) {
         snprintf(z->s.glass, LN_NAME_MAX, "%s", name);   /* a medium, a model ND/VD */
         ln_glass_spelling(z->s.glass);
+        if (!strchr(name, '/'))
+            ln_note(r->notes, r->src, r->line, "glass %s is not in the glass catalogues: "
+                    "taken as the medium %s, a constant index %.6g at every wavelength "
+                    "(no dispersion)", name, name, idx);
         return LN_OK;
     }
     snprintf(z->s.glass, LN_NAME_MAX, "%s", name);
@@ -215,9 +179,16 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
         nd = 1 + atoi(name) / 1000 / 1000.0;               /* 517642: nd 1.517, Vd 64.2 */
         vd = (atoi(name) % 1000) / 10.0;
     }
-    if (!(nd > 1)) return zbad(r, "glass %s is not in lensmat's catalogue (data/glass.txt) "
-                               "and the file gives no nd for it (add the glass's formula "
-                               "to data/glass.txt, or nd and Vd to this GLAS line)", name);
+    if (placeholder)
+        return zbad(r, "glass %s is not in lensmat's glass catalogues, and the file's nd "
+                    "1.5, Vd 40 are OpticStudio's placeholder for a glass the exporting "
+                    "machine lacked, not %s's data: add the glass's catalogue (its maker's "
+                    "AGF file in data/agf/, ../shared/glass/ or $LENSMAT_GLASS_PATH) or "
+                    "its formula to data/glass.txt", name, name);
+    if (!(nd > 1)) return zbad(r, "glass %s is not in lensmat's glass catalogues "
+                               "(data/glass.txt, AGF files) and the file gives no nd for "
+                               "it (add the glass's catalogue or formula, or nd and Vd to "
+                               "this GLAS line)", name);
     z->s.nd = nd;
     z->s.vd = vd;
     ln_note(r->notes, r->src, r->line, "glass %s is not in lensmat's catalogue: taken as "
@@ -319,6 +290,13 @@ static int system_line(zr *r, const char *k, char **tok, int n, const char *rest
         while (len && strchr(" \t\r", rest[len - 1])) len--;
         if (len >= 2 && rest[0] == '"' && rest[len - 1] == '"') { rest++; len -= 2; }
         ln_title(l->title, rest, len);
+        return LN_OK;
+    }
+    if (!strcmp(k, "GCAT")) {                  /* the glass catalogues, in order */
+        l->ncat = 0;
+        for (int i = 1; i < n && l->ncat < LN_CAT_MAX; i++)
+            if (strlen(tok[i]) < LN_NAME_MAX) snprintf(l->catalogs[l->ncat++], LN_NAME_MAX,
+                                                       "%s", tok[i]);
         return LN_OK;
     }
     if (!strcmp(k, "MODE")) {
@@ -631,11 +609,19 @@ char *ln_write_zmx(const ln_lens *lens)
     const char *unit = "MM";
     for (size_t i = 0; i < sizeof zu / sizeof *zu; i += 2)
         if (!strcmp(l->unit, zu[i])) unit = zu[i + 1];
-    {   /* the reader takes one pair of quotes off a title: a quoted title keeps its own */
-        size_t n = strlen(l->title);
+    {   /* the reader takes one pair of quotes off a title: a quoted title keeps its own;
+         * a title read as Latin-1 bytes (a thickness prescription) is written in UTF-8 */
+        size_t n = strlen(l->title), m;
         int q = n >= 2 && l->title[0] == '"' && l->title[n - 1] == '"';
+        char *t = lm_utf8_fix(l->title, n, &m);
         ln_buf_printf(&b, "MODE SEQ\r\nNAME %s%s%s\r\nUNIT %s X W X CM MR CPMM\r\n",
-                      q ? "\"" : "", l->title, q ? "\"" : "", unit);
+                      q ? "\"" : "", t ? t : "", q ? "\"" : "", unit);
+        free(t);
+    }
+    if (l->ncat) {
+        ln_buf_printf(&b, "GCAT");
+        for (int i = 0; i < l->ncat; i++) ln_buf_printf(&b, " %s", l->catalogs[i]);
+        ln_buf_printf(&b, "\r\n");
     }
     if (l->ap_kind != LN_AP_NONE) {
         ln_format(l->ap_value, a, sizeof a);
