@@ -588,7 +588,7 @@ static int angles_to_heights(pdlg *d, const px_pupil *prim)
     calc_say(&d->c, P(ANGLE_FINITE), fmt_len(z, sizeof z, CL(prim->z_ep)), d->c.uname);
     for (int i = 0; i < l->nfield; i++) {
         ln_field *f = &l->field[i];
-        double hx = -tan(f->x * DEG) * L, hy = -tan(f->y * DEG) * L;
+        double hx = -tan(f->x * DEG) * L + 0.0, hy = -tan(f->y * DEG) * L + 0.0;  /* no -0 */
         if (f->x == 0) calc_say(&d->c, P(ANGLE_FINITE_ROW), i + 1, f->y, CL(hy));
         else calc_say(&d->c, P(ANGLE_FINITE_XY), i + 1, f->x, f->y, CL(hx), CL(hy));
         f->x = hx;

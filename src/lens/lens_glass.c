@@ -74,7 +74,7 @@ int ln_glass_lookup(const ln_lens *l, const char *name, char *out, ln_notes *not
     const char *why = NULL, *now;
     if (lookup(l, name, out, notes, src, line, name)) return 1;
     if ((now = px_glass_former(name, &why)) && lookup(l, now, out, notes, src, line, now)) {
-        ln_note(notes, src, line, "glass %s is a former name: read as %s (%s)", name, out,
+        ln_note(notes, src, line, "glass %s is a former name: read as %s, %s", name, out,
                 why);
         return 1;
     }

@@ -180,8 +180,12 @@ static int surface_keys(rd *r, ln_surface *s, char **tok, int n)
             r->l->stop = r->l->nsurf - 1;
             continue;
         }
+        if (!strcmp(k, "mirror")) {              /* reflects: back into the same medium */
+            s->mirror = 1;
+            continue;
+        }
         if (i + 1 == n) return bad(r, "'%s' needs a value (keys: semi, conic, a2..a16, "
-                                   "nd, vd, stop)", k);
+                                   "nd, vd, stop, mirror)", k);
         if (number(r, k, tok[++i], 0, &v)) return LN_BAD;
         if (!strcmp(k, "semi")) {
             if (!(v >= 0)) return bad(r, "semi: the semi-diameter must not be negative");
@@ -200,7 +204,7 @@ static int surface_keys(rd *r, ln_surface *s, char **tok, int n)
             s->asph[j] = v;
             if (j + 1 > s->nasph) s->nasph = j + 1;
         } else return bad(r, "'%s' is not a surface key (semi, conic, a2..a16, nd, vd, "
-                          "stop)", k);
+                          "stop, mirror)", k);
     }
     return LN_OK;
 }
@@ -223,9 +227,7 @@ static int surface(rd *r, char **tok, int n)
     s->line = r->line;
     ln_set_radius(s, rad);
     if (r->thick) {
-        if (t < 0) return bad(r, "the thickness must not be negative (mirrors and folded "
-                              "systems are not supported)");
-        s->t = t;
+        s->t = t;            /* < 0 after a mirror; ln_check checks the signs */
         if (set_glass(r, tok[2], s->glass)) return LN_BAD;
         return surface_keys(r, s, tok + 3, n - 3);
     }
@@ -573,6 +575,7 @@ char *ln_write_rx(const ln_lens *l)
                 ln_buf_printf(&b, " a%d %s", 2 * k + 2, a);
             }
         if (l->stop == i) ln_buf_printf(&b, " stop");
+        if (s->mirror) ln_buf_printf(&b, " mirror");
         ln_buf_printf(&b, "\n");
     }
     if (l->image_c != 0 || l->image_semi != 0) {

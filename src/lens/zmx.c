@@ -1,10 +1,12 @@
 /* zmx.c -- Zemax OpticStudio sequential .zmx files into the lens model and back.
  * The text format: one keyword a line (surface data indented under SURF n), in
  * UTF-8/Latin-1 or, as OpticStudio writes it, UTF-16 with a byte-order mark.  What
- * the model holds is read (surfaces STANDARD and EVENASPH with CURV, DISZ, GLAS,
- * DIAM, CONI, PARM, STOP; WAVL/WAVM, ENPD/FNUM/OBNA, FTYP, fields); every other
- * surface type and glass the catalogue lacks is noted with its line, and the other
- * keywords (display, tolerancing, optimisation, coatings...) in one note. */
+ * the model holds is read (surfaces STANDARD and EVENASPH with CURV, DISZ, GLAS
+ * (MIRROR too), DIAM, CONI, PARM, STOP; GCAT; WAVL/WAVM, ENPD/FNUM/OBNA, FTYP,
+ * fields); every other surface type and glass the catalogue lacks is noted with its
+ * line, coordinate breaks that tilt or decentre are refused (those that do not are
+ * skipped), and the other keywords (display, tolerancing, optimisation, coatings...)
+ * are listed in one note. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +27,9 @@ typedef struct zsurf {
     ln_surface s;
     int stop, supported;       /* supported: STANDARD or EVENASPH */
     char type[16];
+    int cb;                    /* a coordinate break (TYPE COORDBRK) */
+    double cbp[6];             /* its PARM 1-6: decentre x, y; tilt about x, y, z; order */
+    long cb_line;              /* the first PARM line that tilts or decentres */
 } zsurf;
 
 #define NSKIP 64
@@ -117,9 +122,12 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
     z->s.nd = z->s.vd = 0;                  /* a second GLAS line replaces the first */
     if (n >= 6 && (!ln_parse_number(tok[4], 0, &nd) || !ln_parse_number(tok[5], 0, &vd)))
         nd = vd = 0;
-    if (!strcasecmp(name, "MIRROR"))
-        return zbad(r, "GLAS MIRROR: reflecting surfaces are not supported (the lens model "
-                    "is a sequence of refracting surfaces)");
+    if (!strcasecmp(name, "MIRROR")) {      /* back into the medium it came from (air) */
+        z->s.mirror = 1;
+        z->s.glass[0] = '\0';
+        return LN_OK;
+    }
+    z->s.mirror = 0;
     if (strlen(name) >= LN_NAME_MAX) return zbad(r, "GLAS: name too long");
     for (const char *p = name; *p; p++)      /* what a prescription's column can hold */
         if (*p <= ' ' || *p > '~' || *p == '@' || *p == '#' || *p == ',')
@@ -214,6 +222,7 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
         snprintf(z->type, sizeof z->type, "%s", tok[1]);
         if (!strcmp(tok[1], "STANDARD")) z->s.type = LN_STANDARD;
         else if (!strcmp(tok[1], "EVENASPH")) z->s.type = LN_EVENASPH;
+        else if (!strcmp(tok[1], "COORDBRK")) { z->supported = 0; z->cb = 1; }
         else {
             z->supported = 0;
             ln_note(r->notes, r->src, r->line, "surface %d: type %s is not supported: read "
@@ -237,9 +246,7 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
             return LN_OK;
         }
         if (isinf(v)) return zbad(r, "DISZ INFINITY: only the object may lie at infinity");
-        if (v < 0) return zbad(r, "DISZ %s: a negative thickness is not supported (mirrors "
-                               "and folded systems are not)", tok[1]);
-        z->s.t = v;
+        z->s.t = v;          /* < 0 after a mirror: ln_check checks the signs */
         return LN_OK;
     }
     if (!strcmp(k, "GLAS")) return glass(r, z, tok, n);
@@ -261,6 +268,11 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
             return zbad(r, "PARM N VALUE: a parameter number and a value are needed");
         if (znum(r, k, tok[2], &v)) return LN_BAD;
         if (isinf(v)) return zbad(r, "PARM: the value must be finite");
+        if (z->cb) {                          /* decentre x, y, tilt x, y, z, order */
+            if (i >= 1 && i <= 6) z->cbp[(int)i - 1] = v;
+            if (i >= 1 && i <= 5 && v != 0 && !z->cb_line) z->cb_line = r->line;
+            return LN_OK;
+        }
         if (z->s.type == LN_EVENASPH && i >= 1 && i <= LN_ASPH_MAX) {
             z->s.asph[(int)i - 1] = v;
             if (v != 0 && (int)i > z->s.nasph) z->s.nasph = (int)i;
@@ -423,14 +435,35 @@ static int assemble(zr *r)
         l->obj_vd = r->zs[0].s.vd;
     }
     for (int i = 1; i < r->nz - 1; i++) {
-        ln_surface *s = ln_add_surface(l);
-        if (!s) { snprintf(r->err, r->cap, "%s: out of memory", r->src); return LN_NOMEM; }
+        ln_surface *s;
+        if (r->zs[i].cb) {
+            zsurf *z = &r->zs[i];
+            if (z->cb_line) {
+                r->line = z->cb_line;
+                return zbad(r, "surface %d: a coordinate break (TYPE COORDBRK) that decentres "
+                            "by x %g, y %g and tilts by %g, %g, %g degrees about x, y, z: "
+                            "the lens model is one rotationally symmetric axis, so tilted and "
+                            "decentred parts are refused rather than read as centred", i,
+                            z->cbp[0], z->cbp[1], z->cbp[2], z->cbp[3], z->cbp[4]);
+            }
+            /* a break that moves nothing (files keep them as placeholders): its
+             * thickness joins the gap before it */
+            if (l->nsurf) l->surf[l->nsurf - 1].t += z->s.t;
+            else l->object += z->s.t;
+            ln_note(r->notes, r->src, z->s.line, "surface %d: a coordinate break with no "
+                    "decentre or tilt is skipped (its thickness %g joins the gap before it)",
+                    i, z->s.t);
+            if (z->stop) ln_note(r->notes, r->src, z->s.line, "surface %d: the stop on a "
+                                 "coordinate break is skipped", i);
+            continue;
+        }
+        if (!(s = ln_add_surface(l))) { snprintf(r->err, r->cap, "%s: out of memory", r->src); return LN_NOMEM; }
         *s = r->zs[i].s;
         if (r->zs[i].stop) {
             if (l->stop >= 0)
                 ln_note(r->notes, r->src, r->zs[i].s.line, "surface %d: a second STOP "
                         "(surface %d is the stop)", i, l->stop + 1);
-            else l->stop = i - 1;
+            else l->stop = l->nsurf - 1;
         }
     }
     if (r->zs[0].stop || r->zs[r->nz - 1].stop)
@@ -535,10 +568,11 @@ static void zfmt(double v, char *buf, size_t cap)
     else ln_format(v, buf, cap);
 }
 
-static void write_glass(ln_buf *b, const char *g, double nd, double vd)
+static void write_glass(ln_buf *b, const char *g, double nd, double vd, int mirror)
 {
     double n, v = 0;
     char a[40], c[40];
+    if (mirror) { ln_buf_printf(b, "  GLAS MIRROR 0 0 0 0 0 0 0 0 0 0\r\n"); return; }
     if (!g[0]) return;
     if (nd > 1 && px_glass_index(g, PX_LAMBDA_D, &n) == PX_NO_GLASS) {
         ln_format(nd, a, sizeof a);
@@ -585,7 +619,7 @@ static void write_surface(ln_buf *b, int k, const ln_surface *s, int stop, doubl
         }
     zfmt(disz, a, sizeof a);
     ln_buf_printf(b, "  DISZ %s\r\n", a);
-    write_glass(b, glass, nd, vd);
+    write_glass(b, glass, nd, vd, s->mirror);
     if (s->conic != 0) { ln_format(s->conic, a, sizeof a); ln_buf_printf(b, "  CONI %s\r\n", a); }
     if (s->semi != 0) {
         ln_format(s->semi, a, sizeof a);
