@@ -159,7 +159,7 @@ static void rx_bad(const char *text, const char *want)
 static void rx_errors(void)
 {
     rx_bad("thickness\n10 2 N-BK7 semi\n", "bad.rx:2: 'semi' needs a value");
-    rx_bad("thickness\n10 -2 N-BK7\n", "bad.rx:2: the thickness must not be negative");
+    rx_bad("thickness\n10 -2 N-BK7\n", "bad.rx:2: the thickness -2 is negative");
     rx_bad("thickness\n10 2 N-BK7@C\n", "bad.rx:2: 'N-BK7@C'");
     rx_bad("thickness\n10 2 NO-SUCH-GLASS\n-10 5 air\n", "bad.rx:2: surface 1: glass NO-SUCH-GLASS");
     rx_bad("thickness\n10 2 N-BK7 stop\n-10 5 air stop\n", "bad.rx:3: a second stop");
@@ -279,7 +279,8 @@ static void zmx_notes(void)
         ln_free(&l);
     }
     ln_notes_free(&notes);
-    zmx_bad("MODE SEQ\nSURF 0\nSURF 1\n  GLAS MIRROR 0 0\nSURF 2\n", "bad.zmx:4: GLAS MIRROR");
+    zmx_bad("MODE SEQ\nSURF 0\nSURF 1\n  GLAS N-BK7\nSURF 2\n  GLAS MIRROR 0 0\nSURF 3\n",
+            "bad.zmx:5: a mirror in N-BK7 (a Mangin mirror) is not supported");
     zmx_bad("MODE SEQ\nSURF 0\nSURF 1\n  DISZ -3\nSURF 2\n", "bad.zmx:4: DISZ -3");
     zmx_bad("MODE NSC\n", "bad.zmx:1: MODE NSC");
     zmx_bad("MODE SEQ\nSURF 0\nSURF 2\n", "bad.zmx:3: SURF 2");

@@ -186,12 +186,16 @@ int ln_check(const ln_lens *l, const char *src, char *err, size_t cap)
         if (s->mirror) {
             const char *before = i ? l->surf[i - 1].glass : l->obj_glass;
             sigma = -sigma;
-            if (before[0] && strcasecmp(before, "AIR"))
-                return fail(err, cap, src, s->line, "%sa mirror in %s (a Mangin mirror) is "
-                            "not supported: mirrors in air only", before, 0);
-            if (s->glass[0] && strcasecmp(s->glass, "AIR"))
-                return fail(err, cap, src, s->line, "%s: a mirror sends the light back "
-                            "into the medium it came from (air), not into a glass", s->glass, 0);
+            if (before[0] && strcasecmp(before, "AIR")) {
+                snprintf(why, sizeof why, "a mirror in %s (a Mangin mirror) is not supported: "
+                         "mirrors in air only", before);
+                return fail(err, cap, src, s->line, "%s", why, 0);
+            }
+            if (s->glass[0] && strcasecmp(s->glass, "AIR")) {
+                snprintf(why, sizeof why, "%s: a mirror sends the light back into the medium "
+                         "it came from (air), not into a glass", s->glass);
+                return fail(err, cap, src, s->line, "%s", why, 0);
+            }
         }
         if (!isfinite(s->t) || (sigma > 0 ? !(s->t >= 0) : !(s->t <= 0)))
             return fail(err, cap, src, s->line, sigma > 0 ? "%sthe thickness %g is negative "

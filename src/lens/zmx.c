@@ -27,6 +27,7 @@ typedef struct zsurf {
     ln_surface s;
     int stop, supported;       /* supported: STANDARD or EVENASPH */
     char type[16];
+    long dline;                /* the DISZ line */
     int cb;                    /* a coordinate break (TYPE COORDBRK) */
     double cbp[6];             /* its PARM 1-6: decentre x, y; tilt about x, y, z; order */
     long cb_line;              /* the first PARM line that tilts or decentres */
@@ -246,7 +247,8 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
             return LN_OK;
         }
         if (isinf(v)) return zbad(r, "DISZ INFINITY: only the object may lie at infinity");
-        z->s.t = v;          /* < 0 after a mirror: ln_check checks the signs */
+        z->s.t = v;          /* < 0 after a mirror: checked in assemble */
+        z->dline = r->line;
         return LN_OK;
     }
     if (!strcmp(k, "GLAS")) return glass(r, z, tok, n);
@@ -433,6 +435,19 @@ static int assemble(zr *r)
         strcpy(l->obj_glass, r->zs[0].s.glass);
         l->obj_nd = r->zs[0].s.nd;
         l->obj_vd = r->zs[0].s.vd;
+    }
+    for (int i = 1, sigma = 1; i < r->nz - 1; i++) {    /* thickness signs: by DISZ line */
+        double t = r->zs[i].s.t;
+        if (r->zs[i].s.mirror) sigma = -sigma;
+        if (sigma > 0 ? t < 0 : t > 0) {
+            char a[32];
+            r->line = r->zs[i].dline;
+            ln_format(t, a, sizeof a);
+            return zbad(r, sigma > 0 ? "DISZ %s: a negative thickness where the light travels "
+                        "toward +z (thicknesses are negative only after an odd number of "
+                        "mirrors)" : "DISZ %s: a positive thickness where the light travels "
+                        "toward -z (after an odd number of mirrors thicknesses are negative)", a);
+        }
     }
     for (int i = 1; i < r->nz - 1; i++) {
         ln_surface *s;

@@ -108,7 +108,6 @@ static int nm_line(agf *a, char **tok, int n)
     px_glass_cat *c = a->cat;
     px_glass_rec *g;
     double f, nd = 0, vd = 0, st = -1;
-    char buf[32];
     if (n < 3) return afail(a, "NM: expected NM NAME FORMULA CODE ND VD ...");
     if (!num(tok[2], &f) || f != floor(f) || f < 1 || f > 13)
         return afail(a, "NM %s: formula %s is not one of the AGF formulas 1-13 (Schott, "
@@ -137,10 +136,9 @@ static int nm_line(agf *a, char **tok, int n)
     g->catalog = c->name;
     g->status = status_word(st);
     if (!(g->name = dup(tok[1]))) return PX_NOMEM;
-    snprintf(buf, sizeof buf, "%.6f", nd);
-    if (!(g->nd = dup(nd > 0 ? buf : "-"))) { free((char *)g->name); return PX_NOMEM; }
-    snprintf(buf, sizeof buf, "%.2f", vd);
-    if (!(g->vd = dup(vd > 0 ? buf : "-"))) {
+    /* nd and Vd as the catalogue prints them (a test knows the digits printed) */
+    if (!(g->nd = dup(nd > 0 ? tok[4] : "-"))) { free((char *)g->name); return PX_NOMEM; }
+    if (!(g->vd = dup(vd > 0 ? tok[5] : "-"))) {
         free((char *)g->name); free((char *)g->nd);
         return PX_NOMEM;
     }
