@@ -438,6 +438,7 @@ static int assemble(zr *r)
     }
     for (int i = 1, sigma = 1; i < r->nz - 1; i++) {    /* thickness signs: by DISZ line */
         double t = r->zs[i].s.t;
+        if (r->zs[i].cb && r->zs[i].cb_line) break;     /* refused below, at its PARM */
         if (r->zs[i].s.mirror) sigma = -sigma;
         if (sigma > 0 ? t < 0 : t > 0) {
             char a[32];
