@@ -72,6 +72,17 @@ int ln_glass_lookup(const ln_lens *l, const char *name, char *out, ln_notes *not
                     const char *src, long line)
 {
     const char *why = NULL, *now;
+    static int said;                  /* catalogue files that failed: said once a process */
+    if (!said && *px_glass_cat_notes()) {
+        const char *p = px_glass_cat_notes();
+        said = 1;
+        while (*p) {
+            const char *nl = strchr(p, '\n');
+            int k = nl ? (int)(nl - p) : (int)strlen(p);
+            ln_note(notes, src, 0, "glass catalogue skipped: %.*s", k, p);
+            p += k + (nl != NULL);
+        }
+    }
     if (lookup(l, name, out, notes, src, line, name)) return 1;
     if ((now = px_glass_former(name, &why)) && lookup(l, now, out, notes, src, line, now)) {
         ln_note(notes, src, line, "glass %s is a former name: read as %s, %s", name, out,
