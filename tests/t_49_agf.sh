@@ -4,9 +4,14 @@
 # then through the dialogues with LENSMAT_GLASS_PATH: a prescription's `catalog` line,
 # an AGF-only glass's focal lengths against a closed form, GCAT written back, a name
 # in two catalogues said, an unknown catalogue refused with FILE:LINE, a broken
-# catalogue file skipped and said, and no catalogue seen without the path.
+# catalogue file skipped and said, and no catalogue seen without the path.  Also the
+# chromatic figure of issue 22 (tests/unit_chromatic.c), which needs N-BAK1.
 unit "$TOP/build/obj/unit_agf"
 unit "$TOP/build/asan/unit_agf"
+# Laikin's achromat (tests/published/laikin_achromat.txt): the F-C focal shift by the
+# paraxial engine, by real rays traced in the test, to first order; the peer's -0.015
+unit "$TOP/build/obj/unit_chromatic"
+unit "$TOP/build/asan/unit_chromatic"
 AGF=$TOP/tests/agf
 
 # OHARA S-BAL14 (the Sellmeier coefficients of tests/agf/TESTOHARA.agf, OHARA's
