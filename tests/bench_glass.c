@@ -10,7 +10,16 @@
  *  - paraxial_fc_shift: its F-C focal shift bfd(F) - bfd(C), mm, and
  *    paraxial_fc_vs_singlet: that shift over an N-BK7 singlet's of the same f;
  *  - glass_index_per_s: px_glass_index by name (look-up + Sellmeier) against the
- *    baseline of the same Sellmeier with the coefficients in hand, medians of runs. */
+ *    baseline of the same Sellmeier with the coefficients in hand, medians of runs;
+ *  - paraxial_chromatic_err (issue 22): Laikin's cemented achromat
+ *    (tests/published/laikin_achromat.txt), its F-C focal shift bfd(F) - bfd(C) by
+ *    the paraxial engine against real rays near the axis traced here (exact
+ *    refraction at spheres, the h -> 0 limit by Richardson from h = 1e-3, 5e-4),
+ *    relative; paraxial_chromatic_shift, the shift itself; and
+ *    paraxial_chromatic_first_order_err: the Seidel estimate -CI/(n' u'^2) against it
+ *    (the peer's printed -0.015 is checked in tests/unit_chromatic.c);
+ *  - glass_count: the materials the catalogues give (built-in plus every AGF file
+ *    found: $LENSMAT_GLASS_PATH, data/agf, ../shared/glass), and glass_catalogs. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -63,6 +72,53 @@ static double baseline(double *sink)
     return now() - t0;
 }
 
+/* The distance from the last vertex to where a ray parallel to the axis at height h
+ * crosses it (exact meridional refraction at the spheres; air outside). */
+static double real_focus(const px_csurf *s, int ns, double lam, double h)
+{
+    double z = -1, y = h, dz = 1, dy = 0, n1 = 1, zv = 0, zlast = 0;
+    for (int k = 0; k < ns; k++) {
+        double R = s[k].r, n2, cz = zv + R, oz = z - cz, b, c, t, Nz, Ny, mu, ci, ct;
+        if (px_glass_index(s[k].glass, lam, &n2) != PX_OK) return NAN;
+        b = oz * dz + y * dy;
+        c = oz * oz + y * y - R * R;
+        t = -b + (R > 0 ? -1 : 1) * sqrt(b * b - c);
+        z += t * dz;
+        y += t * dy;
+        Nz = (z - cz) / R;
+        Ny = y / R;
+        if (Nz * dz + Ny * dy > 0) { Nz = -Nz; Ny = -Ny; }
+        mu = n1 / n2;
+        ci = -(Nz * dz + Ny * dy);
+        ct = sqrt(1 - mu * mu * (1 - ci * ci));
+        dz = mu * dz + (mu * ci - ct) * Nz;
+        dy = mu * dy + (mu * ci - ct) * Ny;
+        n1 = n2;
+        zlast = zv;
+        zv += s[k].t;
+    }
+    return z - y / dy * dz - zlast;
+}
+
+static int laikin(void)
+{
+    const px_csurf s[3] = {{12.38401, 0.4340, "N-BAK1"}, {-7.94140, 0.3210, "SF2"},
+                           {-48.44396, 19.6059, "air"}};
+    px_colour c;
+    px_seidel sd;
+    double h = 1e-3, d1, d2, real, fo;
+    if (px_colour_fdc(s, 3, "air", &c) != PX_OK || px_seidel_run(s, 3, "air", 1.7, 0, &sd) != PX_OK)
+        return 1;
+    d1 = real_focus(s, 3, PX_LAMBDA_F, h) - real_focus(s, 3, PX_LAMBDA_C, h);
+    d2 = real_focus(s, 3, PX_LAMBDA_F, h / 2) - real_focus(s, 3, PX_LAMBDA_C, h / 2);
+    real = d2 + (d2 - d1) / 3;
+    fo = -sd.total.c1 / (sd.n_last * sd.u_last * sd.u_last);
+    printf("BENCH paraxial_chromatic_err %.2g rel\n", fabs(c.long_colour - real) / fabs(real));
+    printf("BENCH paraxial_chromatic_shift %.6f mm\n", c.long_colour);
+    printf("BENCH paraxial_chromatic_first_order_err %.2g rel\n", fabs(fo - c.long_colour) / fabs(c.long_colour));
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     int runs = argc > 1 ? atoi(argv[1]) : 21;
@@ -90,6 +146,9 @@ int main(int argc, char **argv)
     printf("BENCH paraxial_bfl_err %.2g rel\n", fabs(c.first[1].bfd.v - 97.1) / 97.1);
     printf("BENCH paraxial_fc_shift %.4f mm\n", c.long_colour);
     printf("BENCH paraxial_fc_vs_singlet %.3f ratio\n", c.long_colour / single.long_colour);
+    if (laikin()) return 1;
+    printf("BENCH glass_count %d materials\n", px_glass_total());
+    printf("BENCH glass_catalogs %d agf_files\n", px_glass_cat_count());
     ta = malloc(sizeof *ta * runs);
     tb = malloc(sizeof *tb * runs);
     if (!ta || !tb) return 1;
