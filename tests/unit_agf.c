@@ -302,6 +302,13 @@ static void test_lens_lookup(void)
           "a medium's name is a constant index, said");
     ln_free(&l);
     ln_notes_free(&notes);
+    snprintf(t, sizeof t, base, "SCHOTT", "N-BAK1 0 0 1.6 57.55 0 0");
+    CHECK(read_zmx(t, &l, &notes, err) == LN_OK && notes.s &&
+          strstr(notes.s, "g.zmx:10: glass N-BAK1: the file gives nd 1.6, the catalogue's "
+                 "N-BAK1 has 1.572500: the catalogue's is used"),
+          "a file's nd far from the catalogue's is said");
+    ln_free(&l);
+    ln_notes_free(&notes);
     snprintf(t, sizeof t, base, "SCHOTT", "S-BAL14 0 0 1.5 4.0E+1 0 0");
     CHECK(read_zmx(t, &l, &notes, err) == LN_OK && !strcmp(l.surf[0].glass, "TESTOHARA:S-BAL14") &&
           notes.s && strstr(notes.s, "OpticStudio's placeholder"),

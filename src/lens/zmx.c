@@ -161,10 +161,16 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
      * exporting machine's catalogues lacked: not the glass's data */
     placeholder = n >= 6 && nd == 1.5 && vd == 40;
     if (ln_glass_lookup(r->l, name, z->s.glass, r->notes, r->src, r->line)) {
+        double nc;
         if (placeholder)
             ln_note(r->notes, r->src, r->line, "glass %s: the file's nd 1.5, Vd 40 are "
                     "OpticStudio's placeholder (the exporting machine lacked the glass): "
                     "the catalogue's %s is used", tok[1], z->s.glass);
+        else if (nd > 1 && px_glass_index(z->s.glass, PX_LAMBDA_D, &nc) == PX_OK &&
+                 fabs(nc - nd) > 5e-4)  /* another maker's glass of that name, a typo */
+            ln_note(r->notes, r->src, r->line, "glass %s: the file gives nd %.6g, the "
+                    "catalogue's %s has %.6f: the catalogue's is used", tok[1], nd,
+                    z->s.glass, nc);
         return LN_OK;
     }
     if (ln_parse_number(name, 0, &idx)) {   /* an index as a name: its shortest spelling */
