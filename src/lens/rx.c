@@ -1,8 +1,10 @@
 /* rx.c -- lensmat prescription files into the lens model and back.  A `thickness`
  * line selects the designers' tabulation (radius, thickness to the next surface,
- * glass, then optional `semi`, `conic`, `a2`..`a16`, `nd`/`vd`, `stop` per surface)
- * with `title`, `unit`, `wavelengths`, `wlweights`, `epd`/`fnum`/`na`, `field`,
- * `fieldweights` and `image` lines; without it the file is the classic positions
+ * glass, then optional `semi`, `conic`, `a2`..`a16`, `nd`/`vd`, `stop`, `mirror` per
+ * surface; thicknesses negative after an odd number of mirrors) with `title`, `unit`,
+ * `catalog` (glass catalogues, doc/glass.md), `wavelengths`, `wlweights`,
+ * `epd`/`fnum`/`na`, `field`, `fieldweights` and `image` lines; without it the file
+ * is the classic positions
  * format (radius, position, index), read here with the classic dialogue's reading
  * of indices (a number at one wavelength).  Format in README "Prescription files". */
 #include <math.h>

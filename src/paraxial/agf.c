@@ -60,7 +60,8 @@ static void anote(agf *a, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(why, sizeof why, fmt, ap);
     va_end(ap);
-    snprintf(line, sizeof line, "%s:%ld: %s\n", a->src, a->line, why);
+    if (a->line > 0) snprintf(line, sizeof line, "%s:%ld: %s\n", a->src, a->line, why);
+    else snprintf(line, sizeof line, "%s: %s\n", a->src, why);
     k = strlen(line);
     if (a->nlen + k + 1 > a->ncap) {
         size_t c = (a->ncap + k + 1) * 2;
