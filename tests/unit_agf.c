@@ -218,7 +218,28 @@ static void test_bad_files(void)
           strstr(err, "b.agf:2: X: CD coefficient 2 'zwei' is not a number"),
           "a coefficient that is not a number refused (%s)", err);
     CHECK(px_agf_read(t4, strlen(t4), "B", "b.agf", &c, err, sizeof err) == PX_BAD &&
-          strstr(err, "b.agf:1:"), "a text that is not AGF refused (%s)", err);
+          strstr(err, "b.agf: no NM line: not an AGF glass catalogue"),
+          "a text that is not AGF refused (%s)", err);
+    {   /* as redistributed files come: a text line above the catalogue, a CD line
+         * wrapped onto lines of bare numbers, a name lensmat cannot hold (a liquid
+         * "X-1,6") -- the file reads, each said.  W is NIKON's J-FK5 (formula 13, nd
+         * 1.487490) as its CD lines wrap in nikon.agf distributed at
+         * github.com/nzhagen/zemaxglass (AGF_files/, "Updated 12/2018") */
+        const char *t = "Reproduced from the maker's site\nNM BAD-1,6 2 0 1.5 50 0 0 0\n"
+                        "CD 1 0.01 0 0 0 1\nNM W 13 0 1.5 50 0 0 0\nCD 2.188268550E+000 "
+                        "-9.190447240E-003 -1.116210710E-004 9.263728150E-003\n"
+                        "7.349007330E-005 4.197242420E-006 -1.154122030E-007 0.0\n0.0\nLD 0.3 2.5\n";
+        int rc = px_agf_read(t, strlen(t), "B", "b.agf", &c, err, sizeof err);
+        CHECK(rc == PX_OK && c.n == 1 && !strcmp(c.rec[0].name, "W") &&
+              c.rec[0].coef[4] == 7.349007330E-005 && c.rec[0].coef[6] == -1.154122030E-007 &&
+              fabs(px_glass_formula(&c.rec[0], PX_LAMBDA_D) - 1.487490) < 5e-7 && c.notes &&
+              strstr(c.notes, "b.agf:1: 'Reproduced...' before the first NM line is not an AGF "
+                     "line: skipped") && strstr(c.notes, "b.agf:2: NM BAD-1,6: a glass name with"),
+              "a header line and an unusable name are skipped and said; a wrapped CD line goes "
+              "on (Nikon J-FK5's coefficients give its nd 1.487490: %.7f)",
+              rc == PX_OK && c.n ? px_glass_formula(&c.rec[0], PX_LAMBDA_D) : 0.0);
+        if (rc == PX_OK) px_agf_free(&c);
+    }
     {   /* IT lines out of order or out of range are noted, not fatal */
         const char *t = "NM X 2 0 1.5 50 0 0 0\nCD 1 0.01 0 0 0 1\nLD 0.3 2.5\nIT 0.5 0.9 10\n"
                         "IT 0.4 0.8 10\nIT 0.6 1.5 10\nIT 0.7 0.95 5\n";

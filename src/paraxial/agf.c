@@ -36,6 +36,9 @@ typedef struct agf {
     size_t cap;
     int capr, capt;
     int cur_tau;                     /* the current glass's table (-1: none yet) */
+    int cd_next;                     /* > 0: the CD coefficient a bare-number line
+                                        continues with (some files wrap CD lines) */
+    int skipping;                    /* the current NM's glass is skipped (its name) */
     size_t nlen, ncap;               /* notes */
 } agf;
 
@@ -118,9 +121,17 @@ static int nm_line(agf *a, char **tok, int n)
     if (n > 5 && !num(tok[5], &vd)) return afail(a, "NM %s: Vd '%s' is not a number", tok[1], tok[5]);
     if (n > 7 && !num(tok[7], &st)) st = -1;
     if (strlen(tok[1]) >= 64) return afail(a, "NM: a glass name of more than 63 bytes");
+    a->cd_next = 0;
+    a->skipping = 0;
     for (const char *p = tok[1]; *p; p++)
-        if (*p == '@' || *p == '/' || *p == ':' || *p == '"' || *p == '#' || *p == ',')
-            return afail(a, "NM %s: a glass name holds no @ / : \" # ,", tok[1]);
+        if (*p == '@' || *p == '/' || *p == ':' || *p == '"' || *p == '#' || *p == ',') {
+            /* lensmat's names hold none of these (NAME@W, ND/VD, CATALOG:NAME, the
+             * prescription's columns): this glass is left out, the file still reads */
+            anote(a, "NM %s: a glass name with @ / : \" # or , is skipped (lensmat's glass "
+                  "names hold none of them)", tok[1]);
+            a->skipping = 1;
+            return PX_OK;
+        }
     if (c->n == a->capr) {
         int cap = a->capr ? 2 * a->capr : 64;
         px_glass_rec *r = realloc(c->rec, (size_t)cap * sizeof *r);
@@ -209,18 +220,32 @@ static int line(agf *a, char *s)
     if (n == 0) return PX_OK;
     if (!strcmp(tok[0], "NM")) return nm_line(a, tok, n);
     if (!strcmp(tok[0], "CC") || tok[0][0] == '!') return PX_OK;     /* comments */
-    if (c->n == 0) {
+    if (c->n == 0 && !a->skipping) {
         if (strlen(tok[0]) == 2 && isupper((unsigned char)tok[0][0]))
             return afail(a, "%s before the first NM line (not an AGF catalogue?)", tok[0]);
-        return afail(a, "'%.20s' is not an AGF line (CC, NM, GC, ED, CD, TD, OD, LD, IT...)",
-                     tok[0]);
+        /* a text line above the catalogue (a redistributor's header): said, skipped */
+        anote(a, "'%.20s...' before the first NM line is not an AGF line: skipped", tok[0]);
+        return PX_OK;
     }
+    if (a->skipping) return PX_OK;
     px_glass_rec *g = &c->rec[c->n - 1];
+    {   /* a line of bare numbers right after CD: its coefficients go on */
+        double v;
+        if (a->cd_next > 0 && num(tok[0], &v)) {
+            for (int i = 0; i < n && a->cd_next <= PX_GLASS_MAXCOEF; i++, a->cd_next++)
+                if (!num(tok[i], &g->coef[a->cd_next - 1]))
+                    return afail(a, "%s: CD coefficient %d '%s' is not a number", g->name,
+                                 a->cd_next, tok[i]);
+            return PX_OK;
+        }
+        a->cd_next = 0;
+    }
     if (!strcmp(tok[0], "CD")) {
         int i;
         for (i = 1; i < n && i <= PX_GLASS_MAXCOEF; i++)
             if (!num(tok[i], &g->coef[i - 1]))
                 return afail(a, "%s: CD coefficient %d '%s' is not a number", g->name, i, tok[i]);
+        a->cd_next = i;
         return PX_OK;
     }
     if (!strcmp(tok[0], "LD")) {
