@@ -1,6 +1,7 @@
 /* lens_glass.c -- how the lens readers turn a glass name into a catalogue entry:
  * the catalogues a file selects, the built-in catalogue, the AGF catalogues, and the
  * former names (BK7 -> N-BK7), each choice that is not plain said in a note. */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -59,11 +60,21 @@ static int lookup(const ln_lens *l, const char *name, char *out, ln_notes *notes
         for (int i = 0; i < h && i < MAXHIT; i++)
             n += (size_t)snprintf(list + n, n < sizeof list ? sizeof list - n : 0, "%s%s",
                                   i ? ", " : "", hit[i]->catalog ? hit[i]->catalog : "LENSMAT");
-        ln_note(notes, src, line, "glass %s is in %d catalogues (%s): %s's is taken (%s)",
+        /* how much the choice matters: the largest index difference at F, d, C */
+        double dmax = 0;
+        for (int i = 0; i < h && i < MAXHIT; i++)
+            for (int w = 0; w < 3; w++) {
+                double lw = w == 0 ? PX_LAMBDA_F : w == 1 ? PX_LAMBDA_D : PX_LAMBDA_C;
+                double a = px_glass_formula(hit[k], lw), b = px_glass_formula(hit[i], lw);
+                if (fabs(a - b) > dmax || isnan(a - b)) dmax = isnan(a - b) ? INFINITY : fabs(a - b);
+            }
+        ln_note(notes, src, line, "glass %s is in %d catalogues (%s): %s's is taken (%s; "
+                "their indices at F, d, C differ by up to %.1e)",
                 asked, h, list, hit[k]->catalog ? hit[k]->catalog : "LENSMAT",
                 l->ncat && rank(l, hit[k]->catalog ? hit[k]->catalog : "LENSMAT") >= 0
                 ? "the first selected catalogue that has it"
-                : "the built-in catalogue first, then the AGF catalogues in the order read");
+                : "the built-in catalogue first, then the AGF catalogues in the order read",
+                dmax);
     }
     return 1;
 }
