@@ -69,8 +69,11 @@ int px_glass_find_all(const char *name, const px_glass_rec **out, int max)
     return k;
 }
 
-/* n at l (um) from the record's formula. */
-double px_glass_formula(const px_glass_rec *g, double l)
+/* n at l (um) from the record's formula (static inline: px_glass_index, the hot
+ * path of every traced wavelength's index, keeps it inlined). */
+static inline double formula(const px_glass_rec *g, double l);
+double px_glass_formula(const px_glass_rec *g, double l) { return formula(g, l); }
+static inline double formula(const px_glass_rec *g, double l)
 {
     const double *c = g->coef;
     double l2 = l * l, n2 = 1, L;
@@ -161,7 +164,7 @@ int px_glass_index(const char *name, double l, double *n)
     if (!(l > 0) || !isfinite(l)) return PX_BAD;
     if (g) {
         if (l < g->lmin || l > g->lmax) return PX_GLASS_RANGE;
-        *n = px_glass_formula(g, l);
+        *n = formula(g, l);
         return isfinite(*n) && *n > 0 ? PX_OK : PX_GLASS_RANGE;
     }
     if (strchr(name, ':')) return PX_NO_GLASS;      /* CATALOG:NAME not in that catalogue */
