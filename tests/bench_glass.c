@@ -10,13 +10,23 @@
  *  - paraxial_fc_shift: its F-C focal shift bfd(F) - bfd(C), mm, and
  *    paraxial_fc_vs_singlet: that shift over an N-BK7 singlet's of the same f;
  *  - glass_index_per_s: px_glass_index by name (look-up + Sellmeier) against the
- *    baseline of the same Sellmeier with the coefficients in hand, medians of runs. */
+ *    baseline of the same Sellmeier with the coefficients in hand, medians of runs;
+ *  - paraxial_chromatic_err (issue 22): Laikin's cemented achromat
+ *    (tests/published/laikin_achromat.txt), its F-C focal shift bfd(F) - bfd(C) by
+ *    the paraxial engine against real rays near the axis traced here (exact
+ *    refraction at spheres, the h -> 0 limit by Richardson from h = 1e-3, 5e-4),
+ *    relative; paraxial_chromatic_shift, the shift itself; and
+ *    paraxial_chromatic_first_order_err: the Seidel estimate -CI/(n' u'^2) against it
+ *    (the peer's printed -0.015 is checked in tests/unit_chromatic.c);
+ *  - glass_count: the materials the catalogues give (built-in plus every AGF file
+ *    found: $LENSMAT_GLASS_PATH, data/agf, ../shared/glass), and glass_catalogs. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include "paraxial/paraxial.h"
+#include "meridional.h"
 #include "bench_util.h"
 
 /* |v - printed| in units of the printed string's last place */
@@ -63,6 +73,23 @@ static double baseline(double *sink)
     return now() - t0;
 }
 
+static int laikin(void)
+{
+    const px_csurf s[3] = {{12.38401, 0.4340, "N-BAK1"}, {-7.94140, 0.3210, "SF2"},
+                           {-48.44396, 19.6059, "air"}};
+    px_colour c;
+    px_seidel sd;
+    double real, fo;
+    if (px_colour_fdc(s, 3, "air", &c) != PX_OK || px_seidel_run(s, 3, "air", 1.7, 0, &sd) != PX_OK)
+        return 1;
+    real = mer_colour(s, 3, PX_LAMBDA_F, PX_LAMBDA_C, 1e-3);
+    fo = -sd.total.c1 / (sd.n_last * sd.u_last * sd.u_last);
+    printf("BENCH paraxial_chromatic_err %.2g rel\n", fabs(c.long_colour - real) / fabs(real));
+    printf("BENCH paraxial_chromatic_shift %.6f mm\n", c.long_colour);
+    printf("BENCH paraxial_chromatic_first_order_err %.2g rel\n", fabs(fo - c.long_colour) / fabs(c.long_colour));
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     int runs = argc > 1 ? atoi(argv[1]) : 21;
@@ -90,6 +117,9 @@ int main(int argc, char **argv)
     printf("BENCH paraxial_bfl_err %.2g rel\n", fabs(c.first[1].bfd.v - 97.1) / 97.1);
     printf("BENCH paraxial_fc_shift %.4f mm\n", c.long_colour);
     printf("BENCH paraxial_fc_vs_singlet %.3f ratio\n", c.long_colour / single.long_colour);
+    if (laikin()) return 1;
+    printf("BENCH glass_count %d materials\n", px_glass_total());
+    printf("BENCH glass_catalogs %d agf_files\n", px_glass_cat_count());
     ta = malloc(sizeof *ta * runs);
     tb = malloc(sizeof *tb * runs);
     if (!ta || !tb) return 1;

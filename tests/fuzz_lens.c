@@ -1,6 +1,7 @@
 /* fuzz_lens.c -- libFuzzer target for the lens model's readers (src/lens): the
- * thickness prescription (rx.c) and the OpticStudio .zmx (zmx.c, any encoding).  The
- * first byte picks the reader: 'z' .zmx, 'r' prescription, anything else both.  Every
+ * thickness prescription (rx.c) and the OpticStudio .zmx (zmx.c, any encoding), and
+ * the AGF glass catalogue reader (src/paraxial/agf.c).  The first byte picks the
+ * reader: 'z' .zmx, 'r' prescription, 'a' AGF, anything else .zmx and prescription.  Every
  * input must give LN_OK or LN_BAD with a "NAME[:LINE]: ..." message, never a crash,
  * a leak or undefined behaviour.  A lens read must pass ln_check, and be written in
  * both formats and read back: the same format keeps every value, the other reads. */
@@ -54,6 +55,7 @@ static const char *differ(const ln_lens *a0, const ln_lens *b0)
         if (strcmp(s->glass, t->glass) || s->nd != t->nd || s->vd != t->vd) return "glass";
         if (s->semi != t->semi) return "semi";
         if (s->conic != t->conic) return "conic";
+        if (s->mirror != t->mirror) return "mirror";
         for (int k = 0; k < s->nasph && k < t->nasph; k++)
             if (s->asph[k] != t->asph[k]) return "asphere";
     }
@@ -107,10 +109,24 @@ static void one(const char *p, size_t n, int zmx)
     ln_free(&l);
 }
 
+/* An AGF glass catalogue (src/paraxial/agf.c): PX_OK, or PX_BAD with a message;
+ * every glass's formula evaluated (NaN allowed, a crash not). */
+static void agf(const char *p, size_t n)
+{
+    char err[1024] = "";
+    px_glass_cat c;
+    int rc = px_agf_read(p, n, "FUZZ", "fuzz.agf", &c, err, sizeof err);
+    if (rc != PX_OK) { if (!strstr(err, "fuzz.agf")) abort(); return; }
+    for (int i = 0; i < c.n; i++)
+        for (double l = 0.3; l < 3; l *= 1.7) (void)px_glass_formula(&c.rec[i], l);
+    px_agf_free(&c);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     const char *p = (const char *)data + 1;
     if (size == 0) return 0;
+    if (data[0] == 'a') { agf(p, size - 1); return 0; }   /* 'a': an AGF catalogue */
     if (data[0] != 'r') one(p, size - 1, 1);
     if (data[0] != 'z') one(p, size - 1, 0);
     return 0;

@@ -87,8 +87,9 @@ lf_bad() (   # a subshell: its cd stays inside
     [ $rc -eq 2 ] || { echo "exit $rc"; return 1; }
     grep -q "$want" "$WORK/bad.err" || { cat "$WORK/bad.err"; return 1; }
 )
-check "a .zmx mirror is refused with its line" lf_bad 'bad.zmx:5: GLAS MIRROR: reflecting' \
-    'VERS 1\nMODE SEQ\nSURF 0\nSURF 1\n  GLAS MIRROR 0 0\nSURF 2\n'
+check "a .zmx mirror in glass (Mangin) is refused with its line" lf_bad \
+    'bad.zmx:6: a mirror in N-BK7 (a Mangin mirror) is not supported' \
+    'VERS 1\nMODE SEQ\nSURF 0\nSURF 1\n  GLAS N-BK7\nSURF 2\n  GLAS MIRROR 0 0\nSURF 3\n'
 check "a thickness file's bad key is refused with its line" lf_bad "bad.zmx:2: 'semi' needs a value" \
     'thickness\n10 2 N-BK7 semi\n-10 40 air\n'
 check "an unknown glass is refused with its line" lf_bad "bad.zmx:2: surface 1: glass NOPE" \

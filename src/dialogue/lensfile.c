@@ -140,6 +140,18 @@ int lm_model_answers(const char *src, const char *s, size_t len, char **out, siz
     }
     if (!quiet) print_notes(&notes);
     ln_notes_free(&notes);
+    if (ln_mirrors(&l)) {                /* the classic dialogue refracts only: unfolded */
+        ln_lens u;
+        int nm = ln_mirrors(&l);
+        if (ln_unfold(&l, &u, NULL, tok, sizeof tok) != LN_OK) {
+            snprintf(err, cap, "%s: %s", src, tok);
+            ln_free(&l);
+            return LM_FAIL;
+        }
+        ln_free(&l);
+        l = u;
+        if (!quiet) fprintf(stderr, LF(UNFOLDED), src, nm);
+    }
     wl_token(ln_primary(&l), wl, sizeof wl);
     ln_format(ln_primary(&l), wl_um, sizeof wl_um);
     ln_format(l.nearpoint, tok, sizeof tok);

@@ -90,11 +90,6 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
                  "(the object is at infinity: give field angles)", word);
         r = LN_BAD;
     }
-    if (r == LN_OK && !isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_ANGLE) {
-        snprintf(err, sizeof err, "%s: field angles with a finite object: give the "
-                 "fields as object heights", word);
-        r = LN_BAD;
-    }
     if (r == LN_OK && !isinf(l.object) && !(l.object > 0)) {
         snprintf(err, sizeof err, "%s: the object lies %s surface 1 (a virtual object): "
                  "rays are aimed only from a real object left of it, or from infinity",
@@ -582,6 +577,30 @@ static int refuse(pdlg *d, const char *why)
     return LM_FAIL;
 }
 
+/* Field angles with a finite object (a matched pair's file, OpticStudio's FTYP 0 at a
+ * finite conjugate): the chief ray's angle in object space, aimed at the centre of
+ * the paraxial entrance pupil, so the object point is at -tan(angle) times the
+ * distance from the object plane to that pupil.  The fields become those heights
+ * (said, field by field), so the rest runs as for heights. */
+static int angles_to_heights(pdlg *d, const px_pupil *prim)
+{
+    ln_lens *l = &d->lens;
+    double L = l->object + prim->z_ep;
+    char z[32];
+    if (!isfinite(prim->z_ep) || !(fabs(L) > 0)) return refuse(d, P(ANGLE_FINITE_TELE));
+    calc_say(&d->c, P(ANGLE_FINITE), fmt_len(z, sizeof z, CL(prim->z_ep)), d->c.uname);
+    for (int i = 0; i < l->nfield; i++) {
+        ln_field *f = &l->field[i];
+        double hx = -tan(f->x * DEG) * L + 0.0, hy = -tan(f->y * DEG) * L + 0.0;  /* no -0 */
+        if (f->x == 0) calc_say(&d->c, P(ANGLE_FINITE_ROW), i + 1, f->y, CL(hy));
+        else calc_say(&d->c, P(ANGLE_FINITE_XY), i + 1, f->x, f->y, CL(hx), CL(hy));
+        f->x = hx;
+        f->y = hy;
+    }
+    l->field_kind = LN_FIELD_HEIGHT;
+    return LM_GO;
+}
+
 static int compute(pdlg *d)
 {
     const ln_lens *l = &d->lens;
@@ -595,6 +614,9 @@ static int compute(pdlg *d)
     if (ln_to_csurf(l, cs, names, &obj, why, sizeof why) != LN_OK) return refuse(d, why);
     if (pupil_at(d, cs, obj, lp, &prim, why, sizeof why)) return refuse(d, why);
     d->scale = fmax(fabs(prim.efl), prim.r_stop);
+    if (!isinf(l->object) && l->nfield && l->field_kind == LN_FIELD_ANGLE &&
+        (rc = angles_to_heights(d, &prim)) != LM_GO)
+        return rc;
     for (int i = 0; i + 1 < l->nsurf; i++) zl += l->surf[i].t;
     for (int i = 0; i < l->nfield; i++)
         if (fabs(l->field[i].y) > fabs(fbig)) fbig = l->field[i].y;

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include "lens.h"
 #include "paraxial/paraxial.h"
 
@@ -180,11 +181,27 @@ int ln_check(const ln_lens *l, const char *src, char *err, size_t cap)
                 return LN_BAD;
             }
     }
-    for (int i = 0; i < l->nsurf; i++) {
+    for (int i = 0, sigma = 1; i < l->nsurf; i++) {
         const ln_surface *s = &l->surf[i];
-        if (!(s->t >= 0) || !isfinite(s->t))
-            return fail(err, cap, src, s->line, "%sthe thickness %g is negative or not "
-                        "finite", "", s->t);
+        if (s->mirror) {
+            const char *before = i ? l->surf[i - 1].glass : l->obj_glass;
+            sigma = -sigma;
+            if (before[0] && strcasecmp(before, "AIR")) {
+                snprintf(why, sizeof why, "a mirror in %s (a Mangin mirror) is not supported: "
+                         "mirrors in air only", before);
+                return fail(err, cap, src, s->line, "%s", why, 0);
+            }
+            if (s->glass[0] && strcasecmp(s->glass, "AIR")) {
+                snprintf(why, sizeof why, "%s: a mirror sends the light back into the medium "
+                         "it came from (air), not into a glass", s->glass);
+                return fail(err, cap, src, s->line, "%s", why, 0);
+            }
+        }
+        if (!isfinite(s->t) || (sigma > 0 ? !(s->t >= 0) : !(s->t <= 0)))
+            return fail(err, cap, src, s->line, sigma > 0 ? "%sthe thickness %g is negative "
+                        "or not finite (light travels toward +z here)" : "%sthe thickness %g "
+                        "is positive or not finite (after an odd number of mirrors light "
+                        "travels toward -z: thicknesses are negative)", "", s->t);
         if (isnan(s->r) || isnan(s->c) || isnan(s->conic) || !(s->semi >= 0) ||
             !isfinite(s->semi) || !isfinite(s->conic))
             return fail(err, cap, src, s->line, "%sa value of surface %g is not a number",

@@ -25,6 +25,7 @@ enum { LN_OK = 0, LN_BAD = 2, LN_NOMEM = 3 };
 #define LN_ASPH_MAX 8       /* even aspheric terms r^2 ... r^16 (.zmx EVENASPH PARM 1-8) */
 #define LN_WL_MAX 24        /* wavelengths (OpticStudio's limit) */
 #define LN_FIELD_MAX 64     /* fields */
+#define LN_CAT_MAX 8        /* glass catalogues a file selects */
 
 enum { LN_STANDARD = 0,     /* sphere or conic (conic 0: sphere) */
        LN_EVENASPH = 1 };   /* conic plus sum asph[i] r^(2i+2) */
@@ -52,6 +53,11 @@ typedef struct ln_surface {
     double asph[LN_ASPH_MAX];      /* coefficient of r^(2i+2): asph[0] r^2, asph[1] r^4 ... */
     long line;                     /* the line of the file that started it (0: none) */
     int by_curvature;              /* 1: c is the number given (ln_set_curvature), r = 1/c */
+    /* 1: the surface reflects (.zmx GLAS MIRROR, a prescription's `mirror`): light
+     * leaves it going back, so `glass` is the medium it arrived in, and thicknesses
+     * after an odd number of mirrors are negative (OpticStudio's convention: z is
+     * never flipped).  Mirrors in air only (ln_check). */
+    int mirror;
 } ln_surface;
 
 /* Aperture kinds. */
@@ -90,6 +96,11 @@ typedef struct ln_lens {
     int field_kind;                /* LN_FIELD_* */
     int nfield;
     ln_field field[LN_FIELD_MAX];
+    /* The glass catalogues the file selects, in the order glasses are looked up
+     * (.zmx GCAT, a prescription's `catalog` line); ncat 0: none selected (the
+     * built-in catalogue first, then every AGF catalogue available). */
+    int ncat;
+    char catalogs[LN_CAT_MAX][LN_NAME_MAX];
 } ln_lens;
 
 /* An empty lens (no surfaces, object at infinity in air, no stop, no wavelength,
@@ -118,10 +129,10 @@ int ln_index(const ln_lens *l, int i, double lambda_um, double *n, int *fallback
  * conic has no real point (1 - (1+k) c^2 h^2 < 0). */
 double ln_sag(const ln_surface *s, double h);
 /* Is the lens usable by the first-order engines: at least one surface, finite
- * thicknesses (>= 0 except where a file says otherwise: .zmx mirrors are refused
- * on reading), every glass with an index at every wavelength (and at the primary),
- * stop in range, aperture and fields sane.  LN_OK, or LN_BAD with "SRC:LINE: why"
- * (the surface's line, when it has one) in err. */
+ * thicknesses (>= 0, <= 0 after an odd number of mirrors; mirrors in air), every
+ * glass with an index at every wavelength (and at the primary), stop in range,
+ * aperture and fields sane.  LN_OK, or LN_BAD with "SRC:LINE: why" (the surface's
+ * line, when it has one) in err. */
 int ln_check(const ln_lens *l, const char *src, char *err, size_t cap);
 
 /* Can the lens be made (lens_shape.c): each surface reaches its semi-diameter
@@ -150,11 +161,25 @@ struct px_system;
 int ln_to_csurf(const ln_lens *l, struct px_csurf *out, char (*names)[LN_NAME_MAX],
                 const char **obj_glass, char *err, size_t cap);
 /* The lens as a px_system at lambda_um (px_system_init'd here, surface 0 at z = 0;
- * px_system_free it).  LN_OK, LN_BAD (err says why) or LN_NOMEM. */
+ * px_system_free it).  A lens with mirrors is taken unfolded (ln_unfold).  LN_OK,
+ * LN_BAD (err says why) or LN_NOMEM. */
 int ln_paraxial(const ln_lens *l, double lambda_um, struct px_system *s, char *err,
                 size_t cap);
 /* The paraxial curvature of surface s: c + 2 asph[0]. */
 double ln_paraxial_curvature(const ln_surface *s);
+/* How many surfaces reflect. */
+int ln_mirrors(const ln_lens *l);
+/* The lens unfolded (lens_paraxial.c): the same first-order optics with every mirror
+ * replaced by refracting surfaces, light always going +z.  A mirror of paraxial
+ * radius R in air (power -2/R as it faces the light) becomes a surface of radius -R/2
+ * into a medium of index 2 and a plane back into air at the same place (power
+ * (2 - 1)/(-R/2) = -2/R); the surfaces after an odd number of mirrors have their
+ * radii, aspheric terms and thicknesses negated (z mirrored), so thicknesses are
+ * positive.  `out` is ln_init'd here (ln_free it); *map (may be NULL) is set to a
+ * malloc'd array: map[k] = the original surface of unfolded surface k.  LN_OK,
+ * LN_BAD (a mirror not in air: a Mangin mirror's glass would need index 2n(lambda))
+ * or LN_NOMEM. */
+int ln_unfold(const ln_lens *l, ln_lens *out, int **map, char *err, size_t cap);
 
 /* ---- files --------------------------------------------------------------------
  * Notes: what a reader skipped or substituted, one "SRC:LINE: what" line each
@@ -164,6 +189,16 @@ double ln_paraxial_curvature(const ln_surface *s);
  * between others...). */
 typedef struct ln_notes { char *s; size_t len, cap; int n; } ln_notes;
 void ln_notes_free(ln_notes *n);
+
+/* How a reader takes a glass name (lens_glass.c): the catalogue entry for it -- in
+ * the catalogues the lens selects (l->catalogs, in order; "LENSMAT" is the built-in
+ * one), else the built-in catalogue and then every AGF catalogue available --, or
+ * for a former name (BK7) its successor (N-BK7), noted.  out (LN_NAME_MAX) gets the
+ * spelling the lens stores: the built-in catalogue's name, or "CATALOG:NAME" for an
+ * AGF catalogue's glass.  A name several catalogues hold is noted with the one taken.
+ * 1 when found, 0 when no catalogue has it (out untouched). */
+int ln_glass_lookup(const ln_lens *l, const char *name, char *out, ln_notes *notes,
+                    const char *src, long line);
 
 /* A lensmat prescription by thickness (rx.c; the format in README "Prescription
  * files").  text: the whole file (len bytes, NULs refused), src: its name for
@@ -183,9 +218,12 @@ char *ln_write_rx(const ln_lens *l);
 /* Zemax OpticStudio sequential .zmx (zmx.c): UTF-8, Latin-1 or UTF-16LE/BE (with
  * or without a byte-order mark).  Read: SURF, TYPE STANDARD/EVENASPH, CURV, DISZ,
  * GLAS, DIAM, CONI, PARM, STOP, WAVL/WAVM/PWAV/WWGT, ENPD/FNUM/OBNA, FTYP, XFLN/YFLN
- * (XFLD/YFLD), FWGN/FWGT, NAME, UNIT; everything else is noted (ln_notes) in one
- * note, and each unsupported surface type or glass with its line.  Refused (LN_BAD):
- * GLAS MIRROR, negative thicknesses, MODE NSC.  SURF 0 is the object (its DISZ
+ * (XFLD/YFLD), FWGN/FWGT, NAME, UNIT, GCAT, GLAS MIRROR (with the negative
+ * thicknesses after it); everything else is noted (ln_notes) in one note, and each
+ * unsupported surface type or glass with its line.  A coordinate break (COORDBRK)
+ * with no decentre or tilt is skipped (noted); refused (LN_BAD): a coordinate break
+ * that tilts or decentres, MODE NSC, a glass not in the catalogues whose nd/Vd are
+ * OpticStudio's placeholder 1.5/40.  SURF 0 is the object (its DISZ
  * `object`, its GLAS `obj_glass`), the last SURF the image (image_c, image_semi);
  * wavelengths are reordered primary (PWAV) first. */
 int ln_read_zmx(const char *text, size_t len, const char *src, ln_lens *l,

@@ -127,6 +127,15 @@ void ln_title(char *dst, const char *src, size_t n)
         unsigned char c = (unsigned char)src[i];
         dst[k++] = c < 0x20 || c == 0x7f ? ' ' : (char)c;
     }
+    if (k == LN_TITLE_MAX - 1 && k < n) {     /* cut short: not inside a UTF-8 letter */
+        size_t j = k;
+        while (j && ((unsigned char)dst[j - 1] & 0xc0) == 0x80) j--;
+        if (j && (unsigned char)dst[j - 1] >= 0xc0) {
+            unsigned char lead = (unsigned char)dst[j - 1];
+            size_t want = lead >= 0xf0 ? 4 : lead >= 0xe0 ? 3 : 2;
+            if (k - (j - 1) < want) k = j - 1;
+        }
+    }
     while (k && dst[k - 1] == ' ') k--;
     dst[k] = '\0';
 }

@@ -1,8 +1,10 @@
 /* rx.c -- lensmat prescription files into the lens model and back.  A `thickness`
  * line selects the designers' tabulation (radius, thickness to the next surface,
- * glass, then optional `semi`, `conic`, `a2`..`a16`, `nd`/`vd`, `stop` per surface)
- * with `title`, `unit`, `wavelengths`, `wlweights`, `epd`/`fnum`/`na`, `field`,
- * `fieldweights` and `image` lines; without it the file is the classic positions
+ * glass, then optional `semi`, `conic`, `a2`..`a16`, `nd`/`vd`, `stop`, `mirror` per
+ * surface; thicknesses negative after an odd number of mirrors) with `title`, `unit`,
+ * `catalog` (glass catalogues, doc/glass.md), `wavelengths`, `wlweights`,
+ * `epd`/`fnum`/`na`, `field`, `fieldweights` and `image` lines; without it the file
+ * is the classic positions
  * format (radius, position, index), read here with the classic dialogue's reading
  * of indices (a number at one wavelength).  Format in README "Prescription files". */
 #include <math.h>
@@ -87,6 +89,12 @@ static int set_glass(rd *r, const char *tok, char *out)
     if (strlen(tok) >= LN_NAME_MAX) return bad(r, "glass name '%.40s...' too long", tok);
     strcpy(out, tok);
     ln_glass_spelling(out);
+    if (ln_parse_number(out, 0, &(double){0}) || strchr(out, '/')) return LN_OK;
+    if (ln_glass_lookup(r->l, tok, out, r->notes, r->src, r->line)) return LN_OK;
+    if (px_medium_index(tok) > 0)             /* crown, flint, water...: the seed's media */
+        ln_note(r->notes, r->src, r->line, "%s is not in the glass catalogues: taken as "
+                "the medium's constant index %.6g at every wavelength (no dispersion)",
+                tok, px_medium_index(tok));
     return LN_OK;
 }
 
@@ -174,8 +182,12 @@ static int surface_keys(rd *r, ln_surface *s, char **tok, int n)
             r->l->stop = r->l->nsurf - 1;
             continue;
         }
+        if (!strcmp(k, "mirror")) {              /* reflects: back into the same medium */
+            s->mirror = 1;
+            continue;
+        }
         if (i + 1 == n) return bad(r, "'%s' needs a value (keys: semi, conic, a2..a16, "
-                                   "nd, vd, stop)", k);
+                                   "nd, vd, stop, mirror)", k);
         if (number(r, k, tok[++i], 0, &v)) return LN_BAD;
         if (!strcmp(k, "semi")) {
             if (!(v >= 0)) return bad(r, "semi: the semi-diameter must not be negative");
@@ -194,7 +206,7 @@ static int surface_keys(rd *r, ln_surface *s, char **tok, int n)
             s->asph[j] = v;
             if (j + 1 > s->nasph) s->nasph = j + 1;
         } else return bad(r, "'%s' is not a surface key (semi, conic, a2..a16, nd, vd, "
-                          "stop)", k);
+                          "stop, mirror)", k);
     }
     return LN_OK;
 }
@@ -217,9 +229,7 @@ static int surface(rd *r, char **tok, int n)
     s->line = r->line;
     ln_set_radius(s, rad);
     if (r->thick) {
-        if (t < 0) return bad(r, "the thickness must not be negative (mirrors and folded "
-                              "systems are not supported)");
-        s->t = t;
+        s->t = t;            /* < 0 after a mirror; ln_check checks the signs */
         if (set_glass(r, tok[2], s->glass)) return LN_BAD;
         return surface_keys(r, s, tok + 3, n - 3);
     }
@@ -299,6 +309,20 @@ static int keyword(rd *r, char **tok, int n)
             if (!strcmp(tok[1], units[i])) { strcpy(l->unit, units[i]); return LN_OK; }
         return bad(r, "unit '%s': mm, cm, m or in", tok[1]);
     }
+    if (!strcmp(k, "catalog")) {              /* catalog SCHOTT OHARA ...: lookup order */
+        if (n < 2) return bad(r, "catalog NAME...: the glass catalogues to look glasses up "
+                              "in, in order (LENSMAT: the built-in one)");
+        if (l->ncat) return bad(r, "catalog given twice");
+        if (n - 1 > LN_CAT_MAX) return bad(r, "catalog: at most %d catalogues", LN_CAT_MAX);
+        for (int i = 1; i < n; i++) {
+            if (strcasecmp(tok[i], "LENSMAT") && !px_glass_cat_find(tok[i]))
+                return bad(r, "catalog %s: no such glass catalogue (no %s.agf in "
+                           "$LENSMAT_GLASS_PATH, data/agf/ or ../shared/glass/; LENSMAT is "
+                           "the built-in one)", tok[i], tok[i]);
+            snprintf(l->catalogs[l->ncat++], LN_NAME_MAX, "%s", tok[i]);
+        }
+        return LN_OK;
+    }
     if (!strcmp(k, "wlweights"))
         return weights(r, "wlweights", tok + 1, n - 1, &r->have_wlw, &r->nwlw,
                        l->wl_weight, sizeof l->wl_weight[0]);
@@ -338,7 +362,7 @@ static int is_keyword(const char *k)
 {
     static const char *const keys[] = {"object", "thickness", "nearpoint", "index",
         "wavelength", "wavelengths", "unit", "wlweights", "fieldweights", "epd", "fnum",
-        "na", "field", "image", "title"};
+        "na", "field", "image", "title", "catalog"};
     for (size_t i = 0; i < sizeof keys / sizeof *keys; i++)
         if (!strcmp(k, keys[i])) return 1;
     return 0;
@@ -480,6 +504,14 @@ char *ln_write_rx(const ln_lens *l)
                   "V, a2..a16 V (even asphere), nd V vd V, stop\nthickness\n");
     if (l->title[0]) ln_buf_printf(&b, "title %s\n", l->title);
     if (strcmp(l->unit, "mm") && l->unit[0]) ln_buf_printf(&b, "unit %s\n", l->unit);
+    {   /* the selected catalogues this machine has (a .zmx's GCAT may name others:
+         * its glasses are stored by name, CATALOG:NAME when an AGF file gave them) */
+        int k = 0;
+        for (int i = 0; i < l->ncat; i++)
+            if (!strcasecmp(l->catalogs[i], "LENSMAT") || px_glass_cat_find(l->catalogs[i]))
+                ln_buf_printf(&b, "%s %s", k++ ? "" : "catalog", l->catalogs[i]);
+        if (k) ln_buf_printf(&b, "\n");
+    }
     if (l->nearpoint != 25) { ln_format(l->nearpoint, a, sizeof a); ln_buf_printf(&b, "nearpoint %s\n", a); }
     if (l->nwl) {
         ln_buf_printf(&b, "wavelengths");
@@ -545,6 +577,7 @@ char *ln_write_rx(const ln_lens *l)
                 ln_buf_printf(&b, " a%d %s", 2 * k + 2, a);
             }
         if (l->stop == i) ln_buf_printf(&b, " stop");
+        if (s->mirror) ln_buf_printf(&b, " mirror");
         ln_buf_printf(&b, "\n");
     }
     if (l->image_c != 0 || l->image_semi != 0) {

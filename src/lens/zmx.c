@@ -1,73 +1,24 @@
 /* zmx.c -- Zemax OpticStudio sequential .zmx files into the lens model and back.
  * The text format: one keyword a line (surface data indented under SURF n), in
  * UTF-8/Latin-1 or, as OpticStudio writes it, UTF-16 with a byte-order mark.  What
- * the model holds is read (surfaces STANDARD and EVENASPH with CURV, DISZ, GLAS,
- * DIAM, CONI, PARM, STOP; WAVL/WAVM, ENPD/FNUM/OBNA, FTYP, fields); every other
- * surface type and glass the catalogue lacks is noted with its line, and the other
- * keywords (display, tolerancing, optimisation, coatings...) in one note. */
+ * the model holds is read (surfaces STANDARD and EVENASPH with CURV, DISZ, GLAS
+ * (MIRROR too), DIAM, CONI, PARM, STOP; GCAT; WAVL/WAVM, ENPD/FNUM/OBNA, FTYP,
+ * fields); every other surface type and glass the catalogue lacks is noted with its
+ * line, coordinate breaks that tilt or decentre are refused (those that do not are
+ * skipped), and the other keywords (display, tolerancing, optimisation, coatings...)
+ * are listed in one note. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 #include "lens_text.h"
+#include "common/lm_text.h"
 #include "paraxial/paraxial.h"
 
-/* ---- decoding ------------------------------------------------------------------ */
+/* ---- decoding: src/common/lm_text.h (UTF-16, UTF-8, Latin-1 into UTF-8) ------- */
 
-static size_t put_utf8(char *o, unsigned cp)
-{
-    if (cp < 0x80) { o[0] = (char)cp; return 1; }
-    if (cp < 0x800) { o[0] = (char)(0xc0 | cp >> 6); o[1] = (char)(0x80 | (cp & 63)); return 2; }
-    if (cp < 0x10000) {
-        o[0] = (char)(0xe0 | cp >> 12); o[1] = (char)(0x80 | ((cp >> 6) & 63));
-        o[2] = (char)(0x80 | (cp & 63));
-        return 3;
-    }
-    o[0] = (char)(0xf0 | cp >> 18); o[1] = (char)(0x80 | ((cp >> 12) & 63));
-    o[2] = (char)(0x80 | ((cp >> 6) & 63)); o[3] = (char)(0x80 | (cp & 63));
-    return 4;
-}
-
-/* The text as NUL-terminated UTF-8 (malloc'd; *n its length): UTF-16LE/BE by their
- * byte-order mark, or without one when the first bytes are ASCII with NULs beside
- * them; anything else is taken byte for byte (a UTF-8 mark dropped).  A NUL in the
- * decoded text becomes a blank (the line still reads).  NULL: out of memory. */
-static char *decode(const char *text, size_t len, size_t *n)
-{
-    const unsigned char *u = (const unsigned char *)text;
-    int be = -1;
-    size_t i = 0, k = 0;
-    char *o;
-    if (len >= 2 && u[0] == 0xff && u[1] == 0xfe) { be = 0; i = 2; }
-    else if (len >= 2 && u[0] == 0xfe && u[1] == 0xff) { be = 1; i = 2; }
-    else if (len >= 4 && u[0] && !u[1] && u[2] && !u[3]) be = 0;
-    else if (len >= 4 && !u[0] && u[1] && !u[2] && u[3]) be = 1;
-    if (be < 0) {
-        if (len >= 3 && !memcmp(text, "\xef\xbb\xbf", 3)) i = 3;
-        if (!(o = malloc(len - i + 1))) return NULL;
-        for (; i < len; i++) o[k++] = text[i] ? text[i] : ' ';
-        o[k] = '\0';
-        *n = k;
-        return o;
-    }
-    if (!(o = malloc((len / 2) * 3 + 4))) return NULL;   /* a unit is at most 3 bytes */
-    for (; i + 1 < len; i += 2) {
-        unsigned cp = be ? (unsigned)(u[i] << 8 | u[i + 1]) : (unsigned)(u[i + 1] << 8 | u[i]);
-        if (cp >= 0xd800 && cp < 0xdc00 && i + 3 < len) {          /* a surrogate pair */
-            unsigned lo = be ? (unsigned)(u[i + 2] << 8 | u[i + 3]) : (unsigned)(u[i + 3] << 8 | u[i + 2]);
-            if (lo >= 0xdc00 && lo < 0xe000) {
-                cp = 0x10000 + ((cp - 0xd800) << 10) + (lo - 0xdc00);
-                i += 2;
-            } else cp = '?';
-        } else if (cp >= 0xd800 && cp < 0xe000) cp = '?';
-        if (cp == 0) cp = ' ';
-        k += put_utf8(o + k, cp);
-    }
-    o[k] = '\0';
-    *n = k;
-    return o;
-}
+static char *decode(const char *text, size_t len, size_t *n) { return lm_text_utf8(text, len, n); }
 
 /* ---- reading --------------------------------------------------------------------- */
 
@@ -76,6 +27,10 @@ typedef struct zsurf {
     ln_surface s;
     int stop, supported;       /* supported: STANDARD or EVENASPH */
     char type[16];
+    long dline;                /* the DISZ line */
+    int cb;                    /* a coordinate break (TYPE COORDBRK) */
+    double cbp[6];             /* its PARM 1-6: decentre x, y; tilt about x, y, z; order */
+    long cb_line;              /* the first PARM line that tilts or decentres */
 } zsurf;
 
 #define NSKIP 64
@@ -162,15 +117,18 @@ static const char *const aliases[][3] = {
 static int glass(zr *r, zsurf *z, char **tok, int n)
 {
     double nd = 0, vd = 0, idx;
-    const px_glass_rec *g;
+    int placeholder;
     const char *name = tok[1];
     if (n < 2) return zbad(r, "GLAS: a glass name is missing");
     z->s.nd = z->s.vd = 0;                  /* a second GLAS line replaces the first */
     if (n >= 6 && (!ln_parse_number(tok[4], 0, &nd) || !ln_parse_number(tok[5], 0, &vd)))
         nd = vd = 0;
-    if (!strcasecmp(name, "MIRROR"))
-        return zbad(r, "GLAS MIRROR: reflecting surfaces are not supported (the lens model "
-                    "is a sequence of refracting surfaces)");
+    if (!strcasecmp(name, "MIRROR")) {      /* back into the medium it came from (air) */
+        z->s.mirror = 1;
+        z->s.glass[0] = '\0';
+        return LN_OK;
+    }
+    z->s.mirror = 0;
     if (strlen(name) >= LN_NAME_MAX) return zbad(r, "GLAS: name too long");
     for (const char *p = name; *p; p++)      /* what a prescription's column can hold */
         if (*p <= ' ' || *p > '~' || *p == '@' || *p == '#' || *p == ',')
@@ -199,15 +157,36 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
             r->aliased |= 1u << i;
             name = aliases[i][1];
         }
-    if ((g = px_glass_find(name))) { snprintf(z->s.glass, LN_NAME_MAX, "%s", g->name); return LN_OK; }
+    /* OpticStudio writes nd 1.5, Vd 40 -- its model-glass defaults -- for a glass the
+     * exporting machine's catalogues lacked: not the glass's data */
+    placeholder = n >= 6 && nd == 1.5 && vd == 40;
+    if (ln_glass_lookup(r->l, name, z->s.glass, r->notes, r->src, r->line)) {
+        double nc;
+        if (placeholder)
+            ln_note(r->notes, r->src, r->line, "glass %s: the file's nd 1.5, Vd 40 are "
+                    "OpticStudio's placeholder (the exporting machine lacked the glass): "
+                    "the catalogue's %s is used", tok[1], z->s.glass);
+        else if (nd > 1 && px_glass_index(z->s.glass, PX_LAMBDA_D, &nc) == PX_OK &&
+                 fabs(nc - nd) > 5e-4)  /* another maker's glass of that name, a typo */
+            ln_note(r->notes, r->src, r->line, "glass %s: the file gives nd %.6g, the "
+                    "catalogue's %s has %.6f: the catalogue's is used", tok[1], nd,
+                    z->s.glass, nc);
+        return LN_OK;
+    }
     if (ln_parse_number(name, 0, &idx)) {   /* an index as a name: its shortest spelling */
         if (px_glass_index(name, PX_LAMBDA_D, &idx) == PX_OK) {
             ln_format(idx, z->s.glass, LN_NAME_MAX);
+            ln_note(r->notes, r->src, r->line, "glass %s: a constant index %s at every "
+                    "wavelength (no dispersion)", name, z->s.glass);
             return LN_OK;
         }
     } else if (px_glass_index(name, PX_LAMBDA_D, &idx) == PX_OK) {
         snprintf(z->s.glass, LN_NAME_MAX, "%s", name);   /* a medium, a model ND/VD */
         ln_glass_spelling(z->s.glass);
+        if (!strchr(name, '/'))
+            ln_note(r->notes, r->src, r->line, "glass %s is not in the glass catalogues: "
+                    "taken as the medium %s, a constant index %.6g at every wavelength "
+                    "(no dispersion)", name, name, idx);
         return LN_OK;
     }
     snprintf(z->s.glass, LN_NAME_MAX, "%s", name);
@@ -215,9 +194,16 @@ static int glass(zr *r, zsurf *z, char **tok, int n)
         nd = 1 + atoi(name) / 1000 / 1000.0;               /* 517642: nd 1.517, Vd 64.2 */
         vd = (atoi(name) % 1000) / 10.0;
     }
-    if (!(nd > 1)) return zbad(r, "glass %s is not in lensmat's catalogue (data/glass.txt) "
-                               "and the file gives no nd for it (add the glass's formula "
-                               "to data/glass.txt, or nd and Vd to this GLAS line)", name);
+    if (placeholder)
+        return zbad(r, "glass %s is not in lensmat's glass catalogues, and the file's nd "
+                    "1.5, Vd 40 are OpticStudio's placeholder for a glass the exporting "
+                    "machine lacked, not %s's data: add the glass's catalogue (its maker's "
+                    "AGF file in data/agf/, ../shared/glass/ or $LENSMAT_GLASS_PATH) or "
+                    "its formula to data/glass.txt", name, name);
+    if (!(nd > 1)) return zbad(r, "glass %s is not in lensmat's glass catalogues "
+                               "(data/glass.txt, AGF files) and the file gives no nd for "
+                               "it (add the glass's catalogue or formula, or nd and Vd to "
+                               "this GLAS line)", name);
     z->s.nd = nd;
     z->s.vd = vd;
     ln_note(r->notes, r->src, r->line, "glass %s is not in lensmat's catalogue: taken as "
@@ -243,6 +229,7 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
         snprintf(z->type, sizeof z->type, "%s", tok[1]);
         if (!strcmp(tok[1], "STANDARD")) z->s.type = LN_STANDARD;
         else if (!strcmp(tok[1], "EVENASPH")) z->s.type = LN_EVENASPH;
+        else if (!strcmp(tok[1], "COORDBRK")) { z->supported = 0; z->cb = 1; }
         else {
             z->supported = 0;
             ln_note(r->notes, r->src, r->line, "surface %d: type %s is not supported: read "
@@ -266,9 +253,8 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
             return LN_OK;
         }
         if (isinf(v)) return zbad(r, "DISZ INFINITY: only the object may lie at infinity");
-        if (v < 0) return zbad(r, "DISZ %s: a negative thickness is not supported (mirrors "
-                               "and folded systems are not)", tok[1]);
-        z->s.t = v;
+        z->s.t = v;          /* < 0 after a mirror: checked in assemble */
+        z->dline = r->line;
         return LN_OK;
     }
     if (!strcmp(k, "GLAS")) return glass(r, z, tok, n);
@@ -290,6 +276,11 @@ static int surface_line(zr *r, zsurf *z, const char *k, char **tok, int n)
             return zbad(r, "PARM N VALUE: a parameter number and a value are needed");
         if (znum(r, k, tok[2], &v)) return LN_BAD;
         if (isinf(v)) return zbad(r, "PARM: the value must be finite");
+        if (z->cb) {                          /* decentre x, y, tilt x, y, z, order */
+            if (i >= 1 && i <= 6) z->cbp[(int)i - 1] = v;
+            if (i >= 1 && i <= 5 && v != 0 && !z->cb_line) z->cb_line = r->line;
+            return LN_OK;
+        }
         if (z->s.type == LN_EVENASPH && i >= 1 && i <= LN_ASPH_MAX) {
             z->s.asph[(int)i - 1] = v;
             if (v != 0 && (int)i > z->s.nasph) z->s.nasph = (int)i;
@@ -319,6 +310,13 @@ static int system_line(zr *r, const char *k, char **tok, int n, const char *rest
         while (len && strchr(" \t\r", rest[len - 1])) len--;
         if (len >= 2 && rest[0] == '"' && rest[len - 1] == '"') { rest++; len -= 2; }
         ln_title(l->title, rest, len);
+        return LN_OK;
+    }
+    if (!strcmp(k, "GCAT")) {                  /* the glass catalogues, in order */
+        l->ncat = 0;
+        for (int i = 1; i < n && l->ncat < LN_CAT_MAX; i++)
+            if (strlen(tok[i]) < LN_NAME_MAX) snprintf(l->catalogs[l->ncat++], LN_NAME_MAX,
+                                                       "%s", tok[i]);
         return LN_OK;
     }
     if (!strcmp(k, "MODE")) {
@@ -444,15 +442,50 @@ static int assemble(zr *r)
         l->obj_nd = r->zs[0].s.nd;
         l->obj_vd = r->zs[0].s.vd;
     }
+    for (int i = 1, sigma = 1; i < r->nz - 1; i++) {    /* thickness signs: by DISZ line */
+        double t = r->zs[i].s.t;
+        if (r->zs[i].cb && r->zs[i].cb_line) break;     /* refused below, at its PARM */
+        if (r->zs[i].s.mirror) sigma = -sigma;
+        if (sigma > 0 ? t < 0 : t > 0) {
+            char a[32];
+            r->line = r->zs[i].dline;
+            ln_format(t, a, sizeof a);
+            return zbad(r, sigma > 0 ? "DISZ %s: a negative thickness where the light travels "
+                        "toward +z (thicknesses are negative only after an odd number of "
+                        "mirrors)" : "DISZ %s: a positive thickness where the light travels "
+                        "toward -z (after an odd number of mirrors thicknesses are negative)", a);
+        }
+    }
     for (int i = 1; i < r->nz - 1; i++) {
-        ln_surface *s = ln_add_surface(l);
-        if (!s) { snprintf(r->err, r->cap, "%s: out of memory", r->src); return LN_NOMEM; }
+        ln_surface *s;
+        if (r->zs[i].cb) {
+            zsurf *z = &r->zs[i];
+            if (z->cb_line) {
+                r->line = z->cb_line;
+                return zbad(r, "surface %d: a coordinate break (TYPE COORDBRK) that decentres "
+                            "by x %g, y %g and tilts by %g, %g, %g degrees about x, y, z: "
+                            "the lens model is one rotationally symmetric axis, so tilted and "
+                            "decentred parts are refused rather than read as centred", i,
+                            z->cbp[0], z->cbp[1], z->cbp[2], z->cbp[3], z->cbp[4]);
+            }
+            /* a break that moves nothing (files keep them as placeholders): its
+             * thickness joins the gap before it */
+            if (l->nsurf) l->surf[l->nsurf - 1].t += z->s.t;
+            else l->object += z->s.t;
+            ln_note(r->notes, r->src, z->s.line, "surface %d: a coordinate break with no "
+                    "decentre or tilt is skipped (its thickness %g joins the gap before it)",
+                    i, z->s.t);
+            if (z->stop) ln_note(r->notes, r->src, z->s.line, "surface %d: the stop on a "
+                                 "coordinate break is skipped", i);
+            continue;
+        }
+        if (!(s = ln_add_surface(l))) { snprintf(r->err, r->cap, "%s: out of memory", r->src); return LN_NOMEM; }
         *s = r->zs[i].s;
         if (r->zs[i].stop) {
             if (l->stop >= 0)
                 ln_note(r->notes, r->src, r->zs[i].s.line, "surface %d: a second STOP "
                         "(surface %d is the stop)", i, l->stop + 1);
-            else l->stop = i - 1;
+            else l->stop = l->nsurf - 1;
         }
     }
     if (r->zs[0].stop || r->zs[r->nz - 1].stop)
@@ -557,10 +590,11 @@ static void zfmt(double v, char *buf, size_t cap)
     else ln_format(v, buf, cap);
 }
 
-static void write_glass(ln_buf *b, const char *g, double nd, double vd)
+static void write_glass(ln_buf *b, const char *g, double nd, double vd, int mirror)
 {
     double n, v = 0;
     char a[40], c[40];
+    if (mirror) { ln_buf_printf(b, "  GLAS MIRROR 0 0 0 0 0 0 0 0 0 0\r\n"); return; }
     if (!g[0]) return;
     if (nd > 1 && px_glass_index(g, PX_LAMBDA_D, &n) == PX_NO_GLASS) {
         ln_format(nd, a, sizeof a);
@@ -607,7 +641,7 @@ static void write_surface(ln_buf *b, int k, const ln_surface *s, int stop, doubl
         }
     zfmt(disz, a, sizeof a);
     ln_buf_printf(b, "  DISZ %s\r\n", a);
-    write_glass(b, glass, nd, vd);
+    write_glass(b, glass, nd, vd, s->mirror);
     if (s->conic != 0) { ln_format(s->conic, a, sizeof a); ln_buf_printf(b, "  CONI %s\r\n", a); }
     if (s->semi != 0) {
         ln_format(s->semi, a, sizeof a);
@@ -631,11 +665,19 @@ char *ln_write_zmx(const ln_lens *lens)
     const char *unit = "MM";
     for (size_t i = 0; i < sizeof zu / sizeof *zu; i += 2)
         if (!strcmp(l->unit, zu[i])) unit = zu[i + 1];
-    {   /* the reader takes one pair of quotes off a title: a quoted title keeps its own */
-        size_t n = strlen(l->title);
+    {   /* the reader takes one pair of quotes off a title: a quoted title keeps its own;
+         * a title read as Latin-1 bytes (a thickness prescription) is written in UTF-8 */
+        size_t n = strlen(l->title), m;
         int q = n >= 2 && l->title[0] == '"' && l->title[n - 1] == '"';
+        char *t = lm_utf8_fix(l->title, n, &m);
         ln_buf_printf(&b, "MODE SEQ\r\nNAME %s%s%s\r\nUNIT %s X W X CM MR CPMM\r\n",
-                      q ? "\"" : "", l->title, q ? "\"" : "", unit);
+                      q ? "\"" : "", t ? t : "", q ? "\"" : "", unit);
+        free(t);
+    }
+    if (l->ncat) {
+        ln_buf_printf(&b, "GCAT");
+        for (int i = 0; i < l->ncat; i++) ln_buf_printf(&b, " %s", l->catalogs[i]);
+        ln_buf_printf(&b, "\r\n");
     }
     if (l->ap_kind != LN_AP_NONE) {
         ln_format(l->ap_value, a, sizeof a);

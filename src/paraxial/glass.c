@@ -1,7 +1,8 @@
-/* glass.c -- the glass catalogue (data/glass.txt, compiled in by scripts/gen_glass.sh),
- * indices of catalogue and model glasses at a wavelength, wavelength shorthands, Abbe
- * numbers, and absorption from the catalogue's internal-transmittance tables.  Pure
- * functions: no I/O. */
+/* glass.c -- the glass catalogue (data/glass.txt, compiled in by scripts/gen_glass.sh,
+ * and the AGF catalogues of glass_cat.c behind it), indices of catalogue and model
+ * glasses at a wavelength (every AGF dispersion formula), wavelength shorthands, Abbe
+ * numbers, and absorption from the catalogues' internal-transmittance tables.  No
+ * I/O here: glass_cat.c reads the AGF files. */
 #include <ctype.h>
 #include <math.h>
 #include <stdlib.h>
@@ -19,24 +20,113 @@ const px_glass_rec *px_glass_at(int i)
     return i >= 0 && i < NGLASS ? &px_glass_table[i] : NULL;
 }
 
-const px_glass_rec *px_glass_find(const char *name)
+static const px_glass_rec *builtin(const char *name)
 {
     for (int i = 0; i < NGLASS; i++)
         if (!strcasecmp(name, px_glass_table[i].name)) return &px_glass_table[i];
     return NULL;
 }
 
-/* n at l (um) from the record's formula; l inside the range. */
-static double formula(const px_glass_rec *g, double l)
+static const px_glass_rec *in_cat(const px_glass_cat *c, const char *name)
 {
-    double l2 = l * l, n2 = 1;
-    if (g->model == PX_GLASS_CONST) return g->coef[0];
-    for (int i = 0; i + 1 < g->ncoef; i += 2) {
-        double c = g->coef[i + 1];
-        if (g->model == PX_GLASS_SELLMEIER_L) c *= c;
-        n2 += g->coef[i] * l2 / (l2 - c);
+    for (int i = 0; c && i < c->n; i++)
+        if (!strcasecmp(name, c->rec[i].name)) return &c->rec[i];
+    return NULL;
+}
+
+const px_glass_rec *px_glass_find(const char *name)
+{
+    const px_glass_rec *g;
+    const char *colon = strchr(name, ':');
+    if (colon) {                               /* CATALOG:NAME */
+        char cat[256];
+        if ((size_t)(colon - name) >= sizeof cat) return NULL;
+        memcpy(cat, name, (size_t)(colon - name));
+        cat[colon - name] = '\0';
+        if (!strcasecmp(cat, "LENSMAT")) return builtin(colon + 1);
+        return in_cat(px_glass_cat_find(cat), colon + 1);
     }
-    return sqrt(n2);
+    if ((g = builtin(name))) return g;
+    /* a name that is not a glass's (a number, a model glass, a medium) does not make
+     * the catalogues load */
+    if (!*name || isdigit((unsigned char)*name) || *name == '.' || strchr(name, '/') ||
+        px_medium_index(name) > 0) return NULL;
+    for (int i = 0, n = px_glass_cat_count(); i < n; i++)
+        if ((g = in_cat(px_glass_cat_at(i), name))) return g;
+    return NULL;
+}
+
+int px_glass_find_all(const char *name, const px_glass_rec **out, int max)
+{
+    const px_glass_rec *g;
+    int k = 0;
+    if ((g = builtin(name)) && k++ < max) out[0] = g;
+    for (int i = 0, n = px_glass_cat_count(); i < n; i++)
+        if ((g = in_cat(px_glass_cat_at(i), name))) {
+            if (k < max) out[k] = g;
+            k++;
+        }
+    return k;
+}
+
+/* n at l (um) from the record's formula (static inline: px_glass_index, the hot
+ * path of every traced wavelength's index, keeps it inlined). */
+static inline double formula(const px_glass_rec *g, double l);
+double px_glass_formula(const px_glass_rec *g, double l) { return formula(g, l); }
+static inline double formula(const px_glass_rec *g, double l)
+{
+    const double *c = g->coef;
+    double l2 = l * l, n2 = 1, L;
+    int f = g->model - PX_GLASS_AGF;
+    if (g->model == PX_GLASS_CONST) return c[0];
+    if (g->model == PX_GLASS_SELLMEIER || g->model == PX_GLASS_SELLMEIER_L) {
+        for (int i = 0; i + 1 < g->ncoef; i += 2) {
+            double ci = c[i + 1];
+            if (g->model == PX_GLASS_SELLMEIER_L) ci *= ci;
+            n2 += c[i] * l2 / (l2 - ci);
+        }
+        return sqrt(n2);
+    }
+    switch (f) {
+    case 1:                                                       /* Schott */
+        n2 = c[0] + c[1] * l2 + c[2] / l2 + c[3] / (l2 * l2) + c[4] / (l2 * l2 * l2) +
+             c[5] / (l2 * l2 * l2 * l2);
+        break;
+    case 2: case 6: case 11:                                      /* Sellmeier 1, 3, 5 */
+        for (int i = 0; i < (f == 2 ? 3 : f == 6 ? 4 : 5); i++)
+            n2 += c[2 * i] * l2 / (l2 - c[2 * i + 1]);
+        break;
+    case 3:                                                       /* Herzberger */
+        L = 1 / (l2 - 0.028);
+        return c[0] + c[1] * L + c[2] * L * L + c[3] * l2 + c[4] * l2 * l2 +
+               c[5] * l2 * l2 * l2;
+    case 4:                                                       /* Sellmeier 2 */
+        n2 = 1 + c[0] + c[1] * l2 / (l2 - c[2] * c[2]) + c[3] * l2 / (l2 - c[4] * c[4]);
+        break;
+    case 5:                                                       /* Conrady */
+        return c[0] + c[1] / l + c[2] / pow(l, 3.5);
+    case 7:                                                       /* Handbook 1 */
+        n2 = c[0] + c[1] / (l2 - c[2]) - c[3] * l2;
+        break;
+    case 8:                                                       /* Handbook 2 */
+        n2 = c[0] + c[1] * l2 / (l2 - c[2]) - c[3] * l2;
+        break;
+    case 9:                                                       /* Sellmeier 4 */
+        n2 = c[0] + c[1] * l2 / (l2 - c[2]) + c[3] * l2 / (l2 - c[4]);
+        break;
+    case 10: case 12: case 13: {                                  /* Extended 1-3 */
+        /* the negative powers l^-2, l^-4 ...: c2..c7 (10, 12: c2..c5), c3..c8 (13) */
+        double m = 1 / l2, p = m;
+        int k0 = f == 13 ? 3 : 2, k1 = f == 10 ? 7 : f == 12 ? 5 : 8;
+        n2 = c[0] + c[1] * l2 + (f == 13 ? c[2] * l2 * l2 : 0);
+        for (int k = k0; k <= k1; k++, p *= m) n2 += c[k] * p;
+        if (f == 12) n2 += c[6] * l2 * l2 + c[7] * l2 * l2 * l2;
+        break;
+    }
+    default:
+        return NAN;
+    }
+    return n2 > 0 ? sqrt(n2) : NAN;
 }
 
 /* Model glass: n = A + B/l^2 through nd at d, nF - nC = (nd - 1)/vd. */
@@ -75,8 +165,9 @@ int px_glass_index(const char *name, double l, double *n)
     if (g) {
         if (l < g->lmin || l > g->lmax) return PX_GLASS_RANGE;
         *n = formula(g, l);
-        return PX_OK;
+        return isfinite(*n) && *n > 0 ? PX_OK : PX_GLASS_RANGE;
     }
+    if (strchr(name, ':')) return PX_NO_GLASS;      /* CATALOG:NAME not in that catalogue */
     if (parse_model(name, &nd, &vd)) return px_glass_model(nd, vd, l, n);
     if (isdigit((unsigned char)name[0])) {   /* a plain number: a constant index */
         char *end;
@@ -90,6 +181,16 @@ int px_glass_index(const char *name, double l, double *n)
         return PX_OK;
     }
     return PX_NO_GLASS;
+}
+
+const char *px_glass_former(const char *name, const char **why)
+{
+    for (int i = 0; i < PX_NFORMER; i++)
+        if (!strcasecmp(name, px_former_table[i].old)) {
+            if (why) *why = px_former_table[i].why;
+            return px_former_table[i].now;
+        }
+    return NULL;
 }
 
 int px_wavelength(const char *tok, double *um)
@@ -125,8 +226,16 @@ int px_glass_abbe(const char *name, double *vd)
 
 const px_tau_rec *px_glass_tau(const char *name, int k)
 {
-    for (int i = 0; i < PX_NTAU; i++)
-        if (!strcasecmp(name, px_tau_table[i].name) && k-- == 0) return &px_tau_table[i];
+    const px_glass_rec *g = px_glass_find(name);
+    if (!g || !g->catalog || !strcmp(g->catalog, "LENSMAT")) {
+        for (int i = 0; i < PX_NTAU; i++)
+            if (!strcasecmp(g ? g->name : name, px_tau_table[i].name) && k-- == 0)
+                return &px_tau_table[i];
+        return NULL;
+    }
+    const px_glass_cat *c = px_glass_cat_find(g->catalog);      /* an AGF glass's IT */
+    for (int i = 0; c && i < c->ntau; i++)
+        if (c->tau[i].name == g->name && k-- == 0) return &c->tau[i];
     return NULL;
 }
 

@@ -10,6 +10,7 @@
  * powers are in 1/unit (px_diopters, below, converts to diopters). */
 #ifndef PARAXIAL_H
 #define PARAXIAL_H
+#include <stddef.h>
 
 /* Result codes.  PX_BAD (= 2, with the calculations below): an input outside the
  * domain (negative thickness, index <= 0, not a number); nothing was changed. */
@@ -299,23 +300,87 @@ double px_cornea_doc_dradius(double p, double dp, double n);
 #define PX_LAMBDA_E 0.5460740     /* mercury e */
 #define PX_LAMBDA_G 0.4358343     /* mercury g */
 #define PX_LAMBDA_HENE 0.6328     /* helium-neon laser (the cornea rig's) */
-enum { PX_GLASS_SELLMEIER, PX_GLASS_SELLMEIER_L, PX_GLASS_CONST };
+/* Dispersion models.  PX_GLASS_AGF + N is the Zemax AGF catalogues' formula number N
+ * (l in um, coefficients c0 c1 ... in the order of the AGF "CD" line):
+ *   1 Schott      n^2 = c0 + c1 l^2 + c2 l^-2 + c3 l^-4 + c4 l^-6 + c5 l^-8
+ *   2 Sellmeier 1 n^2 - 1 = sum_{i<3} c_2i l^2 / (l^2 - c_2i+1)
+ *   3 Herzberger  n = c0 + c1 L + c2 L^2 + c3 l^2 + c4 l^4 + c5 l^6, L = 1/(l^2 - 0.028)
+ *   4 Sellmeier 2 n^2 - 1 = c0 + c1 l^2 / (l^2 - c2^2) + c3 l^2 / (l^2 - c4^2)
+ *   5 Conrady     n = c0 + c1 / l + c2 / l^3.5
+ *   6 Sellmeier 3 n^2 - 1 = sum_{i<4} c_2i l^2 / (l^2 - c_2i+1)
+ *   7 Handbook of Optics 1  n^2 = c0 + c1 / (l^2 - c2) - c3 l^2
+ *   8 Handbook of Optics 2  n^2 = c0 + c1 l^2 / (l^2 - c2) - c3 l^2
+ *   9 Sellmeier 4 n^2 = c0 + c1 l^2 / (l^2 - c2) + c3 l^2 / (l^2 - c4)
+ *  10 Extended    n^2 = c0 + c1 l^2 + c2 l^-2 + ... + c7 l^-12
+ *  11 Sellmeier 5 n^2 - 1 = sum_{i<5} c_2i l^2 / (l^2 - c_2i+1)
+ *  12 Extended 2  n^2 = c0 + c1 l^2 + c2 l^-2 + c3 l^-4 + c4 l^-6 + c5 l^-8 + c6 l^4 + c7 l^6
+ *  13 Extended 3  n^2 = c0 + c1 l^2 + c2 l^4 + c3 l^-2 + c4 l^-4 + ... + c8 l^-12 */
+enum { PX_GLASS_SELLMEIER, PX_GLASS_SELLMEIER_L, PX_GLASS_CONST, PX_GLASS_AGF = 100 };
+#define PX_GLASS_MAXCOEF 10
 typedef struct px_glass_rec {
     const char *name;
     int model;                 /* PX_GLASS_* */
     double lmin, lmax;         /* validity range, um */
     const char *nd, *vd;       /* published values as printed ("-": none) */
     int ncoef;
-    double coef[8];
+    double coef[PX_GLASS_MAXCOEF];
+    const char *catalog;       /* "LENSMAT" (data/glass.txt) or an AGF catalogue's name */
+    const char *status;        /* an AGF glass's status ("standard", "preferred",
+                                  "obsolete", "special", "melt"), or "" */
 } px_glass_rec;
+/* n of a record at l (um), without the range check (NaN where the formula has no
+ * real value). */
+double px_glass_formula(const px_glass_rec *g, double l);
 /* Result codes of the look-ups below, besides PX_OK: */
 enum { PX_NO_GLASS = 4,        /* no such glass, or not "nd/Vd" */
        PX_GLASS_RANGE = 5 };   /* the wavelength lies outside the glass's range */
 /* The catalogue's entry for a name (case-insensitive), or NULL; and by number
- * (0 <= i < px_glass_count()) for listings. */
+ * (0 <= i < px_glass_count()) for listings.  A name is looked up in the built-in
+ * catalogue (data/glass.txt) first, then in the AGF catalogues (glass_cat.c) in the
+ * order they were loaded; "CATALOG:NAME" looks in that catalogue only ("LENSMAT:" is
+ * the built-in one).  The built-in catalogue's count and entries only: the AGF
+ * catalogues have px_glass_cat_* below. */
 const px_glass_rec *px_glass_find(const char *name);
 int px_glass_count(void);
 const px_glass_rec *px_glass_at(int i);
+
+/* ---- AGF catalogues (agf.c reads one, glass_cat.c keeps them) --------------------
+ * A Zemax AGF glass catalogue (the glass makers' own files): NM lines (name, formula
+ * number 1-13, glass code, nd, Vd, exclude, status), CD (coefficients), LD (validity
+ * range, um), IT (internal transmittance: wavelength um, transmittance, thickness mm),
+ * ED/TD/OD/CC/GC/MD/BD (read and not used: thermal, environmental and cost data and
+ * comments).  In UTF-8, Latin-1 or UTF-16 with or without a byte-order mark. */
+typedef struct px_glass_cat {
+    char *name;                /* the catalogue's name (its file name, upper case) */
+    char *path;                /* where it was read from ("" for a text given in memory) */
+    int n;
+    px_glass_rec *rec;         /* n glasses (names and strings owned by the catalogue) */
+    int ntau;
+    struct px_tau_rec *tau;    /* their IT tables, one per glass that has one */
+    char *notes;               /* "SRC:LINE: what was skipped" lines, or NULL */
+} px_glass_cat;
+/* Read an AGF text (len bytes) as catalogue `name`; src names it in messages.
+ * PX_OK; PX_BAD with "SRC:LINE: why" in err (a file that is not an AGF catalogue:
+ * no NM line, a formula number outside 1-13, coefficients that are not numbers);
+ * PX_NOMEM.  Lines it cannot use inside a glass are noted (cat->notes), not fatal. */
+int px_agf_read(const char *text, size_t len, const char *name, const char *src,
+                px_glass_cat *cat, char *err, size_t cap);
+void px_agf_free(px_glass_cat *cat);
+/* The catalogues available: every *.agf file (any case) in the directories of
+ * $LENSMAT_GLASS_PATH (':'-separated; a file there is read too), then data/agf/ and
+ * ../shared/glass/ (relative to the working directory), read once on first use;
+ * a catalogue name seen twice is taken from the first place only.  Files that fail
+ * to read are listed in px_glass_cat_notes() and skipped. */
+int px_glass_cat_count(void);
+const px_glass_cat *px_glass_cat_at(int i);
+const px_glass_cat *px_glass_cat_find(const char *name);   /* case-insensitive */
+const char *px_glass_cat_notes(void);                      /* "" when none */
+/* Every catalogue entry of a name (built-in first, then the AGF catalogues in
+ * order), at most max of them; returns how many there are. */
+int px_glass_find_all(const char *name, const px_glass_rec **out, int max);
+/* The number of materials the catalogues give: the built-in ones plus every AGF
+ * glass (a name in several catalogues counts once per catalogue). */
+int px_glass_total(void);
 /* The index of a catalogue glass or a model glass at lambda_um.  A model glass is
  * "ND/VD" (e.g. "1.5168/64.17", 1 < ND < 3, 5 <= VD <= 150): n = A + B/l^2, the line
  * in 1/l^2 through nd at d with nF - nC = (nd - 1)/Vd; valid 0.36-1.0 um.  Returns
@@ -323,6 +388,12 @@ const px_glass_rec *px_glass_at(int i);
  * A plain number (0 < n <= 100) and a name of px_medium_index not in the catalogue
  * are constant indices. */
 int px_glass_index(const char *name, double lambda_um, double *n);
+/* A former glass name's successor in the catalogue (data/glass.txt "former" lines:
+ * BK7 -> N-BK7 ...), case-insensitive, with *why the catalogue's reason (NULL
+ * allowed); NULL when the name is not a former one.  Only the lens readers map
+ * names (a note says so); px_glass_index never does (the classic dialogue's "bk7" is
+ * its constant 1.5168). */
+const char *px_glass_former(const char *name, const char **why);
 int px_glass_model(double nd, double vd, double lambda_um, double *n);
 /* A wavelength: the shorthands F d C e g (any case) and "hene", or a number, taken
  * as nm when above 100, else um (0.6328, 632.8).  PX_OK with *um set, or PX_BAD. */
