@@ -54,6 +54,7 @@ typedef struct sim {
     int64_t indicator_on_at;    /* -1: off */
     int lost[RG_NJOINTS];       /* sim_lose_step_ms injected already */
     int stalled;
+    int64_t last_read;          /* simulated time of the last input read */
     int violations;
     int closed;
 } sim;
@@ -358,7 +359,13 @@ static int sim_inputs(rg_chip *c, unsigned *level, unsigned *edges)
     for (int j = 0; j < RG_NJOINTS; j++) if (limit_tripped(s, j)) v |= RG_IN_LIMIT(j);
     if (key_on(s)) v |= RG_IN_KEY;
     *level = v;
-    *edges = 0;     /* the model changes only between waits: levels say it all */
+    /* an interlock that opened and closed again since the last read: its edge */
+    *edges = 0;
+    if (s->rig->sim_interlock_open_ms >= 0) {
+        int64_t at = (int64_t)llround(s->rig->sim_interlock_open_ms * 1e6);
+        if (at > s->last_read && at <= s->sh->now_ns) *edges |= RG_IN_INTERLOCK;
+    }
+    s->last_read = s->sh->now_ns;
     return 0;
 }
 
