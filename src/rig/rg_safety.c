@@ -123,7 +123,8 @@ static int first_limit(unsigned bits)
 static const char *const jn[RG_NJOINTS] = {"m1a", "m1b", "u", "v", "m2a", "m2b"};
 
 /* Every control step of a move, a homing or an exposure: the interlock (level and
- * edges) and the limit switches; with emitting, the key switch too. */
+ * edges) and the limit switches; emitting 1 (the laser on): the key switch too;
+ * 2: just before an exposure; 0: motion or rest. */
 int rg_guard(rg_machine *m, int emitting, char *err, size_t cap)
 {
     unsigned lv, ed;
@@ -131,12 +132,13 @@ int rg_guard(rg_machine *m, int emitting, char *err, size_t cap)
     if (bad || !(lv & RG_IN_INTERLOCK) || (ed & RG_IN_INTERLOCK))
         return rg_latch(m, RG_F_INTERLOCK, RG_EINTERLOCK, err, cap, bad ?
                         "the inputs cannot be read (the interlock counts as open)" :
-                        emitting ? "the interlock opened during the exposure" :
+                        emitting == 1 ? "the interlock opened during the exposure" :
+                        emitting == 2 ? "the interlock is open: the laser stays off" :
                         "the interlock opened during motion");
     if ((j = first_limit(lv | ed)) >= 0)
         return rg_latch(m, RG_F_LIMIT, RG_EFAULT, err, cap, "axis %s: its limit switch "
                         "(line %d) tripped", jn[j], m->rig.axis[j].limit.offset);
-    if (emitting && m->rig.key_switch.offset >= 0 &&
+    if (emitting == 1 && m->rig.key_switch.offset >= 0 &&
         (!(lv & RG_IN_KEY) || (ed & RG_IN_KEY)))
         return rg_latch(m, RG_F_KEY, RG_EINTERLOCK, err, cap,
                         "the key switch turned off during the exposure");
@@ -184,7 +186,7 @@ static int hold(rg_machine *m, int64_t end, int emitting, unsigned *heart, int64
             return rg_latch(m, RG_F_HEARTBEAT, RG_EFAULT, err, cap, "the exposure loop ran "
                             "%.3f ms late: the heartbeat pump (hold %g ms) has cut the beam",
                             (now - *last_beat) / 1e6, m->rig.heartbeat_timeout_ms);
-        if ((rc = rg_guard(m, emitting, err, cap))) return rc;
+        if ((rc = rg_guard(m, emitting ? 1 : 2, err, cap))) return rc;
         if (stop && stop(ctx)) {
             rg_laser_off(m);
             snprintf(err, cap, "the exposure was stopped: laser off");
@@ -226,7 +228,7 @@ int rg_expose(rg_machine *m, double ms, rg_stop_fn stop, void *ctx, char *err, s
         return RG_EINVAL;
     }
     if ((rc = rg_dose_plan(m, ms + 2 * rig->shutter_ms, 1, &d, err, cap))) return rc;
-    if ((rc = rg_guard(m, 0, err, cap))) return rc;
+    if ((rc = rg_guard(m, 2, err, cap))) return rc;
     if (read_inputs(m, &lv, &ed), rig->key_switch.offset >= 0 && !(lv & RG_IN_KEY)) {
         snprintf(err, cap, "the key switch is off: the laser stays off");
         return RG_EINTERLOCK;
