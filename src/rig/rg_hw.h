@@ -66,7 +66,7 @@ struct rg_machine {
     int fault;                  /* RG_F_*; 0: none */
     char fault_why[RG_ERRMAX];
     int drivers_on;             /* ENABLE lines active (set by homing) */
-    int64_t last_rise;          /* last STEP rising edge (chip clock), for min spacing */
+    int64_t last_rise;          /* last STEP falling edge (chip clock): the low time */
     /* the session's dose (rg_dose.c) */
     long dose_n;
     double dose_t;              /* summed on-time, s */

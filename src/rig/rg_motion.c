@@ -12,7 +12,8 @@
  * STEP edge measures its own lateness and one later than max_late_us stops the
  * motion (a latched deadline fault) instead of sending a burst the motor cannot
  * follow; a pulse stays high at least step_pulse_us after its rising edge really
- * happened, however late the fall's deadline is; a chip that knows the motors
+ * happened, however late the fall's deadline is, and low as long before the next
+ * rise (catch-up pulses after a preemption are spaced, never back to back); a chip that knows the motors
  * (the simulator) is compared with the commanded steps after every move (a lost step
  * latches).  Homing is GRBL's cycle: fast seek, pull-off, slow locate, debounce,
  * pull-off again, then settle_ms. */
@@ -124,6 +125,10 @@ static int pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick, char *e
         return rg_latch(m, RG_F_DEADLINE, RG_EFAULT, err, cap, "a STEP edge came %.3f ms late "
                         "(max_late_us %g): the motion was stopped rather than send steps "
                         "the motor may not follow", late / 1e6, m->rig.max_late_us);
+    /* the drivers' minimum low time too: after a late pulse, catch-up pulses are
+     * spaced, never back to back */
+    if (o->now(m->chip) < m->last_rise + (int64_t)llround(m->rig.step_pulse_us * 1e3))
+        rg_wait(m, m->last_rise + (int64_t)llround(m->rig.step_pulse_us * 1e3));
     o->set(m->chip, RG_G_STEP, mask, mask);
     rise = o->now(m->chip);
     edge_done(m, at);
@@ -132,6 +137,7 @@ static int pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick, char *e
         fall = rise + (int64_t)llround(m->rig.step_pulse_us * 1e3);
     rg_wait(m, fall);
     o->set(m->chip, RG_G_STEP, mask, 0);
+    m->last_rise = o->now(m->chip);      /* (the fall: the low time starts here) */
     edge_done(m, at + tick / 2);
     return 0;
 }

@@ -49,6 +49,7 @@ typedef struct sim {
     int64_t il_opened_at;       /* when the interlock last opened; -1: closed */
     int64_t limit_at[RG_NJOINTS]; /* when each limit switch tripped; -1 */
     int64_t rise_at[RG_NJOINTS];  /* STEP rising edge, for the pulse width */
+    int64_t fall_at[RG_NJOINTS];  /* STEP falling edge, for the low time */
     int rise_dir[RG_NJOINTS];     /* the step that rise made (undone if it was too short) */
     int64_t last_step_edge;     /* any STEP edge; -1 none */
     int64_t indicator_on_at;    /* -1: off */
@@ -265,9 +266,22 @@ static int sim_set(rg_chip *c, int g, unsigned mask, unsigned val)
                     s->sh->steps[j] -= s->rise_dir[j];
                 }
                 s->rise_at[j] = -1;
+                s->fall_at[j] = t;
             }
             if (!(rise >> j & 1)) continue;
             en = s->rig->axis[j].enable.offset < 0 || (s->val[RG_G_ENABLE] >> j & 1);
+            if (en && !s->realclock && s->fall_at[j] >= 0 &&
+                t - s->fall_at[j] < (int64_t)llround(s->rig->step_pulse_us * 1e3)) {
+                lbuf l;
+                s->violations++;
+                start(s, &l); put_s(&l, "VIOLATION a STEP low time of axis ");
+                put_s(&l, jname[j]); put_s(&l, " of "); put_i(&l, t - s->fall_at[j]);
+                put_s(&l, " ns, shorter than the driver's minimum (step missed)");
+                emit(s, &l);
+                s->rise_at[j] = -1;
+                s->rise_dir[j] = 0;
+                continue;
+            }
             s->rise_at[j] = en ? t : -1;
             s->rise_dir[j] = 0;
             if (!en) continue;
@@ -555,7 +569,7 @@ static int sim_make(const rg_rig *rig, const rg_open_opts *o, int realclock, rg_
     s->il_opened_at = -1;
     s->last_step_edge = -1;
     s->indicator_on_at = -1;
-    for (int j = 0; j < RG_NJOINTS; j++) s->limit_at[j] = s->rise_at[j] = -1;
+    for (int j = 0; j < RG_NJOINTS; j++) s->limit_at[j] = s->rise_at[j] = s->fall_at[j] = -1;
     if (o && o->sim_state) rc = open_shared(s, o->sim_state, rig, err, cap);
     else if (!(s->sh = calloc(1, sizeof *s->sh))) { snprintf(err, cap, "out of memory"); rc = RG_ENOMEM; }
     if (rc) { free(s); return rc; }
