@@ -39,6 +39,8 @@ typedef struct gchip {
     ggroup out[RG_NGROUPS];
     ggroup in;                  /* home switches (bit = axis), interlock, limits, key
                                    (the RG_IN_* bits) */
+    unsigned levels;            /* their last levels read */
+    int have_levels;
 } gchip;
 
 static void add(ggroup *g, const rg_line *l, int bit, const char *fmt, const char *a)
@@ -140,9 +142,14 @@ static int g_inputs(rg_chip *cc, unsigned *level, unsigned *edges)
         }
         if (!more) break;
     }
+    /* the levels change only with an event: read them again only then (one poll a
+     * control step instead of a poll and an ioctl) */
+    if (c->have_levels && !*edges) { *level = c->levels; return 0; }
     if (gpiod_line_get_value_bulk(&g->bulk, v)) return RG_EIO;
     for (int i = 0; i < g->n; i++)
         if (v[i] ^ g->lines[i].l->active_low) *level |= 1u << g->lines[i].bit;
+    c->levels = *level;
+    c->have_levels = 1;
     return 0;
 }
 
