@@ -14,7 +14,9 @@
  * 1 - exp(-2 (7/d)^2) of its power through it.  Repeated exposures (a scan): each
  * one against the MPE of its duration, and their sum against the MPE of their summed
  * on-time taken as one exposure (the standard's pulse-train rule with the train's
- * duration shortened to its on-time: never less strict, as the MPE grows with time). */
+ * duration shortened to its on-time: never less strict, as the MPE grows with time).
+ * An exposure of ms with a shutter lasts ms + 2 shutter_ms for the dose (the light
+ * passes, partly, while it opens and closes). */
 #define _DEFAULT_SOURCE
 #include <math.h>
 #include <stdio.h>
@@ -56,7 +58,7 @@ static int dose(const rg_rig *rig, long n0, double t0, double ms, long n, rg_dos
                 char *err, size_t cap)
 {
     double P = rig->laser_power_mw * 1e-3, dm = rig->beam_diameter_mm * 1e-3;
-    double w = dm / 2, eta, t = ms * 1e-3;
+    double w = dm / 2, eta, t = (ms + 2 * rig->shutter_ms) * 1e-3;   /* shutter travel counts */
     const char *lim1 = NULL, *limt = NULL;
     *d = (rg_dose){0};
     if (!(rig->laser_power_mw > 0) || !(rig->wavelength_nm > 0) || !(rig->beam_diameter_mm > 0)) {

@@ -199,7 +199,7 @@ static int global_key(reader *r, int k, char **w, int nw)
     case G_EDELAY: return ranged(r, w[0], a, 0, 60000, &g->emission_delay_ms);
     case G_SHUTMS: return ranged(r, w[0], a, 0, 10000, &g->shutter_ms);
     case G_PULSE: return ranged(r, w[0], a, 0.1, 50000, &g->step_pulse_us);
-    case G_LATE: return ranged(r, w[0], a, 1, 1e6, &g->max_late_us);
+    case G_LATE: return ranged(r, w[0], a, 1, 1e9, &g->max_late_us);
     case G_DEBOUNCE: return ranged(r, w[0], a, 0, 10000, &g->home_debounce_ms);
     case G_SIMILC: return ranged(r, w[0], a, 0, 1e12, &g->sim_interlock_close_ms);
     case G_SIMKEY: return ranged(r, w[0], a, 0, 1e12, &g->sim_key_off_ms);

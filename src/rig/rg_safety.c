@@ -227,7 +227,7 @@ int rg_expose(rg_machine *m, double ms, rg_stop_fn stop, void *ctx, char *err, s
                  "on, say 'eye_safe_without_heartbeat yes')");
         return RG_EINVAL;
     }
-    if ((rc = rg_dose_plan(m, ms + 2 * rig->shutter_ms, 1, &d, err, cap))) return rc;
+    if ((rc = rg_dose_plan(m, ms, 1, &d, err, cap))) return rc;
     if ((rc = rg_guard(m, 2, err, cap))) return rc;
     if (read_inputs(m, &lv, &ed), rig->key_switch.offset >= 0 && !(lv & RG_IN_KEY)) {
         snprintf(err, cap, "the key switch is off: the laser stays off");

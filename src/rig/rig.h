@@ -10,7 +10,8 @@
  * the dialogue say degrees.
  *
  * Two parts, each with its own section: geometry (rg_geom*.c, rg_quant*.c) and the
- * machine (rg_file.c, rg_gpiod.c, rg_sim.c, rg_motion.c, rg_safety.c). */
+ * machine (rg_file.c, rg_gpiod.c, rg_sim.c, rg_motion.c, rg_safety.c, rg_dose.c; the
+ * safety functions: doc/rig-safety.md). */
 #ifndef RIG_H
 #define RIG_H
 #include <stddef.h>
