@@ -123,4 +123,4 @@ safe_vm() {   # safe_vm MIN FILES PROGRAM ARGS...
         fail "gpio-vm $1: only $p checks ran"; tail -20 "$WORK/vms.out"
     fi
 }
-safe_vm 19 tests/rig/vm.rig build/obj/rig_vm/vm_safety vm.rig
+safe_vm 23 tests/rig/vm.rig build/obj/rig_vm/vm_safety vm.rig

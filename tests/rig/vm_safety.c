@@ -61,9 +61,13 @@ typedef struct obs {
     int64_t rise[32], fall[32]; /* first rise / first fall of each line, ms from start */
 } obs;
 
+/* With stop_ms set, the observer also stops the controller (SIGSTOP) at stop_at_ms
+ * for stop_ms: a preemption, as a loaded machine does it. */
+static int stop_at_ms = -1, stop_ms;
+
 static pid_t observe(int line, int up, int at_ms, int ms, int fd[2])
 {
-    pid_t pid;
+    pid_t pid, parent = getpid();
     if (pipe(fd)) return -1;
     pid = fork();
     if (pid == 0) {
@@ -78,6 +82,24 @@ static pid_t observe(int line, int up, int at_ms, int ms, int fd[2])
         close(fd[0]);
         while ((t = now_ms() - t0) < ms) {
             if (!done && t >= at_ms) { pull(line, up); done = 1; }
+            if (stop_at_ms >= 0 && t >= stop_at_ms) {
+                kill(parent, SIGSTOP);
+                usleep(2000);                           /* stopped now */
+                last[26] = sysval(26);
+                stop_at_ms = -1;
+                while (now_ms() - t0 < t + stop_ms) {   /* keep watching meanwhile */
+                    for (int i = 0; i < 32; i++) {
+                        int v;
+                        if (i != 0 && i != 26) continue;
+                        v = sysval(i);
+                        if (v == 1 && last[i] == 0 && i == 0) o.before++;
+                        if (v >= 0 && v != last[i] && i == 26) o.fall[26] = now_ms() - t0;
+                        if (v >= 0) last[i] = v;
+                    }
+                    usleep(500);
+                }
+                kill(parent, SIGCONT);
+            }
             for (int i = 0; i < 32; i++) {
                 int v;
                 if (i != 0 && i != 24 && i != 29 && i != 30) continue;
@@ -178,6 +200,50 @@ static void test_move_faults(const rg_rig *rig)
     rg->close(m);
 }
 
+/* A preempted controller (SIGSTOP 300 ms): mid-move, with a 50 ms lateness bound, the
+ * move stops with a deadline fault and every pulse sent was a pulse seen (no pulse
+ * too short to count); mid-exposure, the loop finds itself later than the pump's
+ * hold and latches a heartbeat fault (the pump had cut the beam meanwhile: the
+ * heartbeat line did not toggle during the stop). */
+static void test_preempted(const rg_rig *rig0)
+{
+    rg_rig rig = *rig0;
+    char err[RG_ERRMAX] = "", why[RG_ERRMAX] = "";
+    long t[RG_NJOINTS], now[RG_NJOINTS];
+    int fd[2], rc;
+    rg_machine *m;
+    pid_t pid;
+    obs o;
+    rig.max_late_us = 50000;
+    if (!(m = open_m(&rig))) return;
+    rg->home(m, NULL, NULL, err, sizeof err);
+    rg->position(m, t, NULL);
+    t[0] += 200;
+    stop_at_ms = 1000; stop_ms = 300;
+    pid = observe(-1, 0, 0, 2500, fd);
+    stop_at_ms = -1;
+    rc = rg->move_steps(m, t, NULL, NULL, err, sizeof err);
+    o = result(pid, fd);
+    rg->position(m, now, NULL);
+    CHECK(rc == RG_EFAULT && rg->fault(m, why, sizeof why) == RG_F_DEADLINE,
+          "preempted 300 ms mid-move: stopped, deadline fault latched (%s)", why);
+    CHECK(o.before == now[0] - (t[0] - 200) && o.before > 5,
+          "... every pulse sent was seen: %d seen, %ld sent", o.before, now[0] - (t[0] - 200));
+    rg->close(m);
+    if (!(m = open_m(&rig))) return;
+    rg->home(m, NULL, NULL, err, sizeof err);
+    stop_at_ms = 400; stop_ms = 300;
+    pid = observe(-1, 0, 0, 1500, fd);
+    stop_at_ms = -1;
+    rc = rg->expose(m, 1000, NULL, NULL, err, sizeof err);
+    o = result(pid, fd);
+    CHECK(rc == RG_EFAULT && rg->fault(m, why, sizeof why) == RG_F_HEARTBEAT && sysval(24) == 0,
+          "preempted 300 ms mid-exposure: heartbeat fault latched, laser low (%s)", why);
+    CHECK(o.fall[26] < 0, "... the heartbeat line did not toggle while it was stopped "
+          "(a pump with a %g ms hold cut the beam)", rig.heartbeat_timeout_ms);
+    rg->close(m);
+}
+
 static void test_homing_fault(const rg_rig *rig0)
 {
     rg_rig rig = *rig0;
@@ -273,6 +339,7 @@ int main(int argc, char **argv)
     pull(28, 1);                        /* key on for the motion tests */
     test_move_faults(&rig);
     test_homing_fault(&rig);
+    test_preempted(&rig);
     test_emission(&rig);
     return unit_failed();
 }
