@@ -2,7 +2,8 @@
  * kernel's gpio-sim chip, inside the gpio-vm guest (tests/t_88_rig_safety.sh): a fault
  * injected through sysfs at each stage -- the interlock opening during a move (STEP
  * pulses stop, latched, reset refused while open, accepted once closed, homing
- * required), during homing, before emission; a limit switch during a move; the key
+ * required), during homing, before emission; a limit switch during a move; the
+ * controller preempted (SIGSTOP) mid-move and mid-exposure; the key
  * switch, emission indicator, emission delay and shutter in their order in time; a
  * rig without a heartbeat line refused for emission.  Lines: vm.rig's (STEP 0-5, DIR
  * 6-11, ENABLE 12-17 active-low, home 18-23, laser 24, interlock 25 active-low,
