@@ -6,4 +6,9 @@
 B=build/obj/rig_tests/bench_geom
 [ -x "$B" ] || { echo "bench_rig: $B not built (make bench builds it)" >&2; exit 1; }
 echo "# bench_rig on: $(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //'), $(nproc) cores"
+# the safety figures (tests/rig/bench_safety.c, doc/rig-safety.md): simulated time, so
+# the same on any machine; BENCH rig_interlock_motion_stop_ms, rig_dose_mpe_fraction
+S=build/obj/rig_tests/bench_safety
+[ -x "$S" ] || { echo "bench_rig: $S not built (make bench builds it)" >&2; exit 1; }
+"$S" golden/rig/example.rig || exit 1
 if [ -n "$BENCH_QUICK" ]; then exec "$B" quick; else exec "$B"; fi

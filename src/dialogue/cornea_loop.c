@@ -512,8 +512,19 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     }
 #define CAMERA_DONE() do { if (src) { r->im->frame->source_close(src); \
         r->im->frame->centroider_free(ccz); src = NULL; } } while (0)
-    /* run: move to each planned point and expose it on the machine */
+    /* run: move to each planned point and expose it on the machine; the scan's whole
+     * dose is checked against the MPE before the first pulse (doc/rig-safety.md) */
     r->nexposed = 0;
+    if (r->m && rg->dose_plan) {
+        rg_dose dz;
+        long np = 0;
+        for (int k = 0; k < n; k++) np += r->pt[k].planned != 0;
+        if (rg->dose_plan(r->m, r->expose_ms, np, &dz, e, sizeof e)) {
+            CAMERA_DONE();
+            snprintf(err, cap, "the scan is refused before its first pulse: %.400s", e);
+            return CN_EINVAL;
+        }
+    }
     if (r->m) {
         for (int k = 0; k < n; k++) {
             cl_point *q = &r->pt[k];

@@ -40,6 +40,8 @@ typedef struct rdlg {
     int cam_off;                /* frames wanted but the imaging engine is missing */
     int nframes;
     double fworst_um, fworst_lim_um, fsigma_um, foff_um;
+    char *dose_log;             /* the session's dose log (written at the end) */
+    size_t dose_len, dose_cap;
 } rdlg;
 
 static const rig_api *volatile hook_api;
@@ -110,10 +112,17 @@ static int ask_num(rdlg *d, const char *q, const char *what, unsigned flags, dou
     return lm_ask_number(d->io, q, q, &spec, v);
 }
 
-/* An engine refusal: said (and recorded); in a replay it ends the session. */
+/* An engine refusal: said (and recorded); in a replay it ends the session.  A latched
+ * fault ends it everywhere (non-zero exit): the machine is stopped until reset. */
 static int refused(rdlg *d, int rc, const char *err)
 {
+    char why[RG_ERRMAX];
     lm_say(d->io, LM_BOTH, P(FAILED), err);
+    if (d->m && d->api->fault && d->api->fault(d->m, why, sizeof why)) {
+        lm_say(d->io, LM_BOTH, P(FAULT), why);
+        fprintf(stderr, "lensmat: %s:%ld: fault latched: %s\n", d->io->src, d->io->line, why);
+        return LM_FAIL;
+    }
     if (rc == RG_ESTOP || lm_stop_requested()) return LM_FAIL;
     if (!d->io->interactive) {
         fprintf(stderr, "lensmat: %s:%ld: %s\n", d->io->src, d->io->line, err);
@@ -152,13 +161,58 @@ static int do_joints(rdlg *d)
     return LM_GO;
 }
 
+/* One line of the session's dose log. */
+static void dose_note(rdlg *d, const char *fmt, double a, double b, double c, double e,
+                      double f)
+{
+    char line[256];
+    int n = snprintf(line, sizeof line, fmt, a, b, c, e, f);
+    if (n <= 0) return;
+    if (d->dose_len + (size_t)n + 1 > d->dose_cap) {
+        size_t cap = d->dose_cap ? d->dose_cap * 2 : 4096;
+        char *p;
+        while (cap < d->dose_len + (size_t)n + 1) cap *= 2;
+        if (!(p = realloc(d->dose_log, cap))) return;
+        d->dose_log = p;
+        d->dose_cap = cap;
+    }
+    memcpy(d->dose_log + d->dose_len, line, (size_t)n + 1);
+    d->dose_len += (size_t)n;
+}
+
 static int do_expose_ms(rdlg *d, double ms)
 {
     char err[RG_ERRMAX];
+    rg_dose z;
     int rc = d->api->expose(d->m, ms, stop_cb, NULL, err, sizeof err);
     if (rc) return refused(d, rc, err);
     lm_say(d->io, LM_BOTH, P(EXPOSED), ms);
+    if (d->api->dose_plan && d->api->dose_plan(d->m, ms, 0, &z, err, sizeof err) != RG_EINVAL)
+        dose_note(d, "exposure %.0f: %g ms, %.6g J/m^2; session %.6g J/m^2 in %.6g s\n",
+                  (double)z.n, ms, z.H_one, z.H_total, z.t_total);
     return LM_GO;
+}
+
+/* The dose log beside the record (RECORD.dose), written like the simulator's log: a
+ * temporary name, renamed when complete; never over an input. */
+static void write_dose_log(rdlg *d)
+{
+    char name[WORD + 16], part[WORD + 48], msg[512];
+    FILE *f;
+    if (!d->dose_log || !d->io->rec_name || !strcmp(d->io->rec_name, "-")) return;
+    snprintf(name, sizeof name, "%s.dose", d->io->rec_name);
+    if (lm_check_output(d->io, name, msg, sizeof msg)) {
+        fprintf(stderr, "lensmat: %s\n", msg);
+        return;
+    }
+    snprintf(part, sizeof part, "%s.part.%ld", name, (long)getpid());
+    if (!(f = fopen(part, "w"))) return;
+    fprintf(f, "# lensmat --rig dose log: rig %s, %g mW, %g nm, %g mm beam at the cornea; "
+            "radiant exposure averaged over the 7 mm aperture (doc/rig-safety.md)\n",
+            d->rig.path, d->rig.laser_power_mw, d->rig.wavelength_nm, d->rig.beam_diameter_mm);
+    fputs(d->dose_log, f);
+    if (fclose(f) || rename(part, name)) { unlink(part); return; }
+    lm_say(d->io, LM_OUT, P(DOSE_LOG_OUT), name);
 }
 
 static int ask_ms(rdlg *d, double *ms)
@@ -341,6 +395,19 @@ static int do_scan(rdlg *d)
     if ((rc = ask_num(d, P(SCAN_H), P(SCAN_H_WHAT), LM_NONNEG, 0, &hmax)) ||
         (rc = ask_ms(d, &ms)))
         return rc;
+    /* the whole scan's dose before its first pulse */
+    if (ms > 0 && d->api->dose_plan) {
+        rg_dose z;
+        char err[RG_ERRMAX];
+        rc = d->api->dose_plan(d->m, ms, (long)n, &z, err, sizeof err);
+        if (rc && rc != RG_EDOSE) return refused(d, rc, err);
+        lm_say(d->io, LM_BOTH, P(DOSE), (int)z.n, ms, d->rig.laser_power_mw,
+               d->rig.wavelength_nm, d->rig.beam_diameter_mm, z.H_one, z.H_total, z.mpe_total,
+               z.limit, z.fraction, 1 / z.fraction);
+        dose_note(d, "scan planned: %.0f exposures of %g ms, %.6g J/m^2 in all, %.4g of the "
+                  "MPE %.6g J/m^2\n", (double)z.n, ms, z.H_total, z.fraction, z.mpe_total);
+        if (rc) return refused(d, rc, err);
+    }
     d->worst_um = d->worst_bound_um = 0;
     d->outside = 0;
     d->nframes = 0;
@@ -426,6 +493,8 @@ int lm_rig(lm_io *io)
         const rg_rig *r = &d->rig;
         lm_say(io, LM_BOTH, P(RIG_LOADED), r->path, r->chip, r->laser.offset,
                r->interlock.offset, r->max_on_ms, r->tick_us);
+        if (r->heartbeat.offset < 0)
+            lm_say(io, LM_BOTH, "%s", r->eye_safe_without_heartbeat ? P(EYE_SAFE) : P(NO_HEARTBEAT));
         rc = open_machine(d);
     }
     while (!rc) {
@@ -445,6 +514,8 @@ int lm_rig(lm_io *io)
     }
     lm_on_stop_remove(laser_off_hook, NULL);
     lm_rigcam_free(&d->cam);
+    if (rc != LM_QUIT) write_dose_log(d);
+    free(d->dose_log);
     free(d);
     if (rc == LM_FAIL || rc == LM_QUIT) return rc;
     lm_check_leftover(io);

@@ -21,6 +21,7 @@ fuzz-rig: build/fuzz_rig_file
 	build/fuzz_rig_file -max_total_time=$${FUZZ_SECONDS:-600} -timeout=5 \
 	    build/fuzz-rig-corpus tests/fuzz-rig
 
-MODULE_TEST_BINS += build/fuzz_rig_file build/obj/rig_vm/vm_rig build/obj/rig_vm/rig_watchdog
+MODULE_TEST_BINS += build/fuzz_rig_file build/obj/rig_vm/vm_rig build/obj/rig_vm/rig_watchdog \
+                    build/obj/rig_vm/vm_safety
 fuzz: fuzz-rig
 .PHONY: fuzz-rig

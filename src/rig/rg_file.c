@@ -26,8 +26,8 @@ typedef struct reader {
     char *err;
     size_t cap;
     /* where each key was given (duplicates): globals, then per axis */
-    long gseen[32];
-    long aseen[RG_NJOINTS][16];
+    long gseen[64];
+    long aseen[RG_NJOINTS][32];
     const rig_api *geo;         /* the geometry half (its keys), or NULL */
 } reader;
 
@@ -90,15 +90,22 @@ static int line_spec(reader *r, const char *key, char **w, int nw, rg_line *l)
 
 enum { G_CHIP, G_LASER, G_INTERLOCK, G_HEART, G_MAXON, G_TICK, G_HTIMEOUT, G_HOMETO,
        G_SETTLE, G_SIMRT, G_SIMIL, G_SIMILMS, G_CAM, G_CPITCH, G_CPIX, G_CNOISE, G_CSEED,
-       G_WAIST, NG };
+       G_WAIST, G_EYESAFE, G_POWER, G_WAVE, G_BEAMD, G_KEY, G_INDIC, G_SHUT, G_EDELAY,
+       G_SHUTMS, G_PULSE, G_LATE, G_DEBOUNCE, G_SIMILC, G_SIMKEY, G_STALLAT, G_STALL, NG };
 static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "max_on_ms", "tick_us", "heartbeat_timeout_ms", "home_timeout_s", "settle_ms",
     "sim_realtime", "sim_interlock", "sim_interlock_open_ms", "camera", "camera_pitch",
-    "camera_pixels", "camera_read_noise", "camera_seed", "beam_waist"};
+    "camera_pixels", "camera_read_noise", "camera_seed", "beam_waist",
+    "eye_safe_without_heartbeat", "laser_power_mw", "wavelength_nm", "beam_diameter_mm",
+    "key_switch", "emission_indicator", "shutter", "emission_delay_ms", "shutter_ms",
+    "step_pulse_us", "max_late_us", "home_debounce_ms", "sim_interlock_close_ms",
+    "sim_key_off_ms", "sim_stall_at_ms", "sim_stall_ms"};
 enum { A_STEP, A_DIR, A_ENABLE, A_HOME, A_STEPS, A_MIN, A_MAX, A_SPEED, A_ACCEL,
-       A_HOMEAT, A_HOMEDIR, A_HOMESPEED, A_DIRINV, A_SIMHOME, NA };
+       A_HOMEAT, A_HOMEDIR, A_HOMESPEED, A_DIRINV, A_SIMHOME, A_LIMIT, A_PULLOFF,
+       A_LOCATE, A_SIMLIMIT, A_SIMLOSE, NA };
 static const char *const akeys[NA] = {"step", "dir", "enable", "home", "steps_per", "min",
-    "max", "speed", "accel", "home_at", "home_dir", "home_speed", "dir_invert", "sim_home"};
+    "max", "speed", "accel", "home_at", "home_dir", "home_speed", "dir_invert", "sim_home",
+    "limit", "home_pulloff", "home_locate_speed", "sim_limit_ms", "sim_lose_step_ms"};
 
 static int find(const char *const *keys, int n, const char *k)
 {
@@ -106,11 +113,20 @@ static int find(const char *const *keys, int n, const char *k)
     return -1;
 }
 
+/* A number from lo to hi (a time, a count). */
+static int ranged(reader *r, const char *key, const char *w, double lo, double hi, double *v)
+{
+    int rc = number(r, key, w, v);
+    if (!rc && !(*v >= lo && *v <= hi)) return fail(r, "'%s' must be from %g to %g", key, lo, hi);
+    return rc;
+}
+
 static int global_key(reader *r, int k, char **w, int nw)
 {
     rg_rig *g = r->rig;
     const char *a = nw > 1 ? w[1] : NULL;
-    if (nw > (k == G_LASER || k == G_INTERLOCK || k == G_HEART ? 3 : 2))
+    if (nw > (k == G_LASER || k == G_INTERLOCK || k == G_HEART || k == G_KEY ||
+              k == G_INDIC || k == G_SHUT ? 3 : 2))
         return fail(r, "'%s' takes one value", w[0]);
     switch (k) {
     case G_CHIP:
@@ -167,6 +183,28 @@ static int global_key(reader *r, int k, char **w, int nw)
         return rc;
     }
     case G_WAIST: return positive(r, w[0], a, 10, &g->beam_waist);
+    case G_EYESAFE: return yesno(r, w[0], a, "yes", "no", &g->eye_safe_without_heartbeat);
+    case G_POWER: return positive(r, w[0], a, 1e4, &g->laser_power_mw);
+    case G_WAVE: {
+        int rc = number(r, w[0], a, &g->wavelength_nm);
+        if (!rc && !(g->wavelength_nm >= 400 && g->wavelength_nm <= 700))
+            return fail(r, "'wavelength_nm' %g: the dose check covers visible light, 400 to "
+                        "700 nm, only", g->wavelength_nm);
+        return rc;
+    }
+    case G_BEAMD: return positive(r, w[0], a, 100, &g->beam_diameter_mm);
+    case G_KEY: return line_spec(r, w[0], w, nw, &g->key_switch);
+    case G_INDIC: return line_spec(r, w[0], w, nw, &g->indicator);
+    case G_SHUT: return line_spec(r, w[0], w, nw, &g->shutter);
+    case G_EDELAY: return ranged(r, w[0], a, 0, 60000, &g->emission_delay_ms);
+    case G_SHUTMS: return ranged(r, w[0], a, 0, 10000, &g->shutter_ms);
+    case G_PULSE: return ranged(r, w[0], a, 0.1, 50000, &g->step_pulse_us);
+    case G_LATE: return ranged(r, w[0], a, 1, 1e9, &g->max_late_us);
+    case G_DEBOUNCE: return ranged(r, w[0], a, 0, 10000, &g->home_debounce_ms);
+    case G_SIMILC: return ranged(r, w[0], a, 0, 1e12, &g->sim_interlock_close_ms);
+    case G_SIMKEY: return ranged(r, w[0], a, 0, 1e12, &g->sim_key_off_ms);
+    case G_STALLAT: return ranged(r, w[0], a, 0, 1e12, &g->sim_stall_at_ms);
+    case G_STALL: return ranged(r, w[0], a, 0, 1e9, &g->sim_stall_ms);
     }
     return 0;
 }
@@ -175,7 +213,7 @@ static int axis_key(reader *r, int k, char **w, int nw)
 {
     rg_axis *x = &r->rig->axis[r->cur];
     const char *a = nw > 1 ? w[1] : NULL;
-    if (nw > (k <= A_HOME ? 3 : 2)) return fail(r, "'%s' takes one value", w[0]);
+    if (nw > (k <= A_HOME || k == A_LIMIT ? 3 : 2)) return fail(r, "'%s' takes one value", w[0]);
     switch (k) {
     case A_STEP: return line_spec(r, w[0], w, nw, &x->step);
     case A_DIR: return line_spec(r, w[0], w, nw, &x->dir);
@@ -198,6 +236,11 @@ static int axis_key(reader *r, int k, char **w, int nw)
         x->sim_home_broken = !ok;
         return rc;
     }
+    case A_LIMIT: return line_spec(r, w[0], w, nw, &x->limit);
+    case A_PULLOFF: return positive(r, w[0], a, 1e6, &x->home_pulloff);
+    case A_LOCATE: return positive(r, w[0], a, 1e6, &x->home_locate_speed);
+    case A_SIMLIMIT: return ranged(r, w[0], a, 0, 1e12, &x->sim_limit_ms);
+    case A_SIMLOSE: return ranged(r, w[0], a, 0, 1e12, &x->sim_lose_step_ms);
     }
     return 0;
 }
@@ -259,12 +302,14 @@ static int one_line(reader *r, char *s)
 typedef struct named_line { const rg_line *l; char what[32]; } named_line;
 
 /* Whole-file checks: required keys, ranges, every GPIO line used once. */
+static int dose_bounds(reader *r);
 static int finish(reader *r)
 {
     rg_rig *g = r->rig;
-    named_line all[RG_NJOINTS * 4 + 3];
+    int rc;
+    named_line all[RG_NJOINTS * 5 + 6];
     int n = 0;
-    static const char *const lname[4] = {"STEP", "DIR", "ENABLE", "home"};
+    static const char *const lname[5] = {"STEP", "DIR", "ENABLE", "home", "limit"};
     r->line = 0;
 #define WHOLE(...) (snprintf(r->err, r->cap, __VA_ARGS__), RG_EINVAL)
     if (!g->chip[0]) return WHOLE("%s: no 'chip' line", r->name);
@@ -302,13 +347,24 @@ static int finish(reader *r)
             if (!(x->home_speed > 0)) x->home_speed = x->speed / 4;
             if (x->home_speed > x->speed)
                 return fail(r, "axis %s: 'home_speed' is more than 'speed'", an);
+            if (!(x->home_pulloff > 0)) x->home_pulloff = 0.5;
+            if (!(x->home_locate_speed > 0)) x->home_locate_speed = x->home_speed / 10;
+            if (x->home_locate_speed > x->home_speed)
+                return fail(r, "axis %s: 'home_locate_speed' is more than 'home_speed'", an);
+            {
+                double off = x->home_at - x->home_dir * x->home_pulloff;
+                if (!(off >= x->min && off <= x->max))
+                    return fail(r, "axis %s: the pull-off from home_at %g by %g leaves its "
+                                "travel [%g, %g]", an, x->home_at, x->home_pulloff, x->min,
+                                x->max);
+            }
         } else if (!r->aseen[j][A_HOMEAT]) {
             return fail(r, "axis %s has neither a 'home' switch nor 'home_at' (where it "
                         "stands at power-on)", an);
         }
-        for (int k = 0; k < 4; k++) {
+        for (int k = 0; k < 5; k++) {
             const rg_line *l = k == 0 ? &x->step : k == 1 ? &x->dir : k == 2 ? &x->enable
-                             : &x->home;
+                             : k == 3 ? &x->home : &x->limit;
             if (l->offset < 0) continue;
             all[n].l = l;
             snprintf(all[n].what, sizeof all[n].what, "the %s line of axis %s", lname[k], an);
@@ -318,6 +374,9 @@ static int finish(reader *r)
     all[n].l = &g->laser; strcpy(all[n++].what, "the laser line");
     all[n].l = &g->interlock; strcpy(all[n++].what, "the interlock line");
     if (g->heartbeat.offset >= 0) { all[n].l = &g->heartbeat; strcpy(all[n++].what, "the heartbeat line"); }
+    if (g->key_switch.offset >= 0) { all[n].l = &g->key_switch; strcpy(all[n++].what, "the key switch line"); }
+    if (g->indicator.offset >= 0) { all[n].l = &g->indicator; strcpy(all[n++].what, "the emission indicator line"); }
+    if (g->shutter.offset >= 0) { all[n].l = &g->shutter; strcpy(all[n++].what, "the shutter line"); }
     for (int a = 0; a < n; a++)
         for (int b = 0; b < n; b++)
             if (a != b && all[a].l->offset == all[b].l->offset &&
@@ -328,6 +387,21 @@ static int finish(reader *r)
             }
     if (g->heartbeat.offset >= 0 && !(g->heartbeat_timeout_ms > 0))
         g->heartbeat_timeout_ms = 5;
+    if (!r->gseen[G_PULSE]) g->step_pulse_us = 5;
+    if (g->step_pulse_us > g->tick_us / 2) {
+        r->line = r->gseen[G_PULSE];
+        return fail(r, "'step_pulse_us' %g does not fit in half a control step (tick_us %g)",
+                    g->step_pulse_us, g->tick_us);
+    }
+    if (!r->gseen[G_LATE]) g->max_late_us = g->tick_us / 2;
+    if (!r->gseen[G_DEBOUNCE]) g->home_debounce_ms = 10;
+    {
+        int nd = !!r->gseen[G_POWER] + !!r->gseen[G_WAVE] + !!r->gseen[G_BEAMD];
+        if (nd && nd < 3)
+            return WHOLE("%s: the dose needs all three of 'laser_power_mw', 'wavelength_nm' "
+                         "and 'beam_diameter_mm'", r->name);
+        if (nd == 3 && (rc = dose_bounds(r))) return rc;
+    }
     /* the geometry's joints are the axes (per rad for angles) */
     for (int j = 0; j < RG_NJOINTS; j++) {
         const rg_axis *x = &g->axis[j];
@@ -345,14 +419,57 @@ static int finish(reader *r)
     return 0;
 }
 
+/* The hold times the dose allows (README-less rule, doc/rig-safety.md): a controller
+ * that dies at the end of a max_on_ms exposure leaves the beam on for the pump's hold
+ * more, so max_on_ms + heartbeat_timeout_ms must stay within the MPE; a rig that says
+ * it is eye-safe without a heartbeat must be, for 100 s (IEC 60825-1's longest
+ * accidental exposure to visible light). */
+static int dose_bounds(reader *r)
+{
+    rg_rig *g = r->rig;
+    rg_dose d;
+    char e[RG_ERRMAX];
+    int rc;
+    if (g->heartbeat.offset >= 0) {
+        double lo = 0, hi = g->heartbeat_timeout_ms;
+        rc = rg_dose_rig(g, g->max_on_ms + g->heartbeat_timeout_ms, 1, &d, e, sizeof e);
+        if (rc == RG_EDOSE) {
+            for (int i = 0; i < 60; i++) {       /* the largest hold within the limit */
+                double mid = 0.5 * (lo + hi);
+                if (rg_dose_rig(g, g->max_on_ms + mid, 1, &d, e, sizeof e) == 0) lo = mid;
+                else hi = mid;
+            }
+            rg_dose_rig(g, g->max_on_ms + g->heartbeat_timeout_ms, 1, &d, e, sizeof e);
+            r->line = r->gseen[G_HTIMEOUT] ? r->gseen[G_HTIMEOUT] : r->gseen[G_MAXON];
+            return fail(r, "a controller that dies at the end of a %g ms exposure leaves the "
+                        "beam on %g ms more (heartbeat_timeout_ms): %.3g times the MPE; the "
+                        "dose allows at most %.3g ms of hold (or a shorter max_on_ms)",
+                        g->max_on_ms, g->heartbeat_timeout_ms, d.fraction, lo);
+        }
+    } else if (g->eye_safe_without_heartbeat) {
+        rc = rg_dose_rig(g, 100e3, 1, &d, e, sizeof e);
+        if (rc == RG_EDOSE) {
+            r->line = r->gseen[G_EYESAFE];
+            return fail(r, "'eye_safe_without_heartbeat yes', but a beam left on for 100 s "
+                        "(IEC 60825-1's longest accidental exposure to visible light) is "
+                        "%.3g times the MPE: add a heartbeat line", d.fraction);
+        }
+    }
+    return 0;
+}
+
 static void defaults(rg_rig *g, const rig_api *geo)
 {
     memset(g, 0, sizeof *g);
     if (geo && geo->geometry_default) geo->geometry_default(&g->geom);
     g->laser.offset = g->interlock.offset = g->heartbeat.offset = -1;
+    g->key_switch.offset = g->indicator.offset = g->shutter.offset = -1;
+    g->sim_interlock_close_ms = g->sim_key_off_ms = g->sim_stall_at_ms = -1;
     for (int j = 0; j < RG_NJOINTS; j++) {
         rg_axis *x = &g->axis[j];
         x->step.offset = x->dir.offset = x->enable.offset = x->home.offset = -1;
+        x->limit.offset = -1;
+        x->sim_limit_ms = x->sim_lose_step_ms = -1;
         x->linear = j == RG_J_U || j == RG_J_V;
     }
     g->tick_us = 250;

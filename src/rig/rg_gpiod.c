@@ -25,10 +25,10 @@ typedef struct gline {
 
 typedef struct ggroup {
     struct gpiod_line_bulk bulk;
-    gline lines[RG_NJOINTS + 1];
+    gline lines[RG_NINPUTS];
     int n, requested;
     unsigned val;               /* logical values of the bits */
-    int phys[RG_NJOINTS + 1];   /* what was last written, per line in bulk order */
+    int phys[RG_NINPUTS];       /* what was last written, per line in bulk order */
 } ggroup;
 
 typedef struct gchip {
@@ -37,7 +37,10 @@ typedef struct gchip {
     struct gpiod_chip *chip;
     char name[RG_NAMEMAX];
     ggroup out[RG_NGROUPS];
-    ggroup in;                  /* home switches (bit = axis), interlock (bit 6) */
+    ggroup in;                  /* home switches (bit = axis), interlock, limits, key
+                                   (the RG_IN_* bits) */
+    unsigned levels;            /* their last levels read */
+    int have_levels;
 } gchip;
 
 static void add(ggroup *g, const rg_line *l, int bit, const char *fmt, const char *a)
@@ -76,7 +79,7 @@ static int request_failed(gchip *c, ggroup *g, int e, char *err, size_t cap)
 
 static int request(gchip *c, ggroup *g, int output, char *err, size_t cap)
 {
-    int defaults[RG_NJOINTS + 1];
+    int defaults[RG_NINPUTS];
     int n = (int)gpiod_chip_num_lines(c->chip), rc;
     char d[128];
     if (!g->n) return 0;
@@ -121,21 +124,32 @@ static int g_inputs(rg_chip *cc, unsigned *level, unsigned *edges)
 {
     gchip *c = (gchip *)cc;
     ggroup *g = &c->in;
-    int v[RG_NJOINTS + 1];
+    int v[RG_NINPUTS];
     struct timespec zero = {0, 0};
+    struct gpiod_line_bulk evb;
     *level = *edges = 0;
     if (!g->requested) return 0;
-    for (int i = 0; i < g->n; i++) {
-        struct gpiod_line *ln = gpiod_line_bulk_get_line(&g->bulk, i);
-        struct gpiod_line_event ev[16];
-        while (gpiod_line_event_wait(ln, &zero) == 1) {
-            *edges |= 1u << g->lines[i].bit;
-            if (gpiod_line_event_read_multiple(ln, ev, 16) < 16) break;
+    /* one poll over every input's event fd (this runs every control step) */
+    while (gpiod_line_event_wait_bulk(&g->bulk, &zero, &evb) == 1) {
+        int more = 0;
+        for (unsigned k = 0; k < gpiod_line_bulk_num_lines(&evb); k++) {
+            struct gpiod_line *ln = gpiod_line_bulk_get_line(&evb, k);
+            struct gpiod_line_event ev[16];
+            for (int i = 0; i < g->n; i++)
+                if (gpiod_line_offset(ln) == (unsigned)g->lines[i].l->offset)
+                    *edges |= 1u << g->lines[i].bit;
+            if (gpiod_line_event_read_multiple(ln, ev, 16) == 16) more = 1;
         }
+        if (!more) break;
     }
+    /* the levels change only with an event: read them again only then (one poll a
+     * control step instead of a poll and an ioctl) */
+    if (c->have_levels && !*edges) { *level = c->levels; return 0; }
     if (gpiod_line_get_value_bulk(&g->bulk, v)) return RG_EIO;
     for (int i = 0; i < g->n; i++)
         if (v[i] ^ g->lines[i].l->active_low) *level |= 1u << g->lines[i].bit;
+    c->levels = *level;
+    c->have_levels = 1;
     return 0;
 }
 
@@ -159,14 +173,14 @@ static void g_sleep_until(rg_chip *c, int64_t t)
 static void g_emergency(rg_chip *cc)
 {
     gchip *c = (gchip *)cc;
-    for (int gi = RG_G_LASER; ; gi = RG_G_ENABLE) {
-        ggroup *g = &c->out[gi];
+    static const int order[] = {RG_G_LASER, RG_G_SHUTTER, RG_G_INDICATOR, RG_G_ENABLE};
+    for (int k = 0; k < 4; k++) {      /* laser first, drivers last */
+        ggroup *g = &c->out[order[k]];
         if (g->requested) {
             for (int i = 0; i < g->n; i++) g->phys[i] = g->lines[i].l->active_low;
             g->val = 0;
             gpiod_line_set_value_bulk(&g->bulk, g->phys);
         }
-        if (gi == RG_G_ENABLE) break;
     }
 }
 
@@ -207,9 +221,16 @@ int rg_gpiod_open(const rg_rig *rig, const char *name, rg_chip **out, char *err,
     }
     add(&c->out[RG_G_LASER], &rig->laser, 0, "%s", "the laser");
     add(&c->out[RG_G_HEART], &rig->heartbeat, 0, "%s", "the heartbeat");
+    add(&c->out[RG_G_SHUTTER], &rig->shutter, 0, "%s", "the shutter");
+    add(&c->out[RG_G_INDICATOR], &rig->indicator, 0, "%s", "the emission indicator");
     add(&c->in, &rig->interlock, RG_NJOINTS, "%s", "the interlock");
+    for (int j = 0; j < RG_NJOINTS; j++)
+        add(&c->in, &rig->axis[j].limit, RG_NJOINTS + 1 + j, "limit switch of axis %s", jname[j]);
+    add(&c->in, &rig->key_switch, 2 * RG_NJOINTS + 1, "%s", "the key switch");
     /* laser first: if anything else fails, it was never on */
     if ((rc = request(c, &c->out[RG_G_LASER], 1, err, cap)) ||
+        (rc = request(c, &c->out[RG_G_SHUTTER], 1, err, cap)) ||
+        (rc = request(c, &c->out[RG_G_INDICATOR], 1, err, cap)) ||
         (rc = request(c, &c->out[RG_G_HEART], 1, err, cap)) ||
         (rc = request(c, &c->out[RG_G_ENABLE], 1, err, cap)) ||
         (rc = request(c, &c->out[RG_G_STEP], 1, err, cap)) ||

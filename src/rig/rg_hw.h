@@ -11,9 +11,15 @@
  * STEP lines together).  Bit j of a mask or value is axis j (RG_J_*); LASER and
  * HEART have bit 0 only.  Values are logical: 1 = active (active-low applied by the
  * backend). */
-enum { RG_G_STEP, RG_G_DIR, RG_G_ENABLE, RG_G_LASER, RG_G_HEART, RG_NGROUPS };
-/* Inputs: bit j = home switch of axis j is active (tripped); RG_IN_INTERLOCK = closed. */
+enum { RG_G_STEP, RG_G_DIR, RG_G_ENABLE, RG_G_LASER, RG_G_HEART, RG_G_SHUTTER,
+       RG_G_INDICATOR, RG_NGROUPS };
+/* Inputs: bit j = home switch of axis j is active (tripped); RG_IN_INTERLOCK = closed;
+ * RG_IN_LIMIT(j) = the limit switch of axis j tripped; RG_IN_KEY = key switch on. */
 #define RG_IN_INTERLOCK (1u << RG_NJOINTS)
+#define RG_IN_LIMIT(j) (1u << (RG_NJOINTS + 1 + (j)))
+#define RG_IN_LIMITS (((1u << RG_NJOINTS) - 1) << (RG_NJOINTS + 1))
+#define RG_IN_KEY (1u << (2 * RG_NJOINTS + 1))
+#define RG_NINPUTS (2 * RG_NJOINTS + 2)
 
 typedef struct rg_chip rg_chip;
 typedef struct rg_chip_ops {
@@ -56,6 +62,14 @@ struct rg_machine {
     float *late;                /* RG_TIMING_MAX samples, us */
     int measure;                /* 1: record lateness */
     struct rg_machine *next;    /* the list emergency_off walks */
+    /* the latch (rg_safety.c) */
+    int fault;                  /* RG_F_*; 0: none */
+    char fault_why[RG_ERRMAX];
+    int drivers_on;             /* ENABLE lines active (set by homing) */
+    int64_t last_rise;          /* last STEP falling edge (chip clock): the low time */
+    /* the session's dose (rg_dose.c) */
+    long dose_n;
+    double dose_t;              /* summed on-time, s */
 };
 
 /* rg_motion.c */
@@ -81,6 +95,16 @@ void rg_emergency_off(void);
 void rg_laser_off(rg_machine *m);
 void rg_get_timing(const rg_machine *m, rg_timing *t);
 const char *rg_sched_note(const rg_machine *m);
+int  rg_latch(rg_machine *m, int cause, int rc, char *err, size_t cap, const char *fmt, ...)
+    __attribute__((format(printf, 6, 7)));
+int  rg_latched(rg_machine *m, char *err, size_t cap);      /* RG_EFAULT if latched */
+int  rg_guard(rg_machine *m, int moving, char *err, size_t cap);
+int  rg_fault_get(const rg_machine *m, char *why, size_t cap);
+int  rg_reset(rg_machine *m, char *err, size_t cap);
+/* rg_dose.c */
+double rg_mpe(double wavelength_nm, double t, const char **limit);
+int  rg_dose_rig(const rg_rig *rig, double ms, long n, rg_dose *d, char *err, size_t cap);
+int  rg_dose_plan(const rg_machine *m, double ms, long n, rg_dose *d, char *err, size_t cap);
 /* rg_file.c */
 int  rg_rig_load(const char *path, rg_rig *rig, char *err, size_t cap);
 int  rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,

@@ -51,7 +51,7 @@ int rg_open(const rg_rig *rig, const rg_open_opts *o, rg_machine **mp, char *err
         else snprintf(m->sched, sizeof m->sched, "normal scheduling (real time not asked)");
     }
     /* safe state first, whatever the lines were */
-    m->chip->ops->set(m->chip, RG_G_LASER, 1, 0);
+    rg_laser_off(m);
     m->chip->ops->set(m->chip, RG_G_ENABLE, (1u << RG_NJOINTS) - 1, 0);
     for (int j = 0; j < RG_NJOINTS; j++)
         if (rig->axis[j].home.offset < 0)
@@ -126,4 +126,9 @@ void rg_machine_fill(rig_api *a)
     a->timing = rg_get_timing;
     a->close = rg_close;
     a->emergency_off = rg_emergency_off;
+    a->fault = rg_fault_get;
+    a->reset = rg_reset;
+    a->dose_plan = rg_dose_plan;
+    a->dose_rig = rg_dose_rig;
+    a->mpe = rg_mpe;
 }

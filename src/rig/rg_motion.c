@@ -6,7 +6,17 @@
  * floor(N_j s(t))): the axes start, accelerate, cruise and arrive together, each
  * within its own speed and acceleration.  Deadlines are absolute (the chip's
  * sleep_until: clock_nanosleep TIMER_ABSTIME on the real clock), so lateness never
- * accumulates.  Every move is checked against travel before its first pulse. */
+ * accumulates.  Every move is checked against travel before its first pulse.
+ * Safety (doc/rig-safety.md): every control step reads the interlock and the limit
+ * switches (rg_guard: a fault latches and no further pulse goes out); each rising
+ * STEP edge measures its own lateness and one later than max_late_us stops the
+ * motion (a latched deadline fault) instead of sending a burst the motor cannot
+ * follow; a pulse stays high at least step_pulse_us after its rising edge really
+ * happened, however late the fall's deadline is, and low as long before the next
+ * rise (catch-up pulses after a preemption are spaced, never back to back); a chip that knows the motors
+ * (the simulator) is compared with the commanded steps after every move (a lost step
+ * latches).  Homing is GRBL's cycle: fast seek, pull-off, slow locate, debounce,
+ * pull-off again, then settle_ms. */
 #define _DEFAULT_SOURCE
 #include <math.h>
 #include <stdio.h>
@@ -99,16 +109,37 @@ static double trap_s(const trap *t, double x)
 
 static int stopped(rg_stop_fn stop, void *ctx) { return stop && stop(ctx); }
 
-/* One tick's pulse on the axes in mask: STEP up at deadline, down half a tick later. */
-static void pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick)
+/* One tick's pulse on the axes in mask: STEP up at deadline, down half a tick later
+ * but never sooner than step_pulse_us after the rise really happened.  First the
+ * guard (interlock, limits) and the lateness: a rise later than max_late_us is not
+ * sent (the motion stops, latched).  0 or the fault's code. */
+static int pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick, char *err, size_t cap)
 {
     const rg_chip_ops *o = m->chip->ops;
+    int64_t rise, fall, late, maxlate = (int64_t)llround(m->rig.max_late_us * 1e3);
+    int rc;
     rg_wait(m, at);
+    if ((rc = rg_guard(m, 0, err, cap))) return rc;
+    late = o->now(m->chip) - at;
+    if (late > maxlate)
+        return rg_latch(m, RG_F_DEADLINE, RG_EFAULT, err, cap, "a STEP edge came %.3f ms late "
+                        "(max_late_us %g): the motion was stopped rather than send steps "
+                        "the motor may not follow", late / 1e6, m->rig.max_late_us);
+    /* the drivers' minimum low time too: after a late pulse, catch-up pulses are
+     * spaced, never back to back */
+    if (o->now(m->chip) < m->last_rise + (int64_t)llround(m->rig.step_pulse_us * 1e3))
+        rg_wait(m, m->last_rise + (int64_t)llround(m->rig.step_pulse_us * 1e3));
     o->set(m->chip, RG_G_STEP, mask, mask);
+    rise = o->now(m->chip);
     edge_done(m, at);
-    rg_wait(m, at + tick / 2);
+    fall = at + tick / 2;
+    if (fall < rise + (int64_t)llround(m->rig.step_pulse_us * 1e3))
+        fall = rise + (int64_t)llround(m->rig.step_pulse_us * 1e3);
+    rg_wait(m, fall);
     o->set(m->chip, RG_G_STEP, mask, 0);
+    m->last_rise = o->now(m->chip);      /* (the fall: the low time starts here) */
     edge_done(m, at + tick / 2);
+    return 0;
 }
 
 static void set_dirs(rg_machine *m, const int sign[RG_NJOINTS])
@@ -162,6 +193,34 @@ int rg_plan_move(const rg_rig *rig, const long from[RG_NJOINTS], const long to[R
     return rc;
 }
 
+/* settle_ms at rest, the guard still read every control step. */
+static int settle(rg_machine *m, char *err, size_t cap)
+{
+    const rg_chip_ops *o = m->chip->ops;
+    int64_t tick = rg_tick_ns(&m->rig), end = o->now(m->chip) + (int64_t)llround(m->rig.settle_ms * 1e6);
+    int rc;
+    if (!(m->rig.settle_ms > 0)) return 0;
+    for (int64_t t = o->now(m->chip) + tick; ; t += tick) {
+        rg_wait(m, t < end ? t : end);
+        if ((rc = rg_guard(m, 0, err, cap))) return rc;
+        if (t >= end) return 0;
+    }
+}
+
+/* Where the chip knows the motors (the simulator; an encoder would do the same): a
+ * motor that is not where it was sent lost steps. */
+static int lost_steps(rg_machine *m, char *err, size_t cap)
+{
+    long real[RG_NJOINTS];
+    if (!m->chip->ops->motors || !m->chip->ops->motors(m->chip, real)) return 0;
+    for (int j = 0; j < RG_NJOINTS; j++)
+        if (real[j] != m->pos[j])
+            return rg_latch(m, RG_F_LOSTSTEP, RG_EFAULT, err, cap, "axis %s is %ld steps off "
+                            "its commanded position: a lost step", jname[j],
+                            real[j] - m->pos[j]);
+    return 0;
+}
+
 int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop, void *ctx,
                   char *err, size_t cap)
 {
@@ -173,6 +232,7 @@ int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop,
     int rc;
     long k, K;
 
+    if ((rc = rg_latched(m, err, cap))) return rc;
     if (!m->homed) { snprintf(err, cap, "the machine is not homed: home it first"); return RG_EINVAL; }
     if ((rc = plan(rig, m->pos, target, n, sign, &tp, err, cap))) return rc;
     if (m->laser_on) rg_laser_off(m);   /* never: expose returns with it off */
@@ -194,7 +254,13 @@ int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop,
             long want = k == K ? n[j] : (long)floor(n[j] * s);
             if (want > done[j]) { mask |= 1u << j; done[j]++; }
         }
-        if (mask) pulse(m, mask, t0 + k * tick, tick);
+        if (mask && (rc = pulse(m, mask, t0 + k * tick, tick, err, cap))) {
+            for (int j = 0; j < RG_NJOINTS; j++)
+                if (mask >> j & 1) done[j]--;      /* not sent */
+            for (int j = 0; j < RG_NJOINTS; j++) m->pos[j] += sign[j] * done[j];
+            note(m, "stopped (fault)");
+            return rc;
+        }
         /* rounding may leave an axis a step behind at the end: finish it */
         if (k == K) {
             int behind;
@@ -202,13 +268,23 @@ int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop,
                 behind = 0; mask = 0;
                 for (int j = 0; j < RG_NJOINTS; j++)
                     if (done[j] < n[j]) { mask |= 1u << j; done[j]++; behind = 1; }
-                if (behind) { K++; pulse(m, mask, t0 + K * tick, tick); }
+                if (behind) {
+                    K++;
+                    if ((rc = pulse(m, mask, t0 + K * tick, tick, err, cap))) {
+                        for (int j = 0; j < RG_NJOINTS; j++) {
+                            if (mask >> j & 1) done[j]--;
+                            m->pos[j] += sign[j] * done[j];
+                        }
+                        note(m, "stopped (fault)");
+                        return rc;
+                    }
+                }
             } while (behind);
         }
     }
     for (int j = 0; j < RG_NJOINTS; j++) m->pos[j] = target[j];
-    if (rig->settle_ms > 0)
-        rg_wait(m, m->chip->ops->now(m->chip) + (int64_t)llround(rig->settle_ms * 1e6));
+    if ((rc = settle(m, err, cap))) return rc;
+    if ((rc = lost_steps(m, err, cap))) return rc;
     note(m, "moved");
     return 0;
 }
@@ -222,21 +298,29 @@ int rg_move(rg_machine *m, const rg_pose *p, rg_stop_fn stop, void *ctx, char *e
     return rg_move_steps(m, steps, stop, ctx, err, cap);
 }
 
-/* Homing: every axis with a switch at once, at its home speed: first off the switch
- * if it already reads tripped, then toward it until it trips; that step is home_at.
- * Gives up after home_timeout_s (a broken switch or wire must not drive forever). */
-static int home_phase(rg_machine *m, unsigned axes, int toward, rg_stop_fn stop, void *ctx,
-                      char *err, size_t cap)
+/* Homing (GRBL's cycle): every axis with a switch at once.  A phase moves the axes in
+ * `axes` toward (toward=1) or away from their switches at `speed` (0: home_speed,
+ * 1: home_locate_speed) until the switch reads tripped (toward) or released (away),
+ * or, with `dist` set, for home_pulloff exactly (then the switch must read released
+ * at the end: a pull-off that does not clear it is a fault).  Gives up after
+ * home_timeout_s (a broken switch or wire must not drive forever).  The guard
+ * (interlock, limits) is read every control step. */
+static int home_phase(rg_machine *m, unsigned axes, int toward, int slow, int dist,
+                      rg_stop_fn stop, void *ctx, char *err, size_t cap)
 {
     const rg_rig *rig = &m->rig;
     const rg_chip_ops *o = m->chip->ops;
     int64_t tick = rg_tick_ns(rig), t0 = o->now(m->chip) + tick, t;
     int64_t limit = (int64_t)llround(rig->home_timeout_s * 1e9);
     double acc[RG_NJOINTS] = {0};
-    int sign[RG_NJOINTS] = {0};
+    long togo[RG_NJOINTS] = {0};
+    int sign[RG_NJOINTS] = {0}, rc;
     unsigned left = axes;
     for (int j = 0; j < RG_NJOINTS; j++)
-        if (axes >> j & 1) sign[j] = toward ? rig->axis[j].home_dir : -rig->axis[j].home_dir;
+        if (axes >> j & 1) {
+            sign[j] = toward ? rig->axis[j].home_dir : -rig->axis[j].home_dir;
+            togo[j] = lround(rig->axis[j].home_pulloff * rig->axis[j].steps_per);
+        }
     set_dirs(m, sign);
     for (long k = 1; left; k++) {
         unsigned lv, ed, mask = 0;
@@ -248,21 +332,39 @@ static int home_phase(rg_machine *m, unsigned axes, int toward, rg_stop_fn stop,
         }
         if (t - t0 > limit) {
             int j = __builtin_ctz(left);
-            snprintf(err, cap, "axis %s: its home switch (line %d) did not %s within %g s",
-                     jname[j], rig->axis[j].home.offset, toward ? "trip" : "release",
-                     rig->home_timeout_s);
             note(m, "stopped (homing timed out)");
-            return RG_ETIMEOUT;
+            return rg_latch(m, RG_F_HOMING, RG_ETIMEOUT, err, cap, "axis %s: its home switch "
+                            "(line %d) did not %s within %g s", jname[j],
+                            rig->axis[j].home.offset, toward ? "trip" : "release",
+                            rig->home_timeout_s);
         }
         o->inputs(m->chip, &lv, &ed);
         for (int j = 0; j < RG_NJOINTS; j++) {
+            double v;
             if (!(left >> j & 1)) continue;
-            if (!!(lv >> j & 1) == !!toward) { left &= ~(1u << j); continue; }
-            acc[j] += rig->axis[j].home_speed * rig->axis[j].steps_per * (tick / 1e9);
-            if (acc[j] >= 1) { acc[j] -= 1; mask |= 1u << j; m->pos[j] += sign[j]; }
+            if (dist ? togo[j] == 0 : !!(lv >> j & 1) == !!toward) {
+                if (dist && (lv >> j & 1)) {
+                    note(m, "stopped (homing: pull-off)");
+                    return rg_latch(m, RG_F_HOMING, RG_EFAULT, err, cap, "axis %s: the "
+                                    "pull-off of %g did not clear its home switch (line %d)",
+                                    jname[j], rig->axis[j].home_pulloff,
+                                    rig->axis[j].home.offset);
+                }
+                left &= ~(1u << j);
+                continue;
+            }
+            v = slow ? rig->axis[j].home_locate_speed : rig->axis[j].home_speed;
+            acc[j] += v * rig->axis[j].steps_per * (tick / 1e9);
+            if (acc[j] >= 1) { acc[j] -= 1; mask |= 1u << j; }
         }
-        if (mask) pulse(m, mask, t, tick);
-        else rg_wait(m, t);
+        if (mask) {
+            if ((rc = pulse(m, mask, t, tick, err, cap))) { note(m, "stopped (fault)"); return rc; }
+            for (int j = 0; j < RG_NJOINTS; j++)
+                if (mask >> j & 1) { m->pos[j] += sign[j]; togo[j]--; }
+        } else {
+            rg_wait(m, t);
+            if ((rc = rg_guard(m, 0, err, cap))) { note(m, "stopped (fault)"); return rc; }
+        }
     }
     return 0;
 }
@@ -272,20 +374,41 @@ int rg_home(rg_machine *m, rg_stop_fn stop, void *ctx, char *err, size_t cap)
     const rg_rig *rig = &m->rig;
     unsigned axes = 0, lv, ed, on = 0;
     int rc;
+    if ((rc = rg_latched(m, err, cap))) return rc;
     if (m->laser_on) rg_laser_off(m);
     for (int j = 0; j < RG_NJOINTS; j++) {
         if (rig->axis[j].home.offset >= 0) axes |= 1u << j;
         if (rig->axis[j].enable.offset >= 0) on |= 1u << j;
     }
     m->homed = 0;
+    if ((rc = rg_guard(m, 0, err, cap))) return rc;
     m->chip->ops->set(m->chip, RG_G_ENABLE, on, on);     /* drivers on, and stay on */
+    m->drivers_on = 1;
     m->chip->ops->inputs(m->chip, &lv, &ed);
-    if ((rc = home_phase(m, axes & lv, 0, stop, ctx, err, cap)) ||
-        (rc = home_phase(m, axes, 1, stop, ctx, err, cap)))
+    if ((rc = home_phase(m, axes & lv, 0, 0, 0, stop, ctx, err, cap)) ||   /* off it */
+        (rc = home_phase(m, axes, 1, 0, 0, stop, ctx, err, cap)) ||        /* seek */
+        (rc = home_phase(m, axes, 0, 0, 1, stop, ctx, err, cap)) ||        /* pull-off */
+        (rc = home_phase(m, axes, 1, 1, 0, stop, ctx, err, cap)))          /* locate */
         return rc;
-    for (int j = 0; j < RG_NJOINTS; j++)
-        m->pos[j] = lround(rig->axis[j].home_at * rig->axis[j].steps_per);
+    if (axes) {                                         /* debounce: still tripped? */
+        int64_t end = m->chip->ops->now(m->chip) + (int64_t)llround(rig->home_debounce_ms * 1e6);
+        rg_wait(m, end);
+        if ((rc = rg_guard(m, 0, err, cap))) return rc;
+        m->chip->ops->inputs(m->chip, &lv, &ed);
+        for (int j = 0; j < RG_NJOINTS; j++)
+            if ((axes >> j & 1) && !(lv >> j & 1))
+                return rg_latch(m, RG_F_HOMING, RG_EFAULT, err, cap, "axis %s: its home switch "
+                                "(line %d) bounced: released %g ms after it tripped", jname[j],
+                                rig->axis[j].home.offset, rig->home_debounce_ms);
+    }
+    if ((rc = home_phase(m, axes, 0, 0, 1, stop, ctx, err, cap))) return rc;  /* pull-off */
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        const rg_axis *x = &rig->axis[j];
+        m->pos[j] = lround(x->home_at * x->steps_per);
+        if (x->home.offset >= 0) m->pos[j] -= x->home_dir * lround(x->home_pulloff * x->steps_per);
+    }
+    note(m, "homed");                /* then settle_ms before anything else */
+    if ((rc = settle(m, err, cap))) return rc;
     m->homed = 1;
-    note(m, "homed");
     return 0;
 }

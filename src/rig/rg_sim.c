@@ -9,6 +9,14 @@
  * closes or stops), so it survives a kill; its formatter is async-signal-safe for the
  * emergency path.  The chip state may live in a shared file (rg_sim_shared) that a
  * watchdog outside the process reads (tests/rig/rig_watchdog.c).
+ * Safety (doc/rig-safety.md): limit switches (tripped beyond travel, or from
+ * sim_limit_ms), a key switch (off from sim_key_off_ms), the shutter and emission
+ * indicator, an interlock that may close again (sim_interlock_close_ms), a stalled
+ * controller (sim_stall_at_ms: the clock jumps as if the process had been
+ * preempted), a driver that drops a pulse (sim_lose_step_ms) or any pulse shorter
+ * than step_pulse_us; VIOLATION lines for a STEP edge more than 1 ms after the
+ * interlock opened or a limit tripped, light with the indicator off or the key off,
+ * and emission sooner than emission_delay_ms after the indicator went on.
  * rg_null_open: the same model on the real clock, no log (the timing benchmark). */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -38,13 +46,23 @@ typedef struct sim {
     int64_t home_step[RG_NJOINTS];
     int64_t pulses[RG_NJOINTS]; /* STEP edges seen since the last note */
     int64_t il_open_since;      /* interlock open with the laser on, since; -1 */
+    int64_t il_opened_at;       /* when the interlock last opened; -1: closed */
+    int64_t limit_at[RG_NJOINTS]; /* when each limit switch tripped; -1 */
+    int64_t rise_at[RG_NJOINTS];  /* STEP rising edge, for the pulse width */
+    int64_t fall_at[RG_NJOINTS];  /* STEP falling edge, for the low time */
+    int rise_dir[RG_NJOINTS];     /* the step that rise made (undone if it was too short) */
+    int64_t last_step_edge;     /* any STEP edge; -1 none */
+    int64_t indicator_on_at;    /* -1: off */
+    int lost[RG_NJOINTS];       /* sim_lose_step_ms injected already */
+    int stalled;
+    int64_t last_read;          /* simulated time of the last input read */
     int violations;
     int closed;
 } sim;
 
 /* ---- async-signal-safe log formatting ------------------------------------------- */
 
-typedef struct lbuf { char b[512]; size_t n; } lbuf;
+typedef struct lbuf { char b[1024]; size_t n; } lbuf;
 
 static void put_s(lbuf *l, const char *s)
 {
@@ -102,10 +120,29 @@ static void logs(sim *s, const char *a, const char *b)
 static int interlock_closed(const sim *s)
 {
     const rg_rig *r = s->rig;
+    if (r->sim_interlock_close_ms >= 0 &&
+        s->sh->now_ns >= (int64_t)llround(r->sim_interlock_close_ms * 1e6)) return 1;
     if (r->sim_interlock_open) return 0;
     if (r->sim_interlock_open_ms >= 0 &&
         s->sh->now_ns >= (int64_t)llround(r->sim_interlock_open_ms * 1e6)) return 0;
     return 1;
+}
+
+static int limit_tripped(const sim *s, int j)
+{
+    const rg_axis *x = &s->rig->axis[j];
+    if (x->limit.offset < 0) return 0;
+    if (x->sim_limit_ms >= 0 && s->sh->now_ns >= (int64_t)llround(x->sim_limit_ms * 1e6))
+        return 1;
+    return s->sh->steps[j] < llround(x->min * x->steps_per) ||
+           s->sh->steps[j] > llround(x->max * x->steps_per);
+}
+
+static int key_on(const sim *s)
+{
+    const rg_rig *r = s->rig;
+    if (r->key_switch.offset < 0) return 1;
+    return !(r->sim_key_off_ms >= 0 && s->sh->now_ns >= (int64_t)llround(r->sim_key_off_ms * 1e6));
 }
 
 static int home_tripped(const sim *s, int j)
@@ -119,6 +156,7 @@ static int home_tripped(const sim *s, int j)
 static int light_now(const sim *s, int64_t t)
 {
     if (!s->sh->laser) return 0;
+    if (s->rig->shutter.offset >= 0 && !s->sh->shutter) return 0;
     if (s->rig->heartbeat.offset < 0) return 1;
     return t - s->sh->heartbeat_last_ns <= s->sh->timeout_ns;
 }
@@ -137,6 +175,14 @@ static void update_light(sim *s)
         logs(s, on ? "light 1" : "light 0", NULL);
     }
     s->sh->light = on;
+    if (on && s->rig->indicator.offset >= 0 && !s->sh->indicator) {
+        s->violations++;
+        logs(s, "VIOLATION light with the emission indicator off", NULL);
+    }
+    if (on && !key_on(s)) {
+        s->violations++;
+        logs(s, "VIOLATION light with the key switch off", NULL);
+    }
 }
 
 static void check_interlock(sim *s)
@@ -147,8 +193,20 @@ static void check_interlock(sim *s)
         int64_t now = s->sh->now_ns, at = (int64_t)llround(s->rig->sim_interlock_open_ms * 1e6);
         s->sh->interlock = closed;
         if (!closed && s->rig->sim_interlock_open_ms >= 0 && at < now) s->sh->now_ns = at;
+        s->il_opened_at = closed ? -1 : s->sh->now_ns;
         logs(s, closed ? "interlock closed" : "interlock open", NULL);
         s->sh->now_ns = now;
+    }
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        int tr = limit_tripped(s, j);
+        if (tr && s->limit_at[j] < 0) {
+            lbuf l;
+            s->limit_at[j] = s->sh->now_ns;
+            start(s, &l); put_s(&l, "limit switch of axis "); put_s(&l, jname[j]);
+            put_s(&l, " tripped"); emit(s, &l);
+        } else if (!tr) {
+            s->limit_at[j] = -1;
+        }
     }
     if (s->sh->laser && !closed) {
         int64_t tick = rg_tick_ns(s->rig);
@@ -164,6 +222,25 @@ static void check_interlock(sim *s)
     }
 }
 
+/* A STEP edge: none may come more than 1 ms after the interlock opened or a limit
+ * switch tripped (the controller reads them every control step). */
+static void step_edges(sim *s, int64_t t)
+{
+    s->last_step_edge = t;
+    if (s->realclock) return;
+    if (s->il_opened_at >= 0 && t - s->il_opened_at > 1000000) {
+        s->violations++;
+        logs(s, "VIOLATION a STEP edge more than 1 ms after the interlock opened", NULL);
+        s->il_opened_at = t;        /* once per ms, not per edge */
+    }
+    for (int j = 0; j < RG_NJOINTS; j++)
+        if (s->limit_at[j] >= 0 && t - s->limit_at[j] > 1000000) {
+            s->violations++;
+            logs(s, "VIOLATION a STEP edge more than 1 ms after a limit switch tripped", NULL);
+            s->limit_at[j] = t;
+        }
+}
+
 static int sim_set(rg_chip *c, int g, unsigned mask, unsigned val)
 {
     sim *s = (sim *)c;
@@ -171,20 +248,72 @@ static int sim_set(rg_chip *c, int g, unsigned mask, unsigned val)
     lbuf l;
     s->val[g] = now;
     if (g == RG_G_STEP) {
-        unsigned rise = now & ~old;
+        unsigned rise = now & ~old, fall = old & ~now;
+        int64_t t = s->sh->now_ns;
+        if (rise | fall) step_edges(s, t);
         for (int j = 0; j < RG_NJOINTS; j++) {
-            int en;
+            int en, d;
+            if (fall >> j & 1) {
+                /* a pulse shorter than the driver's minimum: the driver misses it */
+                if (!s->realclock && s->rise_at[j] >= 0 &&
+                    t - s->rise_at[j] < (int64_t)llround(s->rig->step_pulse_us * 1e3)) {
+                    lbuf l;
+                    s->violations++;
+                    start(s, &l); put_s(&l, "VIOLATION a STEP pulse of axis ");
+                    put_s(&l, jname[j]); put_s(&l, " high "); put_i(&l, t - s->rise_at[j]);
+                    put_s(&l, " ns, shorter than the driver's minimum (step missed)");
+                    emit(s, &l);
+                    s->sh->steps[j] -= s->rise_dir[j];
+                }
+                s->rise_at[j] = -1;
+                s->fall_at[j] = t;
+            }
             if (!(rise >> j & 1)) continue;
             en = s->rig->axis[j].enable.offset < 0 || (s->val[RG_G_ENABLE] >> j & 1);
+            if (en && !s->realclock && s->fall_at[j] >= 0 &&
+                t - s->fall_at[j] < (int64_t)llround(s->rig->step_pulse_us * 1e3)) {
+                lbuf l;
+                s->violations++;
+                start(s, &l); put_s(&l, "VIOLATION a STEP low time of axis ");
+                put_s(&l, jname[j]); put_s(&l, " of "); put_i(&l, t - s->fall_at[j]);
+                put_s(&l, " ns, shorter than the driver's minimum (step missed)");
+                emit(s, &l);
+                s->rise_at[j] = -1;
+                s->rise_dir[j] = 0;
+                continue;
+            }
+            s->rise_at[j] = en ? t : -1;
+            s->rise_dir[j] = 0;
             if (!en) continue;
-            s->sh->steps[j] += ((s->val[RG_G_DIR] >> j & 1) ^ s->rig->axis[j].dir_invert)
-                               ? 1 : -1;
+            if (s->rig->axis[j].sim_lose_step_ms >= 0 && !s->lost[j] &&
+                t >= (int64_t)llround(s->rig->axis[j].sim_lose_step_ms * 1e6)) {
+                s->lost[j] = 1;
+                s->rise_at[j] = -1;
+                logs(s, "driver dropped a step (injected) on axis ", jname[j]);
+                continue;
+            }
+            d = ((s->val[RG_G_DIR] >> j & 1) ^ s->rig->axis[j].dir_invert) ? 1 : -1;
+            s->sh->steps[j] += d;
+            s->rise_dir[j] = d;
             s->pulses[j]++;
             if (s->sh->laser && !s->realclock) {
                 s->violations++;
                 logs(s, "VIOLATION a step with the laser on", NULL);
             }
         }
+        return 0;
+    }
+    if (g == RG_G_SHUTTER || g == RG_G_INDICATOR) {
+        if (old == now) return 0;
+        if (g == RG_G_SHUTTER) s->sh->shutter = (int)(now & 1);
+        else {
+            s->sh->indicator = (int)(now & 1);
+            s->indicator_on_at = (now & 1) ? s->sh->now_ns : -1;
+        }
+        if (!s->realclock && (g == RG_G_SHUTTER ? s->rig->shutter : s->rig->indicator).offset >= 0)
+            logs(s, g == RG_G_SHUTTER ? (now & 1 ? "shutter open" : "shutter closed")
+                                      : (now & 1 ? "indicator on" : "indicator off"), NULL);
+        update_light(s);
         return 0;
     }
     if (g == RG_G_HEART) {
@@ -214,6 +343,12 @@ static int sim_set(rg_chip *c, int g, unsigned mask, unsigned val)
             emit(s, &l);
         }
         if (s->sh->laser) s->il_open_since = -1, check_interlock(s);
+        if (s->sh->laser && s->rig->emission_delay_ms > 0 &&
+            (s->indicator_on_at < 0 || s->sh->now_ns - s->indicator_on_at <
+             (int64_t)llround(s->rig->emission_delay_ms * 1e6))) {
+            s->violations++;
+            logs(s, "VIOLATION laser on sooner than emission_delay_ms after the indicator", NULL);
+        }
         update_light(s);
         return 0;
     }
@@ -235,8 +370,16 @@ static int sim_inputs(rg_chip *c, unsigned *level, unsigned *edges)
     for (int j = 0; j < RG_NJOINTS; j++) if (home_tripped(s, j)) v |= 1u << j;
     check_interlock(s);
     if (s->sh->interlock) v |= RG_IN_INTERLOCK;
+    for (int j = 0; j < RG_NJOINTS; j++) if (limit_tripped(s, j)) v |= RG_IN_LIMIT(j);
+    if (key_on(s)) v |= RG_IN_KEY;
     *level = v;
-    *edges = 0;     /* the model changes only between waits: levels say it all */
+    /* an interlock that opened and closed again since the last read: its edge */
+    *edges = 0;
+    if (s->rig->sim_interlock_open_ms >= 0) {
+        int64_t at = (int64_t)llround(s->rig->sim_interlock_open_ms * 1e6);
+        if (at > s->last_read && at <= s->sh->now_ns) *edges |= RG_IN_INTERLOCK;
+    }
+    s->last_read = s->sh->now_ns;
     return 0;
 }
 
@@ -266,6 +409,17 @@ static void sim_sleep_until(rg_chip *c, int64_t t)
     if (t > s->sh->now_ns) {
         if (s->rig->sim_realtime) real_sleep(s->t0_real + t);
         s->sh->now_ns = t;
+    }
+    /* injected: the controller is preempted here (its clock jumps on) */
+    if (!s->stalled && s->rig->sim_stall_at_ms >= 0 &&
+        s->sh->now_ns >= (int64_t)llround(s->rig->sim_stall_at_ms * 1e6)) {
+        lbuf l;
+        s->stalled = 1;
+        start(s, &l); put_s(&l, "controller preempted (injected) for ");
+        put_i(&l, (int64_t)llround(s->rig->sim_stall_ms * 1e3)); put_s(&l, " us"); emit(s, &l);
+        if (s->rig->sim_realtime) real_sleep(s->t0_real + s->sh->now_ns +
+                                             (int64_t)llround(s->rig->sim_stall_ms * 1e6));
+        s->sh->now_ns += (int64_t)llround(s->rig->sim_stall_ms * 1e6);
     }
     check_interlock(s);
     update_light(s);
@@ -305,6 +459,8 @@ static void sim_emergency(rg_chip *c)
     s->sh->laser = 0;
     s->sh->light = 0;
     logs(s, "stop: laser 0", NULL);
+    s->val[RG_G_SHUTTER] = s->val[RG_G_INDICATOR] = 0;
+    s->sh->shutter = s->sh->indicator = 0;
     s->val[RG_G_ENABLE] = 0;
     for (int j = 0; j < RG_NJOINTS; j++) s->sh->enable[j] = 0;
     logs(s, "stop: enable 0 (every driver)", NULL);
@@ -319,6 +475,11 @@ static void sim_note(rg_chip *c, const char *what)
     if (s->log < 0) return;
     start(s, &l);
     put_s(&l, what);
+    if (!strncmp(what, "FAULT", 5) || !strncmp(what, "stopped", 7)) {
+        put_s(&l, "; last STEP edge ");
+        if (s->last_step_edge >= 0) put_t(&l, s->last_step_edge); else put_s(&l, "none");
+        if (s->il_opened_at >= 0) { put_s(&l, ", interlock opened "); put_t(&l, s->il_opened_at); }
+    }
     if (!strncmp(what, "moved", 5) || !strncmp(what, "homed", 5) ||
         !strncmp(what, "stopped", 7)) {
         put_s(&l, ": pulses");
@@ -359,7 +520,7 @@ static const rg_chip_ops sim_ops = {sim_set, sim_inputs, sim_now, sim_sleep_unti
 
 /* The state file appears under its name only once it has its full size (a watchdog
  * mapping it earlier would fault): made as PATH.part, renamed when it is mapped. */
-static int open_shared(sim *s, const char *path, char *err, size_t cap)
+static int open_shared(sim *s, const char *path, const rg_rig *rig, char *err, size_t cap)
 {
     char part[600];
     int fd;
@@ -380,6 +541,10 @@ static int open_shared(sim *s, const char *path, char *err, size_t cap)
     }
     memcpy(s->sh->magic, "lmrigsim", 8);
     s->sh->pid = (int32_t)getpid();
+    /* the pump's hold and presence before the file appears: a watchdog must never see
+     * a hold of 0 */
+    s->sh->timeout_ns = (int64_t)llround(rig->heartbeat_timeout_ms * 1e6);
+    s->sh->pump = rig->heartbeat.offset >= 0;
     if (rename(part, path)) {
         snprintf(err, cap, "%s: %s", path, strerror(errno));
         munmap(s->sh, s->shlen);
@@ -401,12 +566,17 @@ static int sim_make(const rg_rig *rig, const rg_open_opts *o, int realclock, rg_
     s->log = -1;
     s->realclock = realclock;
     s->il_open_since = -1;
-    if (o && o->sim_state) rc = open_shared(s, o->sim_state, err, cap);
+    s->il_opened_at = -1;
+    s->last_step_edge = -1;
+    s->indicator_on_at = -1;
+    for (int j = 0; j < RG_NJOINTS; j++) s->limit_at[j] = s->rise_at[j] = s->fall_at[j] = -1;
+    if (o && o->sim_state) rc = open_shared(s, o->sim_state, rig, err, cap);
     else if (!(s->sh = calloc(1, sizeof *s->sh))) { snprintf(err, cap, "out of memory"); rc = RG_ENOMEM; }
     if (rc) { free(s); return rc; }
     memcpy(s->sh->magic, "lmrigsim", 8);
     s->sh->pid = (int32_t)getpid();
     s->sh->timeout_ns = (int64_t)llround(rig->heartbeat_timeout_ms * 1e6);
+    s->sh->pump = rig->heartbeat.offset >= 0;
     s->sh->heartbeat_last_ns = -s->sh->timeout_ns - 1;
     for (int j = 0; j < RG_NJOINTS; j++) {
         const rg_axis *x = &rig->axis[j];
@@ -446,6 +616,10 @@ static int sim_make(const rg_rig *rig, const rg_open_opts *o, int realclock, rg_
             put_s(&l, ", heartbeat pump hold ");
             put_i(&l, s->sh->timeout_ns / 1000);
             put_s(&l, " us");
+        } else if (rig->eye_safe_without_heartbeat) {
+            put_s(&l, ", no heartbeat (the rig file says the beam is eye-safe without one)");
+        } else {
+            put_s(&l, ", no heartbeat: emission refused");
         }
         emit(s, &l);
     }

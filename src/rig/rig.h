@@ -10,7 +10,8 @@
  * the dialogue say degrees.
  *
  * Two parts, each with its own section: geometry (rg_geom*.c, rg_quant*.c) and the
- * machine (rg_file.c, rg_gpiod.c, rg_sim.c, rg_motion.c, rg_safety.c). */
+ * machine (rg_file.c, rg_gpiod.c, rg_sim.c, rg_motion.c, rg_safety.c, rg_dose.c; the
+ * safety functions: doc/rig-safety.md). */
 #ifndef RIG_H
 #define RIG_H
 #include <stddef.h>
@@ -21,7 +22,7 @@
 
 enum { RG_OK = 0, RG_EINVAL = -1, RG_ENOMEM = -2, RG_EIO = -3, RG_ESTOP = -4,
        RG_EUNREACH = -5, RG_ETRAVEL = -6, RG_EINTERLOCK = -7, RG_EBUSY = -8,
-       RG_ETIMEOUT = -9, RG_EABI = -10 };
+       RG_ETIMEOUT = -9, RG_EABI = -10, RG_EFAULT = -11, RG_EDOSE = -12 };
 
 /* ==== geometry (section 38) ====================================================== */
 /* The contract between the geometry and the machine: the rig file fills rg_geometry,
@@ -247,6 +248,12 @@ typedef struct rg_axis {
     int dir_invert;             /* 1: positive moves drive DIR inactive */
     int sim_home_broken;        /* simulator: this home switch never trips */
     int at;                     /* rig-file line of its "axis" line; 0: missing */
+    /* (added by the safety work: doc/rig-safety.md) */
+    rg_line limit;              /* hard-limit switch input (both ends in series); -1 */
+    double home_pulloff;        /* homing pull-off distance (deg or mm; default 0.5) */
+    double home_locate_speed;   /* slow locate speed (/s; default home_speed / 10) */
+    double sim_limit_ms;        /* simulator: the limit switch trips at this time; < 0 */
+    double sim_lose_step_ms;    /* simulator: the driver drops one pulse after this; < 0 */
 } rg_axis;
 typedef struct rg_rig {
     char path[256];
@@ -272,7 +279,47 @@ typedef struct rg_rig {
     double cam_read_noise;      /* camera_read_noise E: electrons rms (default 5) */
     double cam_seed;            /* camera_seed N: noise seed of the first frame (default 1) */
     double beam_waist;          /* beam_waist MM: the laser's waist radius (default 0.2) */
+    /* ---- safety (doc/rig-safety.md) ---- */
+    int eye_safe_without_heartbeat; /* "eye_safe_without_heartbeat yes": emission allowed
+                                       with no heartbeat line (said in words) */
+    double laser_power_mw;      /* power at the cornea (mW); 0: not given: no emission */
+    double wavelength_nm;       /* the laser's wavelength (nm) */
+    double beam_diameter_mm;    /* 1/e^2 beam diameter at the cornea (mm) */
+    rg_line key_switch;         /* input: active = key on (emission allowed); -1 */
+    rg_line indicator;          /* output: emission indicator, on before and during */
+    rg_line shutter;            /* output: beam shutter, active = open */
+    double emission_delay_ms;   /* indicator on this long before the laser may emit */
+    double shutter_ms;          /* shutter travel time (open and close) */
+    double step_pulse_us;       /* the drivers' minimum STEP high time (default 5) */
+    double max_late_us;         /* a STEP edge later than this stops the motion
+                                   (default tick_us / 2) */
+    double home_debounce_ms;    /* homing: the switch re-read after this (default 10) */
+    double sim_interlock_close_ms; /* simulator: the interlock closes again; < 0 never */
+    double sim_key_off_ms;      /* simulator: the key switch turns off at this time */
+    double sim_stall_at_ms;     /* simulator: the controller is preempted at this time */
+    double sim_stall_ms;        /* ... for this long (a missed deadline) */
 } rg_rig;
+
+/* Latched faults (LinuxCNC's estop_latch model): the first one is kept; laser off
+ * first, then drivers off; only rig_api.reset clears it, refused while the cause
+ * persists. */
+enum rg_fault_cause { RG_F_NONE, RG_F_INTERLOCK, RG_F_LIMIT, RG_F_DEADLINE,
+                      RG_F_HEARTBEAT, RG_F_LOSTSTEP, RG_F_KEY, RG_F_HOMING };
+
+/* The dose at the cornea against the maximum permissible exposure (rg_dose.c): the
+ * session's exposures so far plus n more of ms each. */
+typedef struct rg_dose {
+    double E_peak;              /* peak irradiance of the Gaussian beam (W/m^2) */
+    double E_aperture;          /* irradiance averaged over the 7 mm limiting aperture */
+    double H_one;               /* radiant exposure of one exposure (J/m^2, aperture) */
+    double mpe_one;             /* MPE for one exposure's duration (J/m^2) */
+    long n;                     /* exposures: the session's plus the planned */
+    double t_total;             /* their summed on-time (s) */
+    double H_total;             /* their summed radiant exposure (J/m^2) */
+    double mpe_total;           /* MPE for t_total as one exposure (J/m^2) */
+    double fraction;            /* the larger of H_one/mpe_one and H_total/mpe_total */
+    const char *limit;          /* which row of which table gave the limit */
+} rg_dose;
 
 enum rg_backend { RG_BACKEND_SIM, RG_BACKEND_GPIOD, RG_BACKEND_NULL };
 typedef struct rg_open_opts {
@@ -301,6 +348,9 @@ typedef struct rg_sim_shared {
     volatile int64_t heartbeat_edges;   /* toggles so far */
     volatile int64_t heartbeat_last_ns; /* simulated time of the last toggle */
     volatile int64_t timeout_ns;        /* the pump's hold time */
+    volatile int32_t pump;              /* 1: a heartbeat pump gates the light; 0: none
+                                           (the light follows the laser line) */
+    volatile int32_t shutter, indicator;
 } rg_sim_shared;
 /* ==== end of the machine ========================================================= */
 
@@ -403,6 +453,24 @@ typedef struct rig_api {
     /* Async-signal-safe: every open machine's laser off, then its drivers disabled
      * (and the simulator's log completed).  For a signal handler or stop hook. */
     void (*emergency_off)(void);
+    /* ---- safety (doc/rig-safety.md) ---- */
+    /* The latched fault: its cause (RG_F_*; 0 none) and why, with when (sim time). */
+    int (*fault)(const rg_machine *m, char *why, size_t cap);
+    /* Clear the latch: RG_OK, or RG_EFAULT while its cause persists (interlock open,
+     * limit switch tripped, key off).  Homing is still required after a fault that
+     * found the drivers enabled (their current cut: position not held). */
+    int (*reset)(rg_machine *m, char *err, size_t cap);
+    /* The dose of the session so far plus n exposures of ms: RG_OK, RG_EDOSE (over
+     * the limit: message with the fraction) or RG_EINVAL (no dose keys, a
+     * wavelength outside 400-700 nm).  d filled in every case it can be. */
+    int (*dose_plan)(const rg_machine *m, double ms, long n, rg_dose *d, char *err,
+                     size_t cap);
+    /* The same from a rig alone (no session). */
+    int (*dose_rig)(const rg_rig *rig, double ms, long n, rg_dose *d, char *err,
+                    size_t cap);
+    /* MPE at the cornea (J/m^2) for a small source, wavelength nm, duration s: IEC
+     * 60825-1:2014 Table A.1 (see rg_dose.c); NAN outside 400-700 nm or t < 18 us. */
+    double (*mpe)(double wavelength_nm, double t, const char **limit);
 } rig_api;
 
 typedef const rig_api *(*rig_get_api_fn)(int abi);

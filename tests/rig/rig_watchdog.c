@@ -5,7 +5,9 @@
  * the pump: light = laser line active and a toggle seen within the hold time.  When
  * the simulated process is gone it waits for the pump to run down and reports:
  *     seen_light=1 line_after=1 light_after=0 off_ms=5.1
- * (off_ms: from the last toggle seen to the light going off).  Usage:
+ * (off_ms: from the last toggle seen to the light going off; the hold is the one the
+ * simulator wrote from the rig file, pump=0 when it has no heartbeat line: then the
+ * light stays as the laser line left it and is reported at once).  Usage:
  *     rig_watchdog STATEFILE [SECONDS]          exit 0 report printed, 1 timeout */
 #define _GNU_SOURCE
 #include <fcntl.h>
@@ -52,14 +54,16 @@ int main(int argc, char **argv)
         double t = now_ms();
         hold = sh->timeout_ns / 1e6;        /* set just after the file appears */
         if (sh->heartbeat_edges != edges) { edges = sh->heartbeat_edges; last_edge = t; }
-        light = sh->laser && t - last_edge <= hold;
+        /* no pump (no heartbeat line): nothing cuts the light but the laser line */
+        light = sh->laser && (!sh->pump || t - last_edge <= hold);
         seen |= light;
         if (!gone && kill(sh->pid, 0) && errno == ESRCH) gone = 1;
-        if (gone && !light) { off_at = t; break; }
+        if (gone && (!light || !sh->pump)) { off_at = t; break; }
         usleep(100);
     }
     if (off_at < 0) { printf("watchdog: timed out\n"); return 1; }
-    printf("seen_light=%d line_after=%d light_after=%d off_ms=%.2f hold_ms=%.2f\n", seen,
-           (int)sh->laser, light, last_edge > 0 ? off_at - last_edge : -1, hold);
+    printf("seen_light=%d line_after=%d light_after=%d off_ms=%.2f hold_ms=%.2f pump=%d\n",
+           seen, (int)sh->laser, light, last_edge > 0 ? off_at - last_edge : -1, hold,
+           (int)sh->pump);
     return 0;
 }

@@ -8,9 +8,23 @@ cd /data || exit 1
 export LD_LIBRARY_PATH=/data/vmlibs LENSMAT_LIBDIR=/data
 fails=0
 ok() { if [ "$1" = 0 ]; then echo "PASS $2"; else echo "FAIL $2"; fails=$((fails+1)); fi; }
+# The home switches as a model of real ones: tripped 1 s in (the seek reaches them),
+# released when DIR of m1a (line 6) turns away from home (the pull-off), tripped again
+# 50 ms after it turns back (the slow locate), released at the second pull-off.
+hs() { for j in 18 19 20 21 22 23; do echo "$1" > $GPIO_SIM/sim_gpio$j/pull; done; }
+switches() {
+    sleep 1; hs pull-up; phase=0; n=0
+    while [ $phase -lt 3 ] && [ $n -lt 20000 ]; do
+        d=$(cat $GPIO_SIM/sim_gpio6/value); n=$((n+1))
+        if [ $phase = 0 ] && [ "$d" = 1 ]; then hs pull-down; phase=1
+        elif [ $phase = 1 ] && [ "$d" = 0 ]; then usleep 50000; hs pull-up; phase=2
+        elif [ $phase = 2 ] && [ "$d" = 1 ]; then hs pull-down; phase=3; fi
+        usleep 1000
+    done
+}
 run() {   # run REC: the session, answers from the file 'answers'
     for j in 18 19 20 21 22 23; do echo pull-down > $GPIO_SIM/sim_gpio$j/pull; done
-    ( sleep 1; for j in 18 19 20 21 22 23; do echo pull-up > $GPIO_SIM/sim_gpio$j/pull; done ) &
+    switches &                      # the home switches as a model (GRBL homing)
     ./lensmat --rig -i answers "$1" > out 2> err; rc=$?
     wait
     return $rc
