@@ -103,7 +103,19 @@ typedef struct sc_scene {
     int named_wl;             /* some source names its wavelengths: outputs carry a
                                  wavelength column, the trace runs once per wavelength */
     char mismatch_where[256]; /* the first such pair: "FILE:LINE and FILE:LINE" ... */
+    int out_format[3];        /* segments, hits, summary: scene_out.h's so_format
+                                 (0: from the file name: .npy, .h5/.hdf5, else text);
+                                 HDF5 outputs that name one file share it */
 } sc_scene;
+
+/* An output's format: `output KIND FILE [csv|csv17|npy|h5]`, else from FILE's name. */
+typedef enum {
+    SC_OUT_AUTO,     /* from the file name: .npy, .h5/.hdf5, else text */
+    SC_OUT_TEXT,     /* hits: CSV, shortest round-trip numbers; segments: the p.l text */
+    SC_OUT_CSV17,    /* hits: the CSV of before ("%.17g"), byte for byte */
+    SC_OUT_NPY,      /* NumPy .npy structured array */
+    SC_OUT_H5        /* HDF5: /hits, /segments, /summary */
+} sc_out_format;
 
 /* One ray as the sources emit it. */
 typedef struct sc_ray {
@@ -182,7 +194,7 @@ typedef struct sc_tess_row {
  * without refinement, with analytic normals, with full re-intersection. */
 int sc_tess_table(const sc_tess_spec *spec, sc_tess_row *rows, char *err);
 
-#define SC_API_ABI 1
+#define SC_API_ABI 2
 #define SC_API_SYMBOL "lm_scene_api"
 typedef struct scene_api {
     int abi;

@@ -9,6 +9,7 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include "scene.h"
+#include "scene_out.h"
 
 /* ---- files -------------------------------------------------------------------- */
 
@@ -129,6 +130,14 @@ static int clash(const sc_scene *sc, const char *what, const char *out, const ch
     return bad ? -1 : 0;
 }
 
+/* Outputs i and j are tables of one HDF5 file (the same name, both HDF5): allowed. */
+static int h5_shared(const sc_scene *sc, int i, int j)
+{
+    const char *out[3] = {sc->out_segments, sc->out_hits, sc->out_summary};
+    return sc->out_format[i] == SC_OUT_H5 && sc->out_format[j] == SC_OUT_H5 &&
+           strcmp(out[i], out[j]) == 0;
+}
+
 /* Every output (and its .part) against the scene file, its mesh and media files and
  * the other outputs, before anything is opened for writing. */
 static int outputs_over_inputs(const sc_scene *sc, const char *path, char *err)
@@ -139,7 +148,7 @@ static int outputs_over_inputs(const sc_scene *sc, const char *path, char *err)
         if (!out[i]) continue;
         if (clash(sc, what[i], out[i], path, "the scene file", err)) return -1;
         for (int j = 0; j < i; j++)
-            if (out[j] && (clash(sc, what[i], out[i], out[j], "output", err) ||
+            if (out[j] && !h5_shared(sc, i, j) && (clash(sc, what[i], out[i], out[j], "output", err) ||
                            clash(sc, what[j], out[j], out[i], "output", err)))
                 return -1;
         for (int k = 0; k < sc->nsurf; k++) {

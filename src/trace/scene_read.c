@@ -13,6 +13,7 @@
 #include <strings.h>
 #include "paraxial/paraxial.h"
 #include "scene_int.h"
+#include "scene_out.h"
 
 #define PI 3.14159265358979323846
 
@@ -558,7 +559,7 @@ static int read_source(reader *r, sc_scene *sc)
 }
 
 /* depth N / cutoff X / threads N / escape L / fresnel on|off / reflections on|off /
- * output segments|hits|summary FILE */
+ * output segments|hits|summary|all FILE [csv|csv17|npy|h5] */
 static int read_setting(reader *r, sc_scene *sc)
 {
     double v;
@@ -567,15 +568,37 @@ static int read_setting(reader *r, sc_scene *sc)
     if (sl_tok_is(d, "output")) {
         static const char *const what[] = {"segments", "hits", "summary"};
         char **slot[] = {&sc->out_segments, &sc->out_hits, &sc->out_summary};
-        if (r->nt != 3)
-            return sl_fail(r, "output: expected 'output segments|hits|summary FILE'");
+        sc_out_format f = SC_OUT_AUTO;
+        int all = r->nt >= 2 && sl_tok_is(&r->t[1], "all");
+        if (r->nt != 3 && r->nt != 4)
+            return sl_fail(r, "output: expected 'output segments|hits|summary|all FILE "
+                           "[csv|csv17|npy|h5]'");
+        if (r->nt == 4 && so_format_keyword(r->t[3].s, r->t[3].n, &f))
+            return sl_fail(r, "output: '%.*s' is not a format (csv, csv17, npy, h5)",
+                           (int)(r->t[3].n < 24 ? r->t[3].n : 24), r->t[3].s);
+        if (all) {   /* one HDF5 file with every table */
+            for (int i = 0; i < 3; i++) {
+                if (*slot[i]) return sl_fail(r, "output %s given twice", what[i]);
+                if (!(*slot[i] = tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
+                sc->out_format[i] = SC_OUT_H5;
+            }
+            if (so_format_of(sc->out_summary, f) != SC_OUT_H5)
+                return sl_fail(r, "output all: the tables go together in one HDF5 file "
+                               "(FILE.h5 or FILE.hdf5, or the keyword h5)");
+            return 0;
+        }
         for (int i = 0; i < 3; i++)
             if (sl_tok_is(&r->t[1], what[i])) {
                 if (*slot[i]) return sl_fail(r, "output %s given twice", what[i]);
                 if (!(*slot[i] = tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
+                sc->out_format[i] = (int)so_format_of(*slot[i], f);
+                if (i == 2 && sc->out_format[i] != SC_OUT_TEXT && sc->out_format[i] != SC_OUT_H5)
+                    return sl_fail(r, "output summary: text or h5");
+                if (i == 0 && sc->out_format[i] == SC_OUT_CSV17)
+                    return sl_fail(r, "output segments: csv17 is a hits format");
                 return 0;
             }
-        return sl_fail(r, "output: '%.*s' is not segments, hits or summary",
+        return sl_fail(r, "output: '%.*s' is not segments, hits, summary or all",
                     (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
     }
     if (sl_tok_is(d, "mismatch")) {

@@ -1,0 +1,189 @@
+# t_69_trace_out.sh -- the tracer's record outputs (src/trace/scene_out.c, issue 23):
+# hits as CSV with the shortest numbers that read back to the same doubles, as NumPy
+# .npy and as HDF5 (one file with /hits, /segments, /summary).  Every file is read
+# back by other programs (Python's float(), NumPy, h5py) and compared against the
+# CSV of before (keyword csv17: "%.17g", which reads back exactly): every double must
+# come back to the bit.  The CSV's numbers must also be the shortest that do (as
+# short as Python's repr, an independent shortest-digits algorithm).  The example
+# scene's csv17 output must be the bytes the tracer wrote before this format existed
+# (golden/trace/scenes.sha256 holds the sums of both).
+
+cd "$TOP" || return 1
+TO=$WORK/traceout
+mkdir -p "$TO"
+# a Python with NumPy and h5py (a pyenv shim may hide the system's)
+TOPY=
+for p in python3 /usr/bin/python3; do
+    "$p" -c 'import numpy, h5py' 2>/dev/null && { TOPY=$p; break; }
+done
+
+# to_trace NAME SCENE-FILE...: copy the example scenes to $TO/NAME, trace SCENE there
+to_trace() {
+    wd=$TO/$1; rm -rf "$wd"; mkdir -p "$wd"
+    cp "$TOP"/scenes/* "$wd/"
+    trace_session "$BIN" "$wd" scene "$2" n || { cat "$wd/err"; return 1; }
+}
+
+# The prism scene (TIR, 291 hits, 1649 segments) four ways: csv17, CSV, .npy, HDF5 (all)
+to_scenes() {
+    s=$TOP/scenes/prism.scene
+    grep -v '^output' "$s" > "$TO/base"
+    { cat "$TO/base"; echo "output hits h17.csv csv17"; echo "output segments s.l"
+      echo "output summary s.sum"; } > "$TO/p17.scene"
+    { cat "$TO/base"; echo "output hits h.csv"; } > "$TO/pcsv.scene"
+    { cat "$TO/base"; echo "output hits h.npy"; echo "output segments s.npy"; } > "$TO/pnpy.scene"
+    { cat "$TO/base"; echo "output all all.h5"; } > "$TO/ph5.scene"
+    # a scene that names wavelengths: the lambda_nm column
+    { echo "plane refract 1 N-BK7 at 0 0 0 normal 0 0 1 disc 8"
+      echo "plane refract N-BK7 1 at 0 0 10 normal 0 -0.5 0.8660254037844386 disc 8"
+      echo "plane detect at 0 0 60 normal 0 0 1 rect 400 400"
+      echo "source collimated from 0 0 -5 dir 0 0 1 radius 2 grid 5 lambda F d C"
+      echo "reflections off" ; } > "$TO/wbase"
+    { cat "$TO/wbase"; echo "output hits w17.csv csv17"; } > "$TO/w17.scene"
+    { cat "$TO/wbase"; echo "output hits w.csv"; echo "output segments ws.l"; } > "$TO/wcsv.scene"
+    { cat "$TO/wbase"; echo "output hits w.npy"; echo "output segments ws.npy"; } > "$TO/wnpy.scene"
+    { cat "$TO/wbase"; echo "output all w.hdf5"; } > "$TO/wh5.scene"
+    for sn in p17 pcsv pnpy ph5 w17 wcsv wnpy wh5; do
+        mkdir -p "$TO/$sn"; cp "$TOP"/scenes/prism.obj "$TO/$sn/"; mv "$TO/$sn.scene" "$TO/$sn/s.scene"
+        trace_session "$BIN" "$TO/$sn" scene s.scene n || { echo "$sn:"; cat "$TO/$sn/err"; return 1; }
+    done
+}
+check "trace out: the prism and a three-wavelength prism traced with csv17, CSV, .npy and HDF5 outputs" to_scenes
+
+# CSV: the same doubles as csv17, to the bit, and the shortest digits
+to_csv() {
+    "${TOPY:-python3}" - "$TO/p17/h17.csv" "$TO/pcsv/h.csv" "$TO/w17/w17.csv" "$TO/wcsv/w.csv" <<'EOF'
+import sys, struct
+def bits(x): return struct.pack('<d', x)
+def digits(s):   # significant digits of a decimal string
+    m = s.lower().split('e')[0].lstrip('-').replace('.', '').lstrip('0').rstrip('0')
+    return len(m) or 1
+for ref, new in ((sys.argv[1], sys.argv[2]), (sys.argv[3], sys.argv[4])):
+    a = open(ref).read().splitlines(); b = open(new).read().splitlines()
+    assert a[0] == b[0], "header differs: %r %r" % (a[0], b[0])
+    assert len(a) == len(b) and len(a) > 10, "rows: %d %d" % (len(a), len(b))
+    n = shorter = 0
+    for x, y in zip(a[1:], b[1:]):
+        xs, ys = x.split(','), y.split(',')
+        assert len(xs) == len(ys)
+        for i, (u, v) in enumerate(zip(xs, ys)):
+            if i < 4: assert u == v, (u, v); continue     # integers: the same text
+            assert bits(float(u)) == bits(float(v)), "%s reads back as %r, not %r" % (v, float(v), float(u))
+            if a[0].endswith('lambda_nm') and i == len(xs) - 1: continue  # %.10g, as before
+            r = repr(float(v))
+            assert digits(v) == digits(r), "%s: %d digits, repr %s has %d" % (v, digits(v), r, digits(r))
+            shorter += len(v) < len(u); n += 1
+    print("%s: %d values read back to the bit, %d shorter than %%.17g; %d vs %d bytes" %
+          (new, n, shorter, len(open(new).read()), len(open(ref).read())))
+    assert shorter > 0 and len(open(new).read()) < len(open(ref).read())
+EOF
+}
+check "trace out: CSV hits are the csv17 doubles to the bit, in the fewest digits (Python float and repr)" to_csv
+
+# .npy: NumPy reads the CSV's columns with their names, the same doubles and integers
+to_npy() {
+    [ -n "$TOPY" ] || { echo "no python3 with numpy and h5py"; return 1; }
+    "$TOPY" - "$TO" <<'EOF'
+import sys, struct, numpy as np
+d = sys.argv[1]
+def rows(path):
+    t = open(path).read().splitlines()
+    return t[0].split(','), [r.split(',') for r in t[1:]]
+for csv, npy in (("p17/h17.csv", "pnpy/h.npy"), ("w17/w17.csv", "wnpy/w.npy")):
+    head, r = rows(d + "/" + csv)
+    a = np.load(d + "/" + npy)
+    assert list(a.dtype.names) == head, (a.dtype.names, head)
+    assert a.shape == (len(r),), (a.shape, len(r))
+    for j, name in enumerate(head):
+        col = a[name]
+        if j < 4:
+            assert [int(x[j]) for x in r] == col.tolist(), name
+        else:
+            want = np.array([float(x[j]) for x in r])
+            assert col.dtype == np.float64 and (col.view(np.uint64) == want.view(np.uint64)).all(), name
+    print("%s: %d rows x %d columns, every value the csv17 one" % (npy, len(r), len(head)))
+# segments: the p.l text's points ("%.10g") within its rounding, in order
+def pl(path, k):
+    v = [list(map(float, l.split())) for l in open(path) if l.strip()]
+    return np.array([a[:3] + b[:3] + a[3:] for a, b in zip(v[0::2], v[1::2])])
+for text, npy, k in (("p17/s.l", "pnpy/s.npy", 6), ("wcsv/ws.l", "wnpy/ws.npy", 7)):
+    want = pl(d + "/" + text, k)
+    a = np.load(d + "/" + npy)
+    got = np.stack([a[n] for n in a.dtype.names], axis=1)
+    assert got.shape == want.shape, (got.shape, want.shape)
+    err = np.abs(got - want) / np.maximum(np.abs(want), 1e-300)
+    assert ((np.abs(got - want) <= 1e-12) | (err <= 5.1e-10)).all(), err.max()
+    print("%s: %d segments, within %%.10g of %s" % (npy, len(a), text))
+EOF
+}
+check "trace out: .npy hits and segments read by NumPy: the CSV's columns, every double exact" to_npy
+
+# HDF5: h5py reads /hits and /segments (the .npy tables, bit for bit) and /summary
+# (the text summary's numbers)
+to_h5() {
+    [ -n "$TOPY" ] || { echo "no python3 with numpy and h5py"; return 1; }
+    "$TOPY" - "$TO" <<'EOF'
+import sys, numpy as np, h5py
+d = sys.argv[1]
+for h5, hn, sn in (("ph5/all.h5", "pnpy/h.npy", "pnpy/s.npy"), ("wh5/w.hdf5", "wnpy/w.npy", "wnpy/ws.npy")):
+    f = h5py.File(d + "/" + h5, "r")
+    assert sorted(f.keys()) == ["hits", "segments", "summary"], list(f.keys())
+    for name, npy in (("hits", hn), ("segments", sn)):
+        a, b = np.load(d + "/" + npy), f[name][()]
+        assert a.dtype.names == b.dtype.names and a.shape == b.shape, name
+        for c in a.dtype.names:
+            assert (a[c] == b[c]).all() and a[c].tobytes() == b[c].tobytes(), (name, c)
+    print("%s: /hits %d rows, /segments %d rows, as the .npy files" % (h5, len(f["hits"]), len(f["segments"])))
+# /summary against the csv17 run's text summary
+s = {}
+for line in open(d + "/p17/s.sum"):
+    k, v = line.split()[:2]
+    s[k] = v
+at = h5py.File(d + "/ph5/all.h5", "r")["summary"].attrs
+assert at["scene"] == "s.scene", at["scene"]
+for k, v in s.items():
+    if k == "scene": continue
+    if k == "balance_error": assert abs(float(at[k]) - float(v)) <= 1e-3 * abs(float(v)) + 1e-300; continue
+    assert k in at, k
+    assert (int(v) == int(at[k])) if "." not in v and "e" not in v else float(v) == float(at[k]), (k, v, at[k])
+print("/summary: %d values as the text summary" % (len(s) - 1))
+w = h5py.File(d + "/wh5/w.hdf5", "r")["summary/wavelengths"][()]
+assert sorted(w["wavelength_nm"].tolist()) == [486.1327, 587.5618, 656.2725], w["wavelength_nm"]
+assert w["rays"].sum() == h5py.File(d + "/wh5/w.hdf5", "r")["summary"].attrs["rays"]
+print("/summary/wavelengths:", w["wavelength_nm"].tolist())
+EOF
+}
+check "trace out: one HDF5 file (output all) read by h5py: /hits, /segments as the .npy, /summary as the text" to_h5
+
+# the keyword wins over the name; unknown keywords and `all` to a non-HDF5 file refused
+to_bad() {
+    wd=$TO/bad; rm -rf "$wd"; mkdir -p "$wd"
+    printf '%s\n' "plane detect at 0 0 5 normal 0 0 1 disc 5" "source ray from 0 0 0 dir 0 0 1" \
+        "output hits h.dat npy" > "$wd/s.scene"
+    trace_session "$BIN" "$wd" scene s.scene n || { cat "$wd/err"; return 1; }
+    "${TOPY:-python3}" -c "import numpy; a = numpy.load('$wd/h.dat'); assert a.shape == (1,) and a['z'][0] == 5" ||
+        { echo "h.dat (keyword npy) is not a .npy"; return 1; }
+    for bad in "output hits h.csv xls:'xls' is not a format" \
+               "output all a.csv:the tables go together in one HDF5 file" \
+               "output summary s.npy:output summary: text or h5"; do
+        line=${bad%%:*}; msg=${bad#*:}
+        printf '%s\n' "plane detect at 0 0 5 normal 0 0 1 disc 5" "source ray from 0 0 0 dir 0 0 1" \
+            "$line" > "$wd/s.scene"
+        (cd "$wd" && printf 'scene\ns.scene\n' | "$BIN" --trace -i /dev/stdin r2.rec > out 2> err)
+        grep -q "s.scene:3: .*$msg" "$wd/out" "$wd/err" ||
+            { echo "'$line' not refused with '$msg':"; cat "$wd/out" "$wd/err"; return 1; }
+    done
+}
+check "trace out: a format keyword overrides the name; a bad keyword, 'all' to a CSV, a .npy summary refused" to_bad
+
+# csv17 keeps the bytes of before: the example prism's hits through csv17 against the
+# sum recorded by the tracer before this change (golden/trace/old_csv17.sha256)
+to_old_bytes() {
+    wd=$TO/old; rm -rf "$wd"; mkdir -p "$wd"; cp "$TOP"/scenes/* "$wd/"
+    sed 's/^output hits prism-hits.csv$/output hits prism-hits.csv csv17/' "$TOP/scenes/prism.scene" > "$wd/prism.scene"
+    trace_session "$BIN" "$wd" scene prism.scene n || { cat "$wd/err"; return 1; }
+    want=b188caf8745ab7f236074244561fab21384890bda10d44b3a25efcebc6d1ccad   # before issue 23
+    [ "$(sha256sum < "$wd/prism-hits.csv" | cut -d' ' -f1)" = "$want" ] ||
+        { echo "csv17 is not the CSV of before"; return 1; }
+}
+check "trace out: csv17 writes the prism's hits byte for byte as the tracer did before" to_old_bytes
