@@ -187,3 +187,85 @@ to_old_bytes() {
         { echo "csv17 is not the CSV of before"; return 1; }
 }
 check "trace out: csv17 writes the prism's hits byte for byte as the tracer did before" to_old_bytes
+
+# ---- closed solids of plane faces (issue 18) -------------------------------------
+# A right-angle prism of three `plane refract` faces (legs z = 0 and y = 0, 10 mm,
+# hypotenuse y + z = 10) and a cube of six: faces that meet along their edges bound a
+# solid and are traced; planes that cross inside both apertures are still refused.
+# Expected values from the closed forms, computed here with awk.
+S2=0.7071067811865476
+to_prism() {   # NAME THETA_DEG N: a ray tilted by THETA in the y-z plane onto leg z = 0
+    wd=$TO/$1; rm -rf "$wd"; mkdir -p "$wd"
+    d=$(awk -v t="$2" 'BEGIN { a = t * atan2(0, -1) / 180; printf "0 %.17g %.17g", sin(a), cos(a) }')
+    printf '%s\n' "plane refract 1 $3 at 0 5 0 normal 0 0 1 rect 10 10 up 0 1 0" \
+        "plane refract $3 1 at 0 0 5 normal 0 -1 0 rect 10 10 up 0 0 1" \
+        "plane refract $3 1 at 0 5 5 normal 0 $S2 $S2 rect 10 14.142135623730951 up 0 $S2 -$S2" \
+        "plane detect at 0 -20 5 normal 0 -1 0 rect 200 200" \
+        "source ray from 0 3 -5 dir $d" "reflections off" \
+        "output hits h.csv" "output summary s.sum" > "$wd/p.scene"
+    trace_session "$BIN" "$wd" scene p.scene n || { cat "$wd/err"; return 1; }
+}
+# the tilt at which the ray meets the hypotenuse at the critical angle:
+# inside angle t' = 45 deg - asin(1/n), outside asin(n sin t')
+prism_crit() { awk -v n="$1" 'BEGIN { pi = atan2(0, -1); c = atan2(1 / n, sqrt(1 - 1 / (n * n)))
+    s = n * sin(pi / 4 - c); printf "%.12f\n", atan2(s, sqrt(1 - s * s)) * 180 / pi }'; }
+to_tir() {
+    for pn in 1.5 1.7; do
+        tc=$(prism_crit $pn)
+        for dt in -0.05 0.05; do
+            t=$(awk -v a="$tc" -v b="$dt" 'BEGIN { printf "%.12f", a + b }')
+            to_prism "tir$pn$dt" "$t" "$pn" || return 1
+            tir=$(awk '$1 == "tir" { print $2 }' "$TO/tir$pn$dt/s.sum")
+            want=$(awk -v d="$dt" 'BEGIN { print (d < 0 ? 1 : 0) }')
+            [ "$tir" = "$want" ] || { echo "n $pn, tilt $t (critical $tc): $tir TIR, want $want"; return 1; }
+            [ "$want" = 1 ] || continue
+            # totally reflected: out along the input mirrored in the hypotenuse,
+            # (0, -cos t, -sin t), a deviation of 90 + 2t degrees
+            awk -F, -v t="$t" 'NR == 2 { pi = atan2(0, -1); a = t * pi / 180
+                e = ($8 - 0) ^ 2 + ($9 + cos(a)) ^ 2 + ($10 + sin(a)) ^ 2
+                dev = atan2(sqrt(1 - (sin(a) * $9 + cos(a) * $10) ^ 2), sin(a) * $9 + cos(a) * $10) * 180 / pi
+                printf "tilt %.6f deg: deviation %.12f deg (closed form %.12f), direction error %.2g\n", t, dev, 90 + 2 * t, sqrt(e)
+                ok = sqrt(e) < 1e-12 && (dev - 90 - 2 * t) ^ 2 < 1e-18 } END { exit !ok }' "$TO/tir$pn$dt/h.csv" || return 1
+        done
+        echo "n $pn: critical tilt $tc deg: TIR below it, none above"
+    done
+}
+check "trace out: a right-angle prism of three plane faces: TIR on the closed form's side of the critical angle, deviation 90 + 2t" to_tir
+
+to_cube() {
+    wd=$TO/cube; rm -rf "$wd"; mkdir -p "$wd"
+    printf '%s\n' "plane refract 1 1.5 at 0 0 0 normal 0 0 1 rect 10 10" \
+        "plane refract 1.5 1 at 0 0 10 normal 0 0 1 rect 10 10" \
+        "plane refract 1 1.5 at -5 0 5 normal 1 0 0 rect 10 10" \
+        "plane refract 1.5 1 at 5 0 5 normal 1 0 0 rect 10 10" \
+        "plane refract 1 1.5 at 0 -5 5 normal 0 1 0 rect 10 10" \
+        "plane refract 1.5 1 at 0 5 5 normal 0 1 0 rect 10 10" \
+        "plane detect at 0 0 30 normal 0 0 1 rect 200 200" \
+        "source ray from -2 1 -5 dir 0.3 0.2 1" "reflections off" \
+        "output hits h.csv" "output summary s.sum" > "$wd/c.scene"
+    trace_session "$BIN" "$wd" scene c.scene n || { cat "$wd/err"; return 1; }
+    # Snell at z = 0 (tangential components / n), straight to z = 10, out parallel
+    awk -F, 'NR == 2 { n = 1.5; l = sqrt(0.09 + 0.04 + 1); dx = 0.3 / l; dy = 0.2 / l; dz = 1 / l
+        x1 = -2 + dx * 5 / dz; y1 = 1 + dy * 5 / dz; L1 = 5 / dz
+        ex = dx / n; ey = dy / n; ez = sqrt(1 - ex * ex - ey * ey)
+        x2 = x1 + ex * 10 / ez; y2 = y1 + ey * 10 / ez; L2 = 10 / ez
+        x3 = x2 + dx * 20 / dz; y3 = y2 + dy * 20 / dz; L3 = 20 / dz
+        e = ($8 - dx) ^ 2 + ($9 - dy) ^ 2 + ($10 - dz) ^ 2; p = ($5 - x3) ^ 2 + ($6 - y3) ^ 2
+        o = $15 - (L1 + n * L2 + L3)
+        printf "out (%.17g %.17g %.17g), in (%.17g %.17g %.17g): error %.2g; position error %.2g, opl error %.2g\n", $8, $9, $10, dx, dy, dz, sqrt(e), sqrt(p), o
+        ok = sqrt(e) < 1e-12 && sqrt(p) < 1e-9 && o * o < 1e-18 } END { exit !ok }' "$wd/h.csv"
+}
+check "trace out: a cube of six plane faces: the transmitted ray leaves parallel, displaced and delayed as Snell says" to_cube
+
+to_crossing() {
+    wd=$TO/cross; rm -rf "$wd"; mkdir -p "$wd"
+    for geo in "at 0 0 5 normal 0 $S2 $S2 rect 10 10:at 0 0 5 normal 0 $S2 -$S2 rect 10 10" \
+               "at 0 0 5 normal 0 0 1 disc 5:at 0 0 5 normal 0 1 0 rect 10 10"; do
+        printf '%s\n' "plane refract 1 1.5 ${geo%%:*}" "plane refract 1.5 1 ${geo#*:}" \
+            "plane detect at 0 0 30 normal 0 0 1 disc 50" "source ray from 0 0 -5 dir 0 0 1" > "$wd/x.scene"
+        (cd "$wd" && printf 'scene\nx.scene\n' | "$BIN" --trace -i /dev/stdin r.rec > out 2> err)
+        grep -q "x.scene:2: this refracting plane crosses the one of line 1 inside both their apertures" "$wd/out" "$wd/err" ||
+            { echo "not refused: ${geo}"; cat "$wd/out" "$wd/err"; return 1; }
+    done
+}
+check "trace out: refracting planes that cross inside both apertures (an X, a disc through a square) are still refused" to_crossing

@@ -103,9 +103,9 @@ typedef struct sc_scene {
     int named_wl;             /* some source names its wavelengths: outputs carry a
                                  wavelength column, the trace runs once per wavelength */
     char mismatch_where[256]; /* the first such pair: "FILE:LINE and FILE:LINE" ... */
-    int out_format[3];        /* segments, hits, summary: scene_out.h's so_format
-                                 (0: from the file name: .npy, .h5/.hdf5, else text);
-                                 HDF5 outputs that name one file share it */
+    int out_format[3];        /* segments, hits, summary: sc_out_format (never
+                                 SC_OUT_AUTO once read); HDF5 outputs that name one
+                                 file are tables of that one file */
 } sc_scene;
 
 /* An output's format: `output KIND FILE [csv|csv17|npy|h5]`, else from FILE's name. */

@@ -9,7 +9,6 @@
 #include <strings.h>
 #include <sys/stat.h>
 #include "scene.h"
-#include "scene_out.h"
 
 /* ---- files -------------------------------------------------------------------- */
 

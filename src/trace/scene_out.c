@@ -26,38 +26,6 @@
 
 int sc_dtoa(double v, char *buf);   /* scene_dtoa.cpp */
 
-/* ---- formats ---------------------------------------------------------------------- */
-
-static int ends_with(const char *s, const char *tail)
-{
-    size_t n = strlen(s), m = strlen(tail);
-    if (n < m) return 0;
-    for (size_t i = 0; i < m; i++) {
-        char c = s[n - m + i];
-        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
-        if (c != tail[i]) return 0;
-    }
-    return 1;
-}
-
-sc_out_format so_format_of(const char *name, sc_out_format keyword)
-{
-    if (keyword != SC_OUT_AUTO) return keyword;
-    if (ends_with(name, ".npy")) return SC_OUT_NPY;
-    if (ends_with(name, ".h5") || ends_with(name, ".hdf5")) return SC_OUT_H5;
-    return SC_OUT_TEXT;
-}
-
-int so_format_keyword(const char *s, size_t n, sc_out_format *f)
-{
-    static const struct { const char *k; sc_out_format f; } kw[] = {
-        {"csv", SC_OUT_TEXT}, {"text", SC_OUT_TEXT}, {"csv17", SC_OUT_CSV17}, {"npy", SC_OUT_NPY},
-        {"h5", SC_OUT_H5}, {"hdf5", SC_OUT_H5}};
-    for (size_t i = 0; i < sizeof kw / sizeof kw[0]; i++)
-        if (strlen(kw[i].k) == n && memcmp(kw[i].k, s, n) == 0) return *f = kw[i].f, 0;
-    return -1;
-}
-
 /* ---- the tables' columns ---------------------------------------------------------- */
 
 /* One row of a binary table: every column at its natural alignment, no padding (the

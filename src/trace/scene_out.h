@@ -9,10 +9,6 @@
 #include "scene.h"
 
 
-sc_out_format so_format_of(const char *name, sc_out_format keyword);
-/* The keyword s[0..n) (csv, text, csv17, npy, h5, hdf5) into f: 0, or -1. */
-int so_format_keyword(const char *s, size_t n, sc_out_format *f);
-
 typedef struct so_table so_table;
 /* A hits (hits=1) or segments table in format fmt written to f (its header now;
  * nothing written to f for SC_OUT_H5: the rows are kept for so_h5_write); wl: with the
