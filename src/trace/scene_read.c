@@ -630,7 +630,7 @@ static int read_setting(reader *r, sc_scene *sc)
                     return sl_fail(r, "output segments: csv17 is a hits format");
                 return 0;
             }
-        return sl_fail(r, "output: '%.*s' is not segments, hits, summary or all",
+        return sl_fail(r, "output: '%.*s' is not segments, hits or summary (or all)",
                     (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
     }
     if (sl_tok_is(d, "mismatch")) {
