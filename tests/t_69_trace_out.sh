@@ -269,3 +269,37 @@ to_crossing() {
     done
 }
 check "trace out: refracting planes that cross inside both apertures (an X, a disc through a square) are still refused" to_crossing
+
+# ---- meshes: kept as shared vertices, refused before reading when they cannot fit --
+# A 300 x 300 quad grid (180 000 triangles, written here with awk) traced from its OBJ
+# (shared vertices) and from the same triangles as a triangle file (three vertex lines
+# each, the soup the OBJ reader made before): the same bytes out.  Under a 250 MB
+# address-space limit it is refused before it is read, with what it needs; with no
+# limit it traces.
+to_mesh_files() {
+    wd=$TO/mesh; rm -rf "$wd"; mkdir -p "$wd"
+    awk 'BEGIN { n = 300; for (i = 0; i <= n; i++) for (j = 0; j <= n; j++) printf "v %d %d %g\n", i, j, (i * j) % 7 * 0.01
+        for (i = 0; i < n; i++) for (j = 0; j < n; j++) { a = i * (n + 1) + j + 1; b = a + 1; c = a + n + 1; d = c + 1
+            printf "f %d %d %d\nf %d %d %d\n", a, b, d, a, d, c } }' > "$wd/grid.obj"
+    awk '$1 == "v" { v[++n] = $2 " " $3 " " $4 } $1 == "f" { print v[$2]; print v[$3]; print v[$4] }' "$wd/grid.obj" > "$wd/grid.t"
+    for m in obj t; do
+        printf '%s\n' "mesh refract 1 1.5 file grid.$m" "plane detect at 150 150 30 normal 0 0 1 disc 100" \
+            "source collimated from 150 150 -20 dir 0.1 0.05 1 radius 40 grid 30" \
+            "output hits h_$m.csv" "output segments s_$m.l" > "$wd/$m.scene"
+        trace_session "$BIN" "$wd/$m" scene ../$m.scene n || { cat "$wd/$m/err"; return 1; }
+    done
+    [ "$(wc -l < "$wd/obj/h_obj.csv")" -gt 100 ] || { echo "too few hits"; return 1; }
+    cmp "$wd/obj/h_obj.csv" "$wd/t/h_t.csv" && cmp "$wd/obj/s_obj.l" "$wd/t/s_t.l"
+}
+check "trace out: an OBJ kept as shared vertices traces to the bytes of its triangle soup (.t)" to_mesh_files
+
+to_mesh_limit() {
+    wd=$TO/mesh
+    [ -f "$wd/grid.obj" ] || { echo "no grid.obj"; return 1; }
+    (cd "$wd" && ulimit -v 250000 && printf 'scene\nobj.scene\n' | "$BIN" --trace -i /dev/stdin r2.rec > lim.out 2> lim.err)
+    rc=$?
+    [ $rc -eq 2 ] || { echo "exit $rc under ulimit -v 250000"; cat "$wd/lim.out" "$wd/lim.err"; return 1; }
+    grep -q "obj.scene:1: .*grid.obj: 180000 triangles need about [0-9]* MB of address space to trace .*more than the [0-9]* MB left under the limit (ulimit -v): not read" "$wd/lim.out" "$wd/lim.err" ||
+        { echo "no refusal naming the need:"; cat "$wd/lim.out" "$wd/lim.err"; return 1; }
+}
+check "trace out: a mesh that cannot fit under the address-space limit is refused before it is read, saying what it needs" to_mesh_limit

@@ -8,6 +8,7 @@
 #ifndef SCENE_H
 #define SCENE_H
 #include <stddef.h>
+#include <stdint.h>
 #include "trace.h"
 
 enum sc_shape { SC_PLANE, SC_SPHERE, SC_CAP, SC_CONIC, SC_ASPHERE, SC_MESH };
@@ -50,6 +51,11 @@ typedef struct sc_surface {
     long ntri;
     double *tri;          /* 9 doubles per triangle */
     double *media;        /* 2 per triangle (n1 n2), or NULL */
+    /* an OBJ mesh keeps its shared vertices (tri is NULL): nvtx vertices of 3
+     * doubles, 3 indices a triangle (only the vertices its faces use, in order) */
+    double *vtx;
+    long nvtx;
+    uint32_t *idx;
     double sphere[4];     /* file mesh: underlying sphere cx cy cz r, r = 0: none */
     char *mesh_file, *media_file;
     const char *src;      /* defined at src:line (for messages) */
@@ -133,6 +139,10 @@ int  sc_parse_media(const char *text, size_t len, const char *name, long ntri,
                     double **media, char *err);
 int  sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
                   long *ntri, char *err);
+/* The same OBJ as shared vertices and indices (what scenes keep: 24 bytes a
+ * vertex and 12 a triangle instead of 72 a triangle). */
+int  sc_parse_obj_ix(const char *text, size_t len, const char *name, double **vtx,
+                     long *nvtx, uint32_t **idx, long *ntri, char *err);
 /* Validate triangles (finite, non-degenerate): 0 or -1 with the triangle's number. */
 int  sc_check_triangles(const double *tri, long ntri, const char *name, char *err);
 /* A whole scene file with its mesh and media files (scene_load.c): 0 or -1 (err

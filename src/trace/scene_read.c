@@ -739,6 +739,8 @@ void sc_free(sc_scene *sc)
 {
     for (int i = 0; i < sc->nsurf; i++) {
         free(sc->surf[i].tri);
+        free(sc->surf[i].vtx);
+        free(sc->surf[i].idx);
         free(sc->surf[i].media);
         free(sc->surf[i].mesh_file);
         free(sc->surf[i].media_file);

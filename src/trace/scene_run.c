@@ -225,8 +225,9 @@ static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s
         return set_alpha(tr, ts, tr->add_surface(ts, &an, &m), a1, a2, s, err);
     }
     memset(&mesh, 0, sizeof mesh);
-    mesh.vertex = s->tri;
-    mesh.nvertex = 3 * s->ntri;
+    mesh.vertex = s->idx ? s->vtx : s->tri;   /* an OBJ: its shared vertices */
+    mesh.nvertex = s->idx ? s->nvtx : 3 * s->ntri;
+    mesh.index = s->idx;
     mesh.ntri = s->ntri;
     mesh.media = s->media;
     if (s->shape != SC_MESH) {
