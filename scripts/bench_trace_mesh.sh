@@ -5,7 +5,8 @@
 # scene without the mesh; the peak resident memory of each lensmat process (getrusage
 # of the child: VmHWM) in the same run:
 #   trace_mesh_bytes_per_tri   (peak with the mesh - peak without) / triangles (<= 120)
-# BENCH_QUICK=1: 248 000 triangles.
+# Then tests/trace/bench_mesh.c: trace_mesh_vs_raw_embree (see there).
+# BENCH_QUICK=1: 248 000 triangles, smaller grids.
 set -e
 LM=$(pwd)/lensmat
 [ -x "$LM" ] && [ -f build/lib/lensmat-trace.so ] || { echo "bench_trace_mesh: lensmat or its trace module not built" >&2; exit 1; }
@@ -51,3 +52,9 @@ echo "# $nt triangles ($(($(wc -c < "$W/ball.obj") / 1048576)) MB OBJ): peak RSS
 awk -v e1="$e1" -v e2="$e2" -v m1="$m1" -v m2="$m2" -v n="$nt" 'BEGIN {
     e = e1 < e2 ? e1 : e2; m = m1 < m2 ? m1 : m2
     printf "BENCH trace_mesh_bytes_per_tri %.1f bytes\n", (m - e) * 1024 / n }'
+# the BVH path against bare Embree, per segment, on the scenes users trace
+# (tests/trace/bench_mesh.c: trace_mesh_vs_raw_embree and its _alone, _mirror, _tir,
+# _mix variants)
+B=build/obj/trace_tests/bench_mesh
+[ -x "$B" ] || { echo "bench_trace_mesh: $B not built (make bench builds it)" >&2; exit 1; }
+"$B" ${BENCH_QUICK:+quick}
