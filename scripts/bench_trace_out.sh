@@ -11,6 +11,10 @@
 #   trace_hits_h5_cost     the same for HDF5 (tables assembled in memory, written once)
 #   trace_hits_csv17_cost  the CSV of before, for comparison
 #   trace_hits_csv_mrays_per_s  rays/s with every hit written as CSV
+#   trace_hits_{csv,npy}_cpu_cost  the same ratios in CPU time of the whole lensmat
+#                          process (every thread: the writer's too; start and scene
+#                          read included, the same in both): what the output costs
+#                          in work, whatever else the machine is doing
 # BENCH_QUICK=1: a 400 x 400 grid.
 set -e
 LM=$(pwd)/lensmat
@@ -44,23 +48,27 @@ for k in none csv npy h5 csv17; do
     printf 'scene\n%s\nn\n' "$W/$k.scene" > "$W/in_$k"
 done
 
-# one lensmat run: the trace time in ms, the rays and hits
+# one lensmat run: the trace time in ms, the rays and hits, the process's CPU seconds
 run() {
-    (cd "$W" && "$LM" --trace -i "in_$1" r.rec > out && rm -f hits.* hits17.csv)
-    awk '/^Rays traced:/ { r = $3 + 0 } /^Detector hits:/ { h = $3 + 0 }
+    (cd "$W" && /usr/bin/time -f '%U %S' -o cpu "$LM" --trace -i "in_$1" r.rec > out &&
+     rm -f hits.* hits17.csv)
+    awk -v cpu="$(awk '{ print $1 + $2 }' "$W/cpu")" '/^Rays traced:/ { r = $3 + 0 } /^Detector hits:/ { h = $3 + 0 }
         /^Build .* rays\/s/ { s = $0; sub(/.*\(/, "", s); sub(/ rays.*/, "", s) }
-        END { if (!r || !s) exit 1; printf "%.6g %d %d\n", r / s * 1e3, r, h }' "$W/out"
+        END { if (!r || !s) exit 1; printf "%.6g %d %d %s\n", r / s * 1e3, r, h, cpu }' "$W/out"
 }
 for i in 1 2 3; do
     for k in none csv npy h5; do run $k >> "$W/t_$k"; done
 done
 run csv17 >> "$W/t_csv17"
-med() { cut -d' ' -f1 "$W/t_$1" | sort -g | sed -n "$(( ($(wc -l < "$W/t_$1") + 1) / 2 ))p"; }
-read -r _ rays hits < "$W/t_none"
-echo "# $rays rays, $hits hits; trace ms (medians): none $(med none), csv $(med csv), npy $(med npy), h5 $(med h5), csv17 $(med csv17)"
+med() { cut -d' ' -f"${2:-1}" "$W/t_$1" | sort -g | sed -n "$(( ($(wc -l < "$W/t_$1") + 1) / 2 ))p"; }
+read -r _ rays hits _ < "$W/t_none"
+echo "# $rays rays, $hits hits; trace ms (medians): none $(med none), csv $(med csv), npy $(med npy), h5 $(med h5), csv17 $(med csv17); process CPU s: none $(med none 4), csv $(med csv 4), npy $(med npy 4), csv17 $(med csv17 4)"
 awk -v n="$(med none)" -v c="$(med csv)" -v p="$(med npy)" -v h="$(med h5)" -v o="$(med csv17)" -v r="$rays" 'BEGIN {
     printf "BENCH trace_hits_csv_cost %.2f ratio\n", c / n
     printf "BENCH trace_hits_npy_cost %.2f ratio\n", p / n
     printf "BENCH trace_hits_h5_cost %.2f ratio\n", h / n
     printf "BENCH trace_hits_csv17_cost %.2f ratio\n", o / n
     printf "BENCH trace_hits_csv_mrays_per_s %.3f Mrays/s\n", r / c / 1e3 }'
+awk -v n="$(med none 4)" -v c="$(med csv 4)" -v p="$(med npy 4)" 'BEGIN {
+    printf "BENCH trace_hits_csv_cpu_cost %.2f ratio\n", c / n
+    printf "BENCH trace_hits_npy_cpu_cost %.2f ratio\n", p / n }'
