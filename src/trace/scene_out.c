@@ -544,7 +544,9 @@ int so_h5_write(FILE *f, const so_table *hits, const so_table *segs, const so_su
     /* in memory (no backing store): the image goes out through f */
     if ((fapl = H5Pcreate(H5P_FILE_ACCESS)) < 0 || H5Pset_fapl_core(fapl, 1 << 20, 0) < 0)
         return snprintf(err, errmax, "HDF5: cannot set up a file"), -1;
-    file = H5Fcreate("lensmat-trace.h5", H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    /* a name no file can have (HDF5 tries to open it even with no backing store:
+     * never a user's file) */
+    file = H5Fcreate("/dev/null/lensmat-trace-core.h5", H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
     H5Pclose(fapl);
     if (file < 0) return snprintf(err, errmax, "HDF5: cannot create a file"), -1;
     if (hits) rc |= h5_table(file, "hits", hits);
