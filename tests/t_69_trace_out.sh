@@ -155,6 +155,26 @@ EOF
 }
 check "trace out: one HDF5 file (output all) read by h5py: /hits, /segments as the .npy, /summary as the text" to_h5
 
+# HDF5 outputs in files of their own: hits in one, segments and summary in another
+to_h5_apart() {
+    [ -n "$TOPY" ] || { echo "no python3 with numpy and h5py"; return 1; }
+    wd=$TO/h5apart; rm -rf "$wd"; mkdir -p "$wd"; cp "$TOP"/scenes/prism.obj "$wd/"
+    { cat "$TO/base"; echo "output hits h.h5"; echo "output segments ss.hdf5"
+      echo "output summary ss.hdf5"; } > "$wd/s.scene"
+    trace_session "$BIN" "$wd" scene s.scene n || { cat "$wd/err"; return 1; }
+    "$TOPY" - "$wd" "$TO/pnpy" <<'EOF2'
+import sys, numpy as np, h5py
+d, n = sys.argv[1], sys.argv[2]
+h, s = h5py.File(d + "/h.h5", "r"), h5py.File(d + "/ss.hdf5", "r")
+assert list(h.keys()) == ["hits"] and sorted(s.keys()) == ["segments", "summary"], (list(h.keys()), list(s.keys()))
+assert h["hits"][()].tobytes() == np.load(n + "/h.npy").tobytes()
+assert s["segments"][()].tobytes() == np.load(n + "/s.npy").tobytes()
+assert s["summary"].attrs["hits"] == len(h["hits"])
+print("h.h5: /hits; ss.hdf5: /segments, /summary; the .npy bytes")
+EOF2
+}
+check "trace out: HDF5 tables in files of their own (hits apart, segments with the summary)" to_h5_apart
+
 # the keyword wins over the name; unknown keywords and `all` to a non-HDF5 file refused
 to_bad() {
     wd=$TO/bad; rm -rf "$wd"; mkdir -p "$wd"
