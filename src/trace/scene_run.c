@@ -228,6 +228,7 @@ static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s
     mesh.vertex = s->idx ? s->vtx : s->tri;   /* an OBJ: its shared vertices */
     mesh.nvertex = s->idx ? s->nvtx : 3 * s->ntri;
     mesh.index = s->idx;
+    mesh.shared = s->idx != NULL;   /* the scene's arrays outlive the engine's scene */
     mesh.ntri = s->ntri;
     mesh.media = s->media;
     if (s->shape != SC_MESH) {

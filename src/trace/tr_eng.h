@@ -21,6 +21,8 @@ typedef struct tr_surf {
     tr_shape shape;            /* analytic surface, or a mesh's underlying one */
     int has_under, refine;
     double *vtx;               /* mesh: nv*3 */
+    int shared;                /* mesh: vtx and idx are the caller's (trace_mesh.shared):
+                                  not freed here */
     uint32_t *idx;             /* mesh: ntri*3 */
     double *media;             /* mesh: ntri*2 or NULL */
     long nv, ntri;

@@ -95,8 +95,10 @@ void tr_scene_free(trace_scene *sc)
     if (!sc) return;
     drop_embree(sc);
     for (int i = 0; i < sc->nsurf; i++) {
-        free(sc->surf[i]->vtx);
-        free(sc->surf[i]->idx);
+        if (!sc->surf[i]->shared) {
+            free(sc->surf[i]->vtx);
+            free(sc->surf[i]->idx);
+        }
         free(sc->surf[i]->media);
         free(sc->surf[i]->weld);
         free(sc->surf[i]->vt_start);
@@ -275,8 +277,10 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     f->mat = *m;
     f->nv = nv;
     f->ntri = mesh->ntri;
-    f->vtx = malloc((size_t)nv * 3 * sizeof(double));
-    f->idx = malloc((size_t)f->ntri * 3 * sizeof(uint32_t));
+    f->shared = mesh->shared && mesh->index;   /* the caller's arrays, in place */
+    f->vtx = f->shared ? (double *)mesh->vertex : malloc((size_t)nv * 3 * sizeof(double));
+    f->idx = f->shared ? (uint32_t *)mesh->index
+                       : malloc((size_t)f->ntri * 3 * sizeof(uint32_t));
     if (mesh->media) f->media = malloc((size_t)f->ntri * 2 * sizeof(double));
     if (!f->vtx || !f->idx || (mesh->media && !f->media)) {
         rc = fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
@@ -296,7 +300,7 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
             rc = fail(sc, TRACE_EINVAL, msg);
             goto bad;
         }
-        f->vtx[i] = x;
+        if (!f->shared) f->vtx[i] = x;
         if (x < lo[i % 3]) lo[i % 3] = x;
         if (x > hi[i % 3]) hi[i % 3] = x;
     }
@@ -308,7 +312,7 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
             rc = fail(sc, TRACE_EINVAL, msg);
             goto bad;
         }
-        f->idx[i] = k;
+        if (!f->shared) f->idx[i] = k;
     }
     for (long i = 0; i < f->ntri; i++) {
         const double *a = f->vtx + 3 * f->idx[3 * i], *b = f->vtx + 3 * f->idx[3 * i + 1],
@@ -357,8 +361,10 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     drop_embree(sc);
     return f->id;
 bad:
-    free(f->vtx);
-    free(f->idx);
+    if (!f->shared) {
+        free(f->vtx);
+        free(f->idx);
+    }
     free(f->media);
     free(f->weld);
     free(f->vt_start);

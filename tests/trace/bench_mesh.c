@@ -144,7 +144,7 @@ static void add_grid(trace_scene *sc, double z, double radius, double y0, long a
 static trace_scene *mesh_scene(const tmesh *m, int kind, double n)
 {
     trace_scene *sc = tr->scene_new();
-    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0};
+    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0, 0};
     trace_material g = {kind, 1.0, n};
     if (tr->add_mesh(sc, &mesh, &g) < 0) { fprintf(stderr, "%s\n", tr->error(sc)); exit(1); }
     return sc;

@@ -76,7 +76,7 @@ static trace_scene *bvh_scene(tmesh *m)
 {
     tm_sphere(m, 1, 100);
     trace_scene *sc = tr->scene_new();
-    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0};
+    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0, 0};
     trace_material g = {TRACE_REFRACT, 1.0, 1.5};
     if (tr->add_mesh(sc, &mesh, &g) < 0) { fprintf(stderr, "%s\n", tr->error(sc)); exit(1); }
     trace_source src = {0};
