@@ -100,9 +100,18 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
 static void report_outputs(tdlg *t)
 {
     const sc_scene *sc = &t->scene;
-    if (sc->out_segments) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_segments, P(WRITTEN_SEGMENTS));
-    if (sc->out_hits) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_hits, P(WRITTEN_HITS));
-    if (sc->out_summary) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_summary, P(WRITTEN_SUMMARY));
+    const int *f = sc->out_format;   /* what each file holds, in its format */
+    if (sc->out_segments)
+        lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_segments, f[0] == SC_OUT_NPY ?
+               P(WRITTEN_SEGMENTS_NPY) : f[0] == SC_OUT_H5 ? P(WRITTEN_SEGMENTS_H5) :
+               P(WRITTEN_SEGMENTS));
+    if (sc->out_hits)
+        lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_hits, f[1] == SC_OUT_NPY ?
+               P(WRITTEN_HITS_NPY) : f[1] == SC_OUT_H5 ? P(WRITTEN_HITS_H5) :
+               P(WRITTEN_HITS));
+    if (sc->out_summary)
+        lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_summary, f[2] == SC_OUT_H5 ?
+               P(WRITTEN_SUMMARY_H5) : P(WRITTEN_SUMMARY));
 }
 
 static void report_summary(tdlg *t, const trace_summary *s)

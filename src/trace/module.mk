@@ -5,9 +5,18 @@
 # Everything in src/trace/*.c goes into the module; lensmat itself never links Embree.
 
 TRACE_SRC   := $(wildcard src/trace/*.c)
-TRACE_OBJ   := $(patsubst src/%.c,build/obj/%.o,$(TRACE_SRC))
-TRACE_SOBJ  := $(patsubst src/%.c,build/asan/%.o,$(TRACE_SRC))
-TRACE_LIBS  := -lembree3 -lm -pthread
+# The outputs' shortest numbers: libdouble-conversion (C++) behind one C function
+# (scene_dtoa.cpp); HDF5 outputs: libhdf5 (Debian's serial build, its own folders).
+TRACE_XSRC  := $(wildcard src/trace/*.cpp)
+TRACE_OBJ   := $(patsubst src/%.c,build/obj/%.o,$(TRACE_SRC)) \
+               $(patsubst src/%.cpp,build/obj/%.o,$(TRACE_XSRC))
+TRACE_SOBJ  := $(patsubst src/%.c,build/asan/%.o,$(TRACE_SRC)) \
+               $(patsubst src/%.cpp,build/asan/%.o,$(TRACE_XSRC))
+TRACE_H5INC  = $(shell pkg-config --cflags hdf5 2>/dev/null || echo -I/usr/include/hdf5/serial)
+TRACE_H5LIB  = $(shell pkg-config --libs hdf5 2>/dev/null || \
+                 echo -L/usr/lib/$$(gcc -print-multiarch)/hdf5/serial -lhdf5)
+TRACE_LIBS   = -lembree3 $(TRACE_H5LIB) -ldouble-conversion -lstdc++ -lm -pthread
+TRACE_CXX    = -std=c++17 $(WARN) -fPIC -fvisibility=hidden -ffp-contract=off
 TRACE_TESTS := $(wildcard tests/trace/t_*.c)
 TRACE_BENCH := $(wildcard tests/trace/bench_*.c)
 TRACE_TBIN  := $(patsubst tests/trace/%.c,build/obj/trace_tests/%,$(TRACE_TESTS)) \
@@ -41,10 +50,16 @@ build/obj/trace/tr_%.o: TRACE_XOPT := $(TRACE_HOT)
 # Module objects need -fPIC (the generic rules make position-independent executables).
 build/obj/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
-	$(CC) $(BASE) $(OPT) $(TRACE_XOPT) -fPIC -pthread -MMD -MP -c $< -o $@
+	$(CC) $(BASE) $(OPT) $(TRACE_XOPT) $(TRACE_H5INC) -fPIC -pthread -MMD -MP -c $< -o $@
 build/asan/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
-	$(CC) $(BASE) $(SAN) -fPIC -pthread -MMD -MP -c $< -o $@
+	$(CC) $(BASE) $(SAN) $(TRACE_H5INC) -fPIC -pthread -MMD -MP -c $< -o $@
+build/obj/trace/%.o: src/trace/%.cpp | $(DEPS)
+	@mkdir -p $(@D)
+	$(CXX) $(TRACE_CXX) $(OPT) -O3 -MMD -MP -c $< -o $@
+build/asan/trace/%.o: src/trace/%.cpp | $(DEPS)
+	@mkdir -p $(@D)
+	$(CXX) $(TRACE_CXX) $(SAN) -MMD -MP -c $< -o $@
 
 build/lib/lensmat-trace.so: $(TRACE_OBJ) $(TRACE_PXA)
 	@mkdir -p $(@D)
@@ -76,10 +91,14 @@ MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
 # checks its objects for AVX instructions.
 ifeq ($(shell uname -m),x86_64)
 TRACE_X86   := -O1 -march=x86-64 -mtune=generic
-TRACE_XOBJ  := $(patsubst src/%.c,build/x86-64/%.o,$(TRACE_SRC))
+TRACE_XOBJ  := $(patsubst src/%.c,build/x86-64/%.o,$(TRACE_SRC)) \
+               $(patsubst src/%.cpp,build/x86-64/%.o,$(TRACE_XSRC))
 build/x86-64/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
-	$(CC) $(BASE) $(TRACE_X86) -fPIC -pthread -MMD -MP -c $< -o $@
+	$(CC) $(BASE) $(TRACE_X86) $(TRACE_H5INC) -fPIC -pthread -MMD -MP -c $< -o $@
+build/x86-64/trace/%.o: src/trace/%.cpp | $(DEPS)
+	@mkdir -p $(@D)
+	$(CXX) $(TRACE_CXX) $(TRACE_X86) -MMD -MP -c $< -o $@
 build/x86-64/trace/px/%.o: src/paraxial/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(TRACE_X86) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@

@@ -8,6 +8,7 @@
 #ifndef SCENE_H
 #define SCENE_H
 #include <stddef.h>
+#include <stdint.h>
 #include "trace.h"
 
 enum sc_shape { SC_PLANE, SC_SPHERE, SC_CAP, SC_CONIC, SC_ASPHERE, SC_MESH };
@@ -50,6 +51,11 @@ typedef struct sc_surface {
     long ntri;
     double *tri;          /* 9 doubles per triangle */
     double *media;        /* 2 per triangle (n1 n2), or NULL */
+    /* an OBJ mesh keeps its shared vertices (tri is NULL): nvtx vertices of 3
+     * doubles, 3 indices a triangle (only the vertices its faces use, in order) */
+    double *vtx;
+    long nvtx;
+    uint32_t *idx;
     double sphere[4];     /* file mesh: underlying sphere cx cy cz r, r = 0: none */
     char *mesh_file, *media_file;
     const char *src;      /* defined at src:line (for messages) */
@@ -103,7 +109,19 @@ typedef struct sc_scene {
     int named_wl;             /* some source names its wavelengths: outputs carry a
                                  wavelength column, the trace runs once per wavelength */
     char mismatch_where[256]; /* the first such pair: "FILE:LINE and FILE:LINE" ... */
+    int out_format[3];        /* segments, hits, summary: sc_out_format (never
+                                 SC_OUT_AUTO once read); HDF5 outputs that name one
+                                 file are tables of that one file */
 } sc_scene;
+
+/* An output's format: `output KIND FILE [csv|csv17|npy|h5]`, else from FILE's name. */
+typedef enum {
+    SC_OUT_AUTO,     /* from the file name: .npy, .h5/.hdf5, else text */
+    SC_OUT_TEXT,     /* hits: CSV, shortest round-trip numbers; segments: the p.l text */
+    SC_OUT_CSV17,    /* hits: the CSV of before ("%.17g"), byte for byte */
+    SC_OUT_NPY,      /* NumPy .npy structured array */
+    SC_OUT_H5        /* HDF5: /hits, /segments, /summary */
+} sc_out_format;
 
 /* One ray as the sources emit it. */
 typedef struct sc_ray {
@@ -121,6 +139,10 @@ int  sc_parse_media(const char *text, size_t len, const char *name, long ntri,
                     double **media, char *err);
 int  sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
                   long *ntri, char *err);
+/* The same OBJ as shared vertices and indices (what scenes keep: 24 bytes a
+ * vertex and 12 a triangle instead of 72 a triangle). */
+int  sc_parse_obj_ix(const char *text, size_t len, const char *name, double **vtx,
+                     long *nvtx, uint32_t **idx, long *ntri, char *err);
 /* Validate triangles (finite, non-degenerate): 0 or -1 with the triangle's number. */
 int  sc_check_triangles(const double *tri, long ntri, const char *name, char *err);
 /* A whole scene file with its mesh and media files (scene_load.c): 0 or -1 (err
@@ -182,7 +204,7 @@ typedef struct sc_tess_row {
  * without refinement, with analytic normals, with full re-intersection. */
 int sc_tess_table(const sc_tess_spec *spec, sc_tess_row *rows, char *err);
 
-#define SC_API_ABI 1
+#define SC_API_ABI 2
 #define SC_API_SYMBOL "lm_scene_api"
 typedef struct scene_api {
     int abi;

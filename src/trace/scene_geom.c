@@ -267,8 +267,11 @@ static int same_aperture(const sc_surface *a, const sc_surface *b)
     return a->aperture <= b->hole || b->aperture <= a->hole ? 0 : -1;
 }
 
-/* Where the line p0 + s e (in plane f) runs inside f's disc or rectangle: [*s0, *s1],
- * or 0 if it misses it. */
+/* Where the line p0 + s e (in plane f) runs through the inside of f's disc or
+ * rectangle: [*s0, *s1], or 0 if it misses it or only runs along its rim.  A line
+ * along a rectangle's edge (parallel to it to 1e-12, within 1e-9 of its width of the
+ * edge) is on the rim: two faces of a prism or a cube meet there, neither crosses the
+ * other. */
 static int plane_chord(const sc_surface *f, const double *p0, const double *e, double *s0,
                        double *s1)
 {
@@ -286,7 +289,7 @@ static int plane_chord(const sc_surface *f, const double *p0, const double *e, d
     const double *ax[2] = {u, f->up};
     for (int k = 0; k < 2; k++) {
         double x = g_dot(q, ax[k]), dx = g_dot(e, ax[k]), h = f->rect[k] / 2;
-        if (dx == 0) { if (fabs(x) > h) return 0; continue; }
+        if (fabs(dx) < 1e-12) { if (!(fabs(x) < h * (1 - 1e-9))) return 0; continue; }
         double a = (-h - x) / dx, b = (h - x) / dx;
         if (a > b) { double t = a; a = b; b = t; }
         if (a > lo) lo = a;
@@ -299,7 +302,9 @@ static int plane_chord(const sc_surface *f, const double *p0, const double *e, d
 }
 
 /* Two refracting planes that cross each other inside both apertures (the media
- * between them would depend on which side of the other each ray is)? */
+ * between them would depend on which side of the other each ray is)?  Planes that
+ * only meet along an edge of one of them (the faces of a prism, a cube: a solid they
+ * bound) do not: one ends where it meets the other. */
 static int planes_cross(const sc_surface *a, const sc_surface *b)
 {
     double e[3], p0[3], m[3], n[3], sa0, sa1, sb0, sb1;

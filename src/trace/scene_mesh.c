@@ -147,18 +147,38 @@ static int obj_index(reader *r, const tok *t, long nv, long *idx)
     return 0;
 }
 
-int sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
-                 long *ntri, char *err)
+/* Growable array of vertex indices. */
+typedef struct ivec { uint32_t *v; size_t n, cap; } ivec;
+static int ivec_push(ivec *a, const uint32_t *x, size_t k)
+{
+    if (a->n + k > a->cap) {
+        size_t cap = a->cap ? a->cap * 2 : 256;
+        while (cap < a->n + k) cap *= 2;
+        uint32_t *p = realloc(a->v, cap * sizeof *p);
+        if (!p) return -1;
+        a->v = p;
+        a->cap = cap;
+    }
+    memcpy(a->v + a->n, x, k * sizeof *x);
+    a->n += k;
+    return 0;
+}
+
+int sc_parse_obj_ix(const char *text, size_t len, const char *name, double **vtx,
+                    long *nvtx, uint32_t **idx_out, long *ntri, char *err)
 {
     static const char *const ignored[] = {"vt", "vn", "vp", "o", "g", "s", "usemtl",
                                           "mtllib", NULL};
     reader r;
-    dvec v = {0}, a = {0};
+    dvec v = {0};
+    ivec a = {0};
+    uint32_t *map = NULL;
     int st;
 
     sl_reader_init(&r, text, len, name, err);
-    *tri = NULL;
-    *ntri = 0;
+    *vtx = NULL;
+    *idx_out = NULL;
+    *nvtx = *ntri = 0;
     while ((st = sl_next_line(&r)) > 0) {
         int skip = 0;
         for (int i = 0; ignored[i]; i++) skip |= sl_tok_is(&r.t[0], ignored[i]);
@@ -181,15 +201,16 @@ int sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
             for (int i = 1; i + 1 < r.nt - 1; i++) {   /* fan: 0, i, i+1 */
                 double t[9];
                 const char *why;
+                uint32_t k[3] = {(uint32_t)idx[0], (uint32_t)idx[i], (uint32_t)idx[i + 1]};
                 memcpy(t, v.v + 3 * idx[0], 3 * sizeof *t);
                 memcpy(t + 3, v.v + 3 * idx[i], 3 * sizeof *t);
                 memcpy(t + 6, v.v + 3 * idx[i + 1], 3 * sizeof *t);
                 if ((why = bad_triangle(t))) {
-                    sl_fail(&r, "f: triangle %ld %s", (long)(a.n / 9) + 1, why);
+                    sl_fail(&r, "f: triangle %ld %s", (long)(a.n / 3) + 1, why);
                     goto bad;
                 }
-                if (a.n / 9 >= (size_t)MAXTRI) { sl_fail(&r, "too many triangles"); goto bad; }
-                if (sl_dvec_push(&a, t, 9)) { sl_fail(&r, "out of memory"); goto bad; }
+                if (a.n / 3 >= (size_t)MAXTRI) { sl_fail(&r, "too many triangles"); goto bad; }
+                if (ivec_push(&a, k, 3)) { sl_fail(&r, "out of memory"); goto bad; }
             }
         } else {
             char w[32];
@@ -201,12 +222,49 @@ int sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
     }
     if (st < 0) goto bad;
     if (!a.n) { sl_fail(&r, "no faces (f lines)"); goto bad; }
-    free(v.v);
-    *tri = a.v;
-    *ntri = (long)(a.n / 9);
+    /* keep only the vertices the faces use, in their order in the file (the engine's
+     * bounds and tolerances come from the vertices it is given) */
+    size_t nv = v.n / 3, m = 0;
+    if (!(map = malloc(nv * sizeof *map))) { sl_fail(&r, "out of memory"); goto bad; }
+    for (size_t i = 0; i < nv; i++) map[i] = UINT32_MAX;
+    for (size_t i = 0; i < a.n; i++) map[a.v[i]] = 0;
+    for (size_t i = 0; i < nv; i++)
+        if (map[i] == 0) {
+            memmove(v.v + 3 * m, v.v + 3 * i, 3 * sizeof *v.v);
+            map[i] = (uint32_t)m++;
+        }
+    for (size_t i = 0; i < a.n; i++) a.v[i] = map[a.v[i]];
+    free(map);
+    /* no growth slack kept: a mesh's arrays live as long as its scene */
+    double *vv = realloc(v.v, 3 * m * sizeof *vv);
+    uint32_t *aa = realloc(a.v, a.n * sizeof *aa);
+    *vtx = vv ? vv : v.v;
+    *idx_out = aa ? aa : a.v;
+    *nvtx = (long)m;
+    *ntri = (long)(a.n / 3);
     return 0;
 bad:
     free(v.v);
     free(a.v);
     return -1;
+}
+
+/* The soup form, for readers of the triangles themselves (9 doubles each). */
+int sc_parse_obj(const char *text, size_t len, const char *name, double **tri,
+                 long *ntri, char *err)
+{
+    double *v;
+    uint32_t *ix;
+    long nv;
+    *tri = NULL;
+    if (sc_parse_obj_ix(text, len, name, &v, &nv, &ix, ntri, err)) return -1;
+    if (!(*tri = malloc((size_t)*ntri * 9 * sizeof **tri))) {
+        snprintf(err, SC_ERRMAX, "%s: out of memory", name);
+        *ntri = 0;
+    } else {
+        for (long i = 0; i < 3 * *ntri; i++) memcpy(*tri + 3 * i, v + 3 * ix[i], 3 * sizeof *v);
+    }
+    free(v);
+    free(ix);
+    return *tri ? 0 : -1;
 }

@@ -557,8 +557,41 @@ static int read_source(reader *r, sc_scene *sc)
     return 0;
 }
 
+/* ---- formats ---------------------------------------------------------------------- */
+
+static int ends_with(const char *s, const char *tail)
+{
+    size_t n = strlen(s), m = strlen(tail);
+    if (n < m) return 0;
+    for (size_t i = 0; i < m; i++) {
+        char c = s[n - m + i];
+        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
+        if (c != tail[i]) return 0;
+    }
+    return 1;
+}
+
+static sc_out_format out_format_of(const char *name, sc_out_format keyword)
+{
+    if (keyword != SC_OUT_AUTO) return keyword;
+    if (ends_with(name, ".npy")) return SC_OUT_NPY;
+    if (ends_with(name, ".h5") || ends_with(name, ".hdf5")) return SC_OUT_H5;
+    return SC_OUT_TEXT;
+}
+
+/* The keyword s[0..n) (csv, text, csv17, npy, h5, hdf5) into f: 0, or -1. */
+static int out_format_keyword(const char *s, size_t n, sc_out_format *f)
+{
+    static const struct { const char *k; sc_out_format f; } kw[] = {
+        {"csv", SC_OUT_TEXT}, {"text", SC_OUT_TEXT}, {"csv17", SC_OUT_CSV17}, {"npy", SC_OUT_NPY},
+        {"h5", SC_OUT_H5}, {"hdf5", SC_OUT_H5}};
+    for (size_t i = 0; i < sizeof kw / sizeof kw[0]; i++)
+        if (strlen(kw[i].k) == n && memcmp(kw[i].k, s, n) == 0) return *f = kw[i].f, 0;
+    return -1;
+}
+
 /* depth N / cutoff X / threads N / escape L / fresnel on|off / reflections on|off /
- * output segments|hits|summary FILE */
+ * output segments|hits|summary|all FILE [csv|csv17|npy|h5] */
 static int read_setting(reader *r, sc_scene *sc)
 {
     double v;
@@ -567,15 +600,37 @@ static int read_setting(reader *r, sc_scene *sc)
     if (sl_tok_is(d, "output")) {
         static const char *const what[] = {"segments", "hits", "summary"};
         char **slot[] = {&sc->out_segments, &sc->out_hits, &sc->out_summary};
-        if (r->nt != 3)
-            return sl_fail(r, "output: expected 'output segments|hits|summary FILE'");
+        sc_out_format f = SC_OUT_AUTO;
+        int all = r->nt >= 2 && sl_tok_is(&r->t[1], "all");
+        if (r->nt != 3 && r->nt != 4)
+            return sl_fail(r, "output: expected 'output segments|hits|summary|all FILE "
+                           "[csv|csv17|npy|h5]'");
+        if (r->nt == 4 && out_format_keyword(r->t[3].s, r->t[3].n, &f))
+            return sl_fail(r, "output: '%.*s' is not a format (csv, csv17, npy, h5)",
+                           (int)(r->t[3].n < 24 ? r->t[3].n : 24), r->t[3].s);
+        if (all) {   /* one HDF5 file with every table */
+            for (int i = 0; i < 3; i++) {
+                if (*slot[i]) return sl_fail(r, "output %s given twice", what[i]);
+                if (!(*slot[i] = tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
+                sc->out_format[i] = SC_OUT_H5;
+            }
+            if (out_format_of(sc->out_summary, f) != SC_OUT_H5)
+                return sl_fail(r, "output all: the tables go together in one HDF5 file "
+                               "(FILE.h5 or FILE.hdf5, or the keyword h5)");
+            return 0;
+        }
         for (int i = 0; i < 3; i++)
             if (sl_tok_is(&r->t[1], what[i])) {
                 if (*slot[i]) return sl_fail(r, "output %s given twice", what[i]);
                 if (!(*slot[i] = tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
+                sc->out_format[i] = (int)out_format_of(*slot[i], f);
+                if (i == 2 && sc->out_format[i] != SC_OUT_TEXT && sc->out_format[i] != SC_OUT_H5)
+                    return sl_fail(r, "output summary: text or h5");
+                if (i == 0 && sc->out_format[i] == SC_OUT_CSV17)
+                    return sl_fail(r, "output segments: csv17 is a hits format");
                 return 0;
             }
-        return sl_fail(r, "output: '%.*s' is not segments, hits or summary",
+        return sl_fail(r, "output: '%.*s' is not segments, hits or summary (or all)",
                     (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
     }
     if (sl_tok_is(d, "mismatch")) {
@@ -684,6 +739,8 @@ void sc_free(sc_scene *sc)
 {
     for (int i = 0; i < sc->nsurf; i++) {
         free(sc->surf[i].tri);
+        free(sc->surf[i].vtx);
+        free(sc->surf[i].idx);
         free(sc->surf[i].media);
         free(sc->surf[i].mesh_file);
         free(sc->surf[i].media_file);

@@ -16,6 +16,7 @@
 #include <unistd.h>
 #include "paraxial/paraxial.h"
 #include "scene.h"
+#include "scene_out.h"
 
 #define DEG 0.017453292519943295
 
@@ -224,8 +225,10 @@ static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s
         return set_alpha(tr, ts, tr->add_surface(ts, &an, &m), a1, a2, s, err);
     }
     memset(&mesh, 0, sizeof mesh);
-    mesh.vertex = s->tri;
-    mesh.nvertex = 3 * s->ntri;
+    mesh.vertex = s->idx ? s->vtx : s->tri;   /* an OBJ: its shared vertices */
+    mesh.nvertex = s->idx ? s->nvtx : 3 * s->ntri;
+    mesh.index = s->idx;
+    mesh.shared = s->idx != NULL;   /* the scene's arrays outlive the engine's scene */
     mesh.ntri = s->ntri;
     mesh.media = s->media;
     if (s->shape != SC_MESH) {
@@ -324,6 +327,8 @@ oom:
 typedef struct out {
     FILE *seg, *hit;
     char *seg_part, *hit_part;
+    so_table *seg_t, *hit_t;    /* their formats (scene_out.c); an HDF5 table that
+                                   shares the segments' file has no FILE of its own */
     int tty;
     double t0, last;
     int shown;
@@ -355,32 +360,14 @@ static int w_segment(void *ctx, const trace_segment *s)
 {
     out *o = ctx;
     if (poll_records(o)) return 1;
-    if (o->wl) {
-        double nm = s->lambda * 1e3;
-        return fprintf(o->seg, "%.10g %.10g %.10g %.10g\n%.10g %.10g %.10g %.10g\n",
-                       s->p0[0], s->p0[1], s->p0[2], nm, s->p1[0], s->p1[1], s->p1[2],
-                       nm) < 0;
-    }
-    return fprintf(o->seg, "%.10g %.10g %.10g\n%.10g %.10g %.10g\n", s->p0[0], s->p0[1],
-                   s->p0[2], s->p1[0], s->p1[1], s->p1[2]) < 0;
+    return so_segment(o->seg_t, o->seg, s);
 }
-
-static const char hit_header[] =
-    "ray,depth,surface,triangle,x,y,z,dx,dy,dz,power_s,power_p,power,length,opl\n";
-static const char hit_header_wl[] =
-    "ray,depth,surface,triangle,x,y,z,dx,dy,dz,power_s,power_p,power,length,opl,lambda_nm\n";
 
 static int w_hit(void *ctx, const trace_hit *h)
 {
     out *o = ctx;
     if (poll_records(o)) return 1;
-    if (fprintf(o->hit, "%llu,%d,%d,%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
-                "%.17g,%.17g,%.17g,%.17g", (unsigned long long)(h->ray + o->ray0), h->depth,
-                h->surface, h->prim, h->pos[0], h->pos[1], h->pos[2], h->dir[0],
-                h->dir[1], h->dir[2], h->power_s, h->power_p, h->power_s + h->power_p,
-                h->length, h->opl) < 0)
-        return 1;
-    return (o->wl ? fprintf(o->hit, ",%.10g\n", h->lambda * 1e3) : fputs("\n", o->hit)) < 0;
+    return so_hit(o->hit_t, o->hit, h, h->ray + o->ray0);
 }
 
 /* A progress line on stderr, only on a terminal and once the trace has run 1 s. */
@@ -432,6 +419,50 @@ static int finish(FILE *f, const char *part, const char *name, int ok, char *err
     return 0;
 }
 
+/* Does output i (0 segments, 1 hits, 2 summary) go into the HDF5 file of an earlier
+ * output (same name, both HDF5)?  Then that one writes its table. */
+static int h5_with(const sc_scene *sc, int i, int j)
+{
+    const char *n[3] = {sc->out_segments, sc->out_hits, sc->out_summary};
+    return j < i && n[i] && n[j] && sc->out_format[i] == SC_OUT_H5 &&
+           sc->out_format[j] == SC_OUT_H5 && strcmp(n[i], n[j]) == 0;
+}
+static int h5_shared(const sc_scene *sc, int i) { return h5_with(sc, i, 0) || h5_with(sc, i, 1); }
+
+/* A table of the format the scene gave output `name` (f: its file, NULL for an HDF5
+ * table written with another's); NULL with a message. */
+static so_table *table(FILE *f, int fmt, int hits, int wl, const char *name, char *err)
+{
+    char why[SC_ERRMAX / 2];
+    so_table *t = so_open(f, (sc_out_format)fmt, hits, wl, why, sizeof why);
+    if (!t) snprintf(err, SC_ERRMAX, "%s: %s", name, why);
+    return t;
+}
+
+/* The end of output i's table (0 segments, 1 hits) before its file is closed: .npy
+ * gets its row count; an HDF5 file gets its tables (the later outputs that share it
+ * too: the hits, the summary when the run went well).  After a failure (err holds a
+ * message) the rows are still written out and the writer stopped: the .part stays. */
+static void end_table(const sc_scene *sc, out *o, int i, const sc_result *res,
+                      const double *wl, const trace_summary *per, int nwl, char *err)
+{
+    FILE *f = i ? o->hit : o->seg;
+    const char *part = i ? o->hit_part : o->seg_part;
+    char why[SC_ERRMAX / 2];
+    int rc;
+    if (!(i ? o->hit_t : o->seg_t)) return;   /* its table could not be set up */
+    if (sc->out_format[i] != SC_OUT_H5) {   /* also after a failure: its writer stops */
+        rc = so_finish(i ? o->hit_t : o->seg_t, f, why, sizeof why);
+    } else {
+        so_summary m = {sc->name, &res->sum, sc->named_wl ? nwl : 0, wl, per};
+        if (err[0]) return;
+        rc = so_h5_write(f, i == 1 || h5_with(sc, 1, i) ? o->hit_t : NULL,
+                         i == 0 ? o->seg_t : NULL, h5_with(sc, 2, i) ? &m : NULL, why,
+                         sizeof why);
+    }
+    if (rc && !err[0]) snprintf(err, SC_ERRMAX, "%s: %s", part, why);
+}
+
 /* One wavelength's run into the scene's summary (counts and powers add). */
 static void add_summary(trace_summary *a, const trace_summary *b)
 {
@@ -463,9 +494,19 @@ static int write_summary(const sc_scene *sc, const trace_summary *s, const doubl
                          const trace_summary *per, int nwl, char *err)
 {
     char *part;
-    FILE *f = open_part(sc->out_summary, &part, err);
+    FILE *f;
     int rc;
-    if (!f) { free(part); return -1; }
+    if (h5_shared(sc, 2)) return 0;   /* written with the tables */
+    if (!(f = open_part(sc->out_summary, &part, err))) { free(part); return -1; }
+    if (sc->out_format[2] == SC_OUT_H5) {
+        so_summary m = {sc->name, s, sc->named_wl ? nwl : 0, wl, per};
+        char why[SC_ERRMAX / 2];
+        rc = so_h5_write(f, NULL, NULL, &m, why, sizeof why);
+        if (rc) snprintf(err, SC_ERRMAX, "%s: %s", part, why);
+        rc = finish(f, part, sc->out_summary, !rc, err);
+        free(part);
+        return rc;
+    }
     fprintf(f, "scene %s\nrays %llu\nsegments %llu\ninteractions %llu\ntir %llu\n"
             "hits %llu\ncut_depth %llu\ncut_power %llu\ncut_reflection %llu\n"
             "failures %llu\nmedium_mismatch %llu\nemitted %.17g\ndetected %.17g\n"
@@ -557,12 +598,15 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     sink.ctx = &o;
     sink.progress = w_progress;
     if (sc->out_segments) {
-        if (!(o.seg = open_part(sc->out_segments, &o.seg_part, err))) goto out;
+        if (!(o.seg = open_part(sc->out_segments, &o.seg_part, err)) ||
+            !(o.seg_t = table(o.seg, sc->out_format[0], 0, o.wl, o.seg_part, err)))
+            goto out;
         sink.segment = w_segment;
     }
     if (sc->out_hits) {
-        if (!(o.hit = open_part(sc->out_hits, &o.hit_part, err))) goto out;
-        fputs(o.wl ? hit_header_wl : hit_header, o.hit);
+        if ((!h5_shared(sc, 1) && !(o.hit = open_part(sc->out_hits, &o.hit_part, err))) ||
+            !(o.hit_t = table(o.hit, sc->out_format[1], 1, o.wl, sc->out_hits, err)))
+            goto out;
         sink.hit = w_hit;
     }
     /* one run per wavelength, in the order the sources name them; rays are numbered on
@@ -594,8 +638,16 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     }
 out:
     /* finish() leaves a message in err on any failure */
-    if (o.seg) finish(o.seg, o.seg_part, sc->out_segments, !err[0], err);
-    if (o.hit) finish(o.hit, o.hit_part, sc->out_hits, !err[0], err);
+    if (o.seg) {
+        end_table(sc, &o, 0, res, wl, per, nwl, err);
+        finish(o.seg, o.seg_part, sc->out_segments, !err[0], err);
+    }
+    if (o.hit) {
+        end_table(sc, &o, 1, res, wl, per, nwl, err);
+        finish(o.hit, o.hit_part, sc->out_hits, !err[0], err);
+    }
+    so_free(o.seg_t);
+    so_free(o.hit_t);
     free(o.seg_part);
     free(o.hit_part);
     if (ts) tr->scene_free(ts);

@@ -21,6 +21,8 @@ typedef struct tr_surf {
     tr_shape shape;            /* analytic surface, or a mesh's underlying one */
     int has_under, refine;
     double *vtx;               /* mesh: nv*3 */
+    int shared;                /* mesh: vtx and idx are the caller's (trace_mesh.shared):
+                                  not freed here */
     uint32_t *idx;             /* mesh: ntri*3 */
     double *media;             /* mesh: ntri*2 or NULL */
     long nv, ntri;
@@ -33,7 +35,9 @@ typedef struct tr_surf {
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */
-    double pad;                /* analytic: its Embree box grows by this (tr_build) */
+    double pad;                /* analytic: its Embree box grows by this; mesh: its
+                                  margin (each triangle grows by 2 pad, hits within
+                                  2 pad of an edge are decided in double) (tr_build) */
     const double *eoff;        /* ... and moves by minus the scene's eoff */
     int group, gprev, gnext;   /* analytic surfaces at the same place (the same shape,
                                   position, axis and aperture): the group's first
@@ -65,6 +69,11 @@ struct trace_scene {
     double nlo[3], nhi[3];     /* ... grown by its diagonal: a ray starting in there
                                   hands Embree its own origin */
     double epad;               /* how far a float ray may stray from the double one */
+    double emag;               /* the largest coordinate Embree holds (less eoff) */
+    double slo[3], shi[3];     /* where rays may start: sources, and surfaces that
+                                  pass rays on (not detectors, absorbers); sglobal:
+                                  anywhere in the n box (a far surface or source) */
+    int sglobal;
     double eoff[3];            /* Embree's coordinates are the world's minus this (the
                                   centre of its box): a scene far from the origin keeps
                                   single precision's digits for its own size */

@@ -175,7 +175,7 @@ static void near_edge(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         long prim = rh->hit.primID, best;
         double u = rh->hit.u, v = rh->hit.v, w = 1 - u - v, t;
         double m = fmin(u, fmin(v, w));
-        if (!tr_wt_near(f, prim, m, 2 * sc->epad)) return;       /* well inside */
+        if (!tr_wt_near(f, prim, m, 2 * f->pad)) return;         /* well inside */
         if (x->xs && x->xs != f) return;   /* one mesh's edges at a time: rare enough */
         int leaving = last_surf == f->id;
         if (tr_wt_ring(f, prim, o, d, leaving ? last_prim : -1, leaving ? f->eps : 0,

@@ -257,14 +257,17 @@ typedef struct tr_source {
     int *row_i0;               /* GRID: first kept column of each row */
     double wsum;               /* GAUSSIAN: sum of weights */
     uint64_t first;            /* global number of its first ray */
+    int has_grid0;             /* GRID: grid0 holds what its rays share */
+    struct tr_ray0 {
+        double o[3], d[3];
+        double power, n;
+        tr_pol pol;
+        double lambda, alpha;    /* wavelength (um, 0: none); absorption of the medium */
+    } grid0;                   /* GRID: every ray but its origin (made once, by the
+                                  code that made each ray before: the same bits) */
 } tr_source;
 
-typedef struct tr_ray0 {
-    double o[3], d[3];
-    double power, n;
-    tr_pol pol;
-    double lambda, alpha;        /* wavelength (um, 0: none); absorption of the medium */
-} tr_ray0;
+typedef struct tr_ray0 tr_ray0;
 
 int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap);
 void tr_source_free(tr_source *ts);

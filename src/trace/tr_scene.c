@@ -73,6 +73,11 @@ trace_scene *tr_scene_new(void)
     return sc;
 }
 
+static void source_box(const tr_source *ts, double lo[3], double hi[3]);
+static int box_inside(const double lo[3], const double hi[3], const double *blo,
+                      const double *bhi);
+static int in_range(const tr_surf *f);
+
 static void drop_embree(trace_scene *sc)
 {
     if (sc->scn) rtcReleaseScene(sc->scn);
@@ -90,8 +95,10 @@ void tr_scene_free(trace_scene *sc)
     if (!sc) return;
     drop_embree(sc);
     for (int i = 0; i < sc->nsurf; i++) {
-        free(sc->surf[i]->vtx);
-        free(sc->surf[i]->idx);
+        if (!sc->surf[i]->shared) {
+            free(sc->surf[i]->vtx);
+            free(sc->surf[i]->idx);
+        }
         free(sc->surf[i]->media);
         free(sc->surf[i]->weld);
         free(sc->surf[i]->vt_start);
@@ -270,8 +277,10 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     f->mat = *m;
     f->nv = nv;
     f->ntri = mesh->ntri;
-    f->vtx = malloc((size_t)nv * 3 * sizeof(double));
-    f->idx = malloc((size_t)f->ntri * 3 * sizeof(uint32_t));
+    f->shared = mesh->shared && mesh->index;   /* the caller's arrays, in place */
+    f->vtx = f->shared ? (double *)mesh->vertex : malloc((size_t)nv * 3 * sizeof(double));
+    f->idx = f->shared ? (uint32_t *)mesh->index
+                       : malloc((size_t)f->ntri * 3 * sizeof(uint32_t));
     if (mesh->media) f->media = malloc((size_t)f->ntri * 2 * sizeof(double));
     if (!f->vtx || !f->idx || (mesh->media && !f->media)) {
         rc = fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
@@ -291,7 +300,7 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
             rc = fail(sc, TRACE_EINVAL, msg);
             goto bad;
         }
-        f->vtx[i] = x;
+        if (!f->shared) f->vtx[i] = x;
         if (x < lo[i % 3]) lo[i % 3] = x;
         if (x > hi[i % 3]) hi[i % 3] = x;
     }
@@ -303,7 +312,7 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
             rc = fail(sc, TRACE_EINVAL, msg);
             goto bad;
         }
-        f->idx[i] = k;
+        if (!f->shared) f->idx[i] = k;
     }
     for (long i = 0; i < f->ntri; i++) {
         const double *a = f->vtx + 3 * f->idx[3 * i], *b = f->vtx + 3 * f->idx[3 * i + 1],
@@ -352,8 +361,10 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     drop_embree(sc);
     return f->id;
 bad:
-    free(f->vtx);
-    free(f->idx);
+    if (!f->shared) {
+        free(f->vtx);
+        free(f->idx);
+    }
     free(f->media);
     free(f->weld);
     free(f->vt_start);
@@ -380,6 +391,11 @@ int tr_add_source(trace_scene *sc, const trace_source *s, uint64_t *first)
     }
     ts->first = sc->nrays;
     if (ts->s.alpha_medium > 0) sc->absorbing = 1;
+    if (sc->built) {   /* rays from outside the start box the meshes' margins assumed */
+        double lo[3], hi[3];
+        source_box(ts, lo, hi);
+        if (!sc->sglobal && !box_inside(lo, hi, sc->slo, sc->shi)) drop_embree(sc);
+    }
     if (first) *first = ts->first;
     sc->nrays += (uint64_t)ts->nrays;
     sc->nsrc++;
@@ -424,7 +440,7 @@ static int attach_mesh(trace_scene *sc, tr_surf *f)
                                            3 * sizeof(unsigned), (size_t)f->ntri);
     if (!v || !ix) { rtcReleaseGeometry(g); return -1; }
     for (long t = 0; t < f->ntri; t++) {
-        double c[3] = {0, 0, 0}, k = tr_wt_margin(f, t, 2 * sc->epad);
+        double c[3] = {0, 0, 0}, k = tr_wt_margin(f, t, 2 * f->pad);
         for (int q = 0; q < 3; q++)
             for (int j = 0; j < 3; j++) c[j] += (f->vtx[3 * f->idx[3 * t + q] + j] - sc->eoff[j]) / 3;
         for (int q = 0; q < 3; q++) {
@@ -505,6 +521,84 @@ static void group_coincident(trace_scene *sc)
     if (sc->ngroup) sc->seq_nsurf = -1;
 }
 
+/* The box of the points source s's rays start from (conservative). */
+static void source_box(const tr_source *ts, double lo[3], double hi[3])
+{
+    const trace_source *s = &ts->s;
+    double r = s->type == TRACE_SRC_GRID ? s->radius :
+               s->type == TRACE_SRC_GAUSSIAN ? ts->s.trunc * s->waist : 0;
+    for (int j = 0; j < 3; j++) { lo[j] = s->at[j] - r; hi[j] = s->at[j] + r; }
+    if (s->type == TRACE_SRC_RAYS)
+        for (long i = 0; i < ts->nrays; i++)
+            for (int j = 0; j < 3; j++) {
+                lo[j] = fmin(lo[j], ts->rays[i].o[j]);
+                hi[j] = fmax(hi[j], ts->rays[i].o[j]);
+            }
+}
+
+static int box_inside(const double lo[3], const double hi[3], const double *blo,
+                      const double *bhi)
+{
+    for (int j = 0; j < 3; j++)
+        if (!(lo[j] >= blo[j] && hi[j] <= bhi[j])) return 0;
+    return 1;
+}
+
+/* Where rays may start (sc->slo/shi): every source's origins and every surface that
+ * passes rays on; a ray ends on a detector or an absorber and never starts there.
+ * Anything of that outside the box that hands Embree its own origins (a far surface,
+ * a far source) makes it the whole of that box (sglobal). */
+static void start_box(trace_scene *sc)
+{
+    sc->sglobal = 0;
+    for (int j = 0; j < 3; j++) { sc->slo[j] = INFINITY; sc->shi[j] = -INFINITY; }
+    for (int i = 0; i < sc->nsurf; i++) {
+        const tr_surf *f = sc->surf[i];
+        if (f->mat.kind == TRACE_DETECT || f->mat.kind == TRACE_ABSORB) continue;
+        if (!in_range(f)) { sc->sglobal = 1; continue; }
+        for (int j = 0; j < 3; j++) {
+            if (f->is_mesh) {
+                for (long v = 0; v < f->nv; v++) {
+                    sc->slo[j] = fmin(sc->slo[j], f->vtx[3 * v + j]);
+                    sc->shi[j] = fmax(sc->shi[j], f->vtx[3 * v + j]);
+                }
+            } else {
+                sc->slo[j] = fmin(sc->slo[j], f->shape.lo[j]);
+                sc->shi[j] = fmax(sc->shi[j], f->shape.hi[j]);
+            }
+        }
+    }
+    for (int i = 0; i < sc->nsrc; i++) {
+        double lo[3], hi[3];
+        source_box(&sc->src[i], lo, hi);
+        if (!box_inside(lo, hi, sc->nlo, sc->nhi)) sc->sglobal = 1;
+        for (int j = 0; j < 3; j++) {
+            sc->slo[j] = fmin(sc->slo[j], lo[j]);
+            sc->shi[j] = fmax(sc->shi[j], hi[j]);
+        }
+    }
+}
+
+/* A mesh's margin: how far a float ray may stray from the double one where it meets
+ * that mesh.  As epad (embree_box), with the distance a ray travels to it bounded by
+ * the diagonal of the mesh's box and where rays start (never more than epad's): a
+ * detector plane far from a small mesh no longer widens the mesh's margin, so fewer
+ * hits need the double-precision test of the triangles around them (tr_wt_ring). */
+static double mesh_pad(const trace_scene *sc, const tr_surf *f)
+{
+    double lo[3], hi[3], d[3];
+    if (sc->sglobal) return sc->epad;
+    for (int j = 0; j < 3; j++) { lo[j] = sc->slo[j]; hi[j] = sc->shi[j]; }
+    for (long v = 0; v < f->nv; v++)
+        for (int j = 0; j < 3; j++) {
+            lo[j] = fmin(lo[j], f->vtx[3 * v + j]);
+            hi[j] = fmax(hi[j], f->vtx[3 * v + j]);
+        }
+    for (int j = 0; j < 3; j++) d[j] = hi[j] - lo[j];
+    double p = 8 * FLT_EPSILON * (sc->emag + 3 * v_norm(d)) + 1e-300;
+    return p < sc->epad ? p : sc->epad;
+}
+
 /* Within the range Embree's single precision serves (meshes always are: add_mesh
  * refuses vertices beyond it)? */
 static int in_range(const tr_surf *f)
@@ -550,6 +644,7 @@ static void embree_box(trace_scene *sc)
     }
     double diag = v_norm(d);
     sc->epad = 8 * FLT_EPSILON * (m + 3 * diag) + 1e-300;
+    sc->emag = m;
     for (int j = 0; j < 3; j++) {
         sc->elo[j] = lo[j] - 2 * sc->epad;
         sc->ehi[j] = hi[j] + 2 * sc->epad;
@@ -578,12 +673,13 @@ int tr_build(trace_scene *sc, double *ms)
         return fail(sc, TRACE_ENOMEM, "out of memory");
     }
     embree_box(sc);
+    start_box(sc);
     group_coincident(sc);
     if (sc->seq_nsurf != sc->nsurf && !sc->ngroup) tr_seq_detect(sc);
     for (int i = 0; i < sc->nsurf; i++) {
         tr_surf *f = sc->surf[i];
         if (!f->is_mesh && !in_range(f)) { sc->far[sc->nfar++] = i; continue; }
-        f->pad = sc->epad;
+        f->pad = f->is_mesh ? mesh_pad(sc, f) : sc->epad;
         f->eoff = sc->eoff;
         sc->nembree++;
         int rc = f->is_mesh ? attach_mesh(sc, f) : attach_user(sc, f);

@@ -82,6 +82,8 @@ static int init_grid(tr_source *ts, char *err, size_t cap)
     return 0;
 }
 
+static void ray_at(const tr_source *ts, long i, long row, tr_ray0 *r);
+
 int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
 {
     memset(ts, 0, sizeof *ts);
@@ -224,6 +226,10 @@ int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
         tr_set_err(err, cap, "linear polarisation needs a direction");
         return -1;
     }
+    if (s->type == TRACE_SRC_GRID) {   /* direction, power, polarisation: once */
+        ray_at(ts, 0, -1, &ts->grid0);
+        ts->has_grid0 = 1;
+    }
     return 0;
 }
 
@@ -274,9 +280,26 @@ static long grid_row(const tr_source *ts, long i)
 }
 
 /* Ray i; row: its grid row if known, else -1. */
+/* GRID: the origin of ray i (in row `row` if known, else -1). */
+static void grid_origin(const tr_source *ts, long i, long row, double o[3])
+{
+    const trace_source *s = &ts->s;
+    long n = s->count, lo = row >= 0 ? row : grid_row(ts, i);
+    double h = 2 * s->radius / (double)n;
+    double y = -s->radius + (lo + 0.5) * h;
+    double x = -s->radius + ((double)ts->row_i0[lo] + (double)(i - ts->row_first[lo])
+                             + 0.5) * h;
+    for (int k = 0; k < 3; k++) o[k] = s->at[k] + x * ts->u[k] + y * ts->v[k];
+}
+
 static void ray_at(const tr_source *ts, long i, long row, tr_ray0 *r)
 {
     const trace_source *s = &ts->s;
+    if (ts->has_grid0) {   /* a collimated grid: its rays differ only in their origin */
+        *r = ts->grid0;
+        grid_origin(ts, i, row, r->o);
+        return;
+    }
     double each = s->power / (double)ts->nrays;
     v_set(r->o, s->at);
     r->power = each;
@@ -309,16 +332,10 @@ static void ray_at(const tr_source *ts, long i, long row, tr_ray0 *r)
         dir_at(ts, th, phi, r->d);
         break;
     }
-    case TRACE_SRC_GRID: {
-        long n = s->count, lo = row >= 0 ? row : grid_row(ts, i);
-        double h = 2 * s->radius / (double)n;
-        double y = -s->radius + (lo + 0.5) * h;
-        double x = -s->radius + ((double)ts->row_i0[lo] + (double)(i - ts->row_first[lo])
-                                 + 0.5) * h;
-        for (int k = 0; k < 3; k++) r->o[k] = s->at[k] + x * ts->u[k] + y * ts->v[k];
+    case TRACE_SRC_GRID:
+        grid_origin(ts, i, row, r->o);
         v_set(r->d, s->dir);
         break;
-    }
     case TRACE_SRC_GAUSSIAN: {
         long ring, j;
         hex_index(i, &ring, &j);

@@ -129,7 +129,7 @@ static trace_scene *glass_scene(const tmesh *m, double n, long across, double ra
                                 double z0)
 {
     trace_scene *sc = tr->scene_new();
-    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0};
+    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0, 0};
     trace_material g = {TRACE_REFRACT, 1.0, n};
     if (tr->add_mesh(sc, &mesh, &g) < 0) { fprintf(stderr, "%s\n", tr->error(sc)); exit(1); }
     trace_source src = {0};
@@ -276,7 +276,7 @@ static void mem_child(void)
     tm_sphere(&m, 1, 354);
     long base = rss_kb();
     trace_scene *sc = tr->scene_new();
-    trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, NULL, 0};
+    trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, NULL, 0, 0};
     trace_material g = {TRACE_REFRACT, 1.0, 1.5};
     tr->add_mesh(sc, &mesh, &g);
     tr->build(sc, NULL);

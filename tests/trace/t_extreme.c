@@ -521,7 +521,7 @@ static int mesh_crossings(const sc_surface *f, int level, const trace_ray *r, in
     char err[SC_ERRMAX];
     if (sc_tessellate(f, level, &tri, &ntri, err)) { printf("# %s\n", err); return -1; }
     trace_scene *sc = tr->scene_new();
-    trace_mesh m = {tri, 3 * ntri, NULL, ntri, NULL, NULL, 0};
+    trace_mesh m = {tri, 3 * ntri, NULL, ntri, NULL, NULL, 0, 0};
     trace_material mm = mat(TRACE_REFRACT, 1, 1);
     int rc = tr->add_mesh(sc, &m, &mm);
     if (rc >= 0) rc = add_rays(sc, r, n);
@@ -671,7 +671,7 @@ static void leak_icosphere(int level)
         r[i] = (trace_ray){{3 * p[0], 3 * p[1], 3 * p[2]}, {-p[0], -p[1], -p[2]}, 1};
     }
     trace_scene *sc = tr->scene_new();
-    trace_mesh mesh = {m.v, m.nv, m.f, m.nf, NULL, NULL, 0};
+    trace_mesh mesh = {m.v, m.nv, m.f, m.nf, NULL, NULL, 0, 0};
     trace_material mm = mat(TRACE_REFRACT, 1, 1);
     int rc = tr->add_mesh(sc, &mesh, &mm);
     if (rc >= 0) rc = add_rays(sc, r, (int)m.nv);

@@ -62,7 +62,7 @@ static void leaks(const char *what, tmesh *m, int inside)
         }
     }
     trace_scene *sc = tr->scene_new();
-    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0};
+    trace_mesh mesh = {m->v, m->nv, m->t, m->nt, NULL, NULL, 0, 0};
     trace_material ab = {TRACE_ABSORB, 1, 1};
     int id = tr->add_mesh(sc, &mesh, &ab);
     trace_source src = {0};
@@ -94,7 +94,7 @@ static void glass_edges(void)
         rays[i].power = 1;
     }
     trace_scene *sc = tr->scene_new();
-    trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, NULL, 0};
+    trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, NULL, 0, 0};
     trace_material g = {TRACE_REFRACT, 1.0, 1.5};
     tr->add_mesh(sc, &mesh, &g);
     trace_surface det = {0};
@@ -138,7 +138,7 @@ static void no_acne(void)
         trace_material g = {TRACE_REFRACT, 1.0, 1.5};
         if (mesh_or_not) {
             tm_sphere(&m, 1, 12);
-            trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, NULL, 0};
+            trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, NULL, 0, 0};
             tr->add_mesh(sc, &mesh, &g);
         } else {
             trace_surface s = {0};
@@ -206,7 +206,7 @@ static double ball_lens(int how, int float_hits, spot *sp)
     if (how < 0) tr->add_surface(sc, &s, &g);
     else {
         tm_sphere(&m, 1, 24);
-        trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, &s, how};
+        trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, &s, how, 0};
         tr->add_mesh(sc, &mesh, &g);
     }
     trace_surface det = {0};
@@ -258,7 +258,7 @@ static void mesh_double(void)
                         10, 10, 1000.123456789, -10, 10, 1000.123456789};
         uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
         trace_scene *sc = tr->scene_new();
-        trace_mesh mesh = {v, 4, ix, 2, NULL, NULL, 0};
+        trace_mesh mesh = {v, 4, ix, 2, NULL, NULL, 0, 0};
         trace_material md = {TRACE_DETECT, 1, 1};
         tr->add_mesh(sc, &mesh, &md);
         trace_source src = {0};
@@ -287,7 +287,7 @@ static void bad_input(void)
     trace_scene *sc = tr->scene_new();
     trace_material ok = {TRACE_REFRACT, 1, 1.5}, neg = {TRACE_REFRACT, -1, 1.5};
     double v[9] = {0, 0, 0, 1, 0, 0, 2, 0, 0};        /* collinear */
-    trace_mesh mesh = {v, 3, NULL, 1, NULL, NULL, 0};
+    trace_mesh mesh = {v, 3, NULL, 1, NULL, NULL, 0, 0};
     int rc = tr->add_mesh(sc, &mesh, &ok);
     CHECK(rc == TRACE_EINVAL && strstr(tr->error(sc), "triangle 1") &&
           strstr(tr->error(sc), "degenerate"), "degenerate triangle refused: %s",
@@ -299,12 +299,12 @@ static void bad_input(void)
           tr->error(sc));
     double u[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     uint32_t ix[3] = {0, 1, 7};
-    trace_mesh m2 = {u, 3, ix, 1, NULL, NULL, 0};
+    trace_mesh m2 = {u, 3, ix, 1, NULL, NULL, 0, 0};
     rc = tr->add_mesh(sc, &m2, &ok);
     CHECK(rc == TRACE_EINVAL && strstr(tr->error(sc), "out of range"), "bad index: %s",
           tr->error(sc));
     double media[2] = {1.0, -1.5};
-    trace_mesh m3 = {u, 3, NULL, 1, media, NULL, 0};
+    trace_mesh m3 = {u, 3, NULL, 1, media, NULL, 0, 0};
     rc = tr->add_mesh(sc, &m3, &ok);
     CHECK(rc == TRACE_EINVAL && strstr(tr->error(sc), "indices"), "negative medium: %s",
           tr->error(sc));
@@ -337,6 +337,42 @@ static void bad_input(void)
     tr->scene_free(sc);
 }
 
+/* A mesh used in place (trace_mesh.shared) traces as the copied one, to the bit: a
+ * glass sphere with Fresnel and reflections, every segment's end point summed. */
+typedef struct segsum { double x; long n; } segsum;
+static int add_seg(void *ctx, const trace_segment *g)
+{
+    segsum *s = ctx;
+    s->x += g->p1[0] + 3 * g->p1[1] + 7 * g->p1[2] + g->power;
+    s->n++;
+    return 0;
+}
+static void shared_mesh(void)
+{
+    tmesh m = {0};
+    tm_sphere(&m, 1, 20);
+    segsum r[2] = {{0, 0}, {0, 0}};
+    trace_summary sum[2];
+    for (int k = 0; k < 2; k++) {
+        trace_scene *sc = tr->scene_new();
+        trace_mesh mesh = {m.v, m.nv, m.t, m.nt, NULL, NULL, 0, k};
+        trace_material g = {TRACE_REFRACT, 1.0, 1.5};
+        tr->add_mesh(sc, &mesh, &g);
+        trace_source src = {0};
+        src.type = TRACE_SRC_GRID; src.at[2] = -3; src.dir[2] = 1; src.up[1] = 1;
+        src.radius = 0.99; src.count = 40;
+        tr->add_source(sc, &src, NULL);
+        trace_sink sink = {&r[k], add_seg, NULL, NULL};
+        tr->run(sc, NULL, &sink, &sum[k]);
+        tr->scene_free(sc);
+    }
+    CHECK(r[0].n > 1000 && r[0].n == r[1].n && r[0].x == r[1].x &&
+          sum[0].detected == sum[1].detected && sum[0].escaped == sum[1].escaped,
+          "a mesh used in place traces as the copied one: %ld and %ld segments, sums "
+          "%.17g and %.17g", r[0].n, r[1].n, r[0].x, r[1].x);
+    free(m.v); free(m.t);
+}
+
 int main(void)
 {
     tr = tt_api();
@@ -354,6 +390,7 @@ int main(void)
     refinement();
     mesh_double();
     bad_input();
+    shared_mesh();
     free(oct.v); free(oct.t); free(geo.v); free(geo.t);
     return unit_failed();
 }

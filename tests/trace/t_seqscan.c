@@ -134,7 +134,7 @@ static void random_scene(const trace_api *tr, trace_scene *sc)
     }
     if (rnd() < 0.3) {                        /* a mesh somewhere along the way */
         double zm = rr(-5, z + 5), v[9] = {-8, -8, zm, 8, -8, zm + 0.5, 0, 8, zm};
-        trace_mesh mesh = {v, 3, NULL, 1, NULL, NULL, 0};
+        trace_mesh mesh = {v, 3, NULL, 1, NULL, NULL, 0, 0};
         trace_material g = {TRACE_REFRACT, 1, 1.3};
         tr->add_mesh(sc, &mesh, &g);
     }
@@ -208,7 +208,7 @@ int main(void)
         l.z_detector = NAN;
         tr->add_lens(sc, &l);
         double vane[9] = {-10, 2, 6, 10, 2, 6, 10, 4, 6.2};
-        trace_mesh m = {vane, 3, NULL, 1, NULL, NULL, 0};
+        trace_mesh m = {vane, 3, NULL, 1, NULL, NULL, 0, 0};
         trace_material ab = {TRACE_ABSORB, 1, 1};
         int id = tr->add_mesh(sc, &m, &ab);
         add_plane(tr, sc, TRACE_DETECT, zi, 50);

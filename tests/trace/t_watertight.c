@@ -113,7 +113,7 @@ static void crossings(const char *what, const double *tri, long ntri, const doub
     int rc[2];
     for (int th = 0; th < 2; th++) {
         trace_scene *sc = tr->scene_new();
-        trace_mesh mesh = {tri, 3 * ntri, NULL, ntri, NULL, NULL, 0};
+        trace_mesh mesh = {tri, 3 * ntri, NULL, ntri, NULL, NULL, 0, 0};
         trace_material clear = {TRACE_REFRACT, 1, 1};
         int id = tr->add_mesh(sc, &mesh, &clear);
         trace_surface det = {0};

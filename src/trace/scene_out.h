@@ -1,0 +1,36 @@
+/* scene_out.h -- the record tables' formats (scene_out.c): CSV/text, .npy, HDF5.
+ * Internal to the scene front end (scene_run.c); the files themselves are opened,
+ * renamed and closed there. */
+#ifndef SCENE_OUT_H
+#define SCENE_OUT_H
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include "scene.h"
+
+
+typedef struct so_table so_table;
+/* A hits (hits=1) or segments table in format fmt written to f (its header now;
+ * nothing written to f for SC_OUT_H5: the rows are kept for so_h5_write); wl: with the
+ * wavelength column.  NULL with a message on failure. */
+so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, char *err, size_t errmax);
+/* One row; 0, or non-zero on a write error (or out of memory). */
+int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray);
+int so_segment(so_table *t, FILE *f, const trace_segment *s);
+/* The table's end (.npy: the rest of the rows, the header's row count); 0 or -1. */
+int so_finish(so_table *t, FILE *f, char *err, size_t errmax);
+void so_free(so_table *t);
+
+/* What /summary holds. */
+typedef struct {
+    const char *scene;
+    const trace_summary *sum;
+    int nwl;                     /* per-wavelength rows (0: no wavelengths named) */
+    const double *wl;            /* um */
+    const trace_summary *per;
+} so_summary;
+/* One HDF5 file with whichever of /hits, /segments, /summary are not NULL, written
+ * to f; 0 or -1 with a message. */
+int so_h5_write(FILE *f, const so_table *hits, const so_table *segs, const so_summary *sum,
+                char *err, size_t errmax);
+#endif
