@@ -28,17 +28,18 @@ build/asan/lib/lensmat-wave.so: $(WV_SOBJ)
 	@mkdir -p $(@D)
 	$(CC) -shared $(SAN) -o $@ $(WV_SOBJ) $(WV_LIBS)
 
-# Tests and benches link the module and GSL (Bessel functions for the closed forms).
+# Tests and benches link the module, GSL (Bessel functions for the closed forms) and
+# FFTW (the bench times bare transforms as its baseline).
 build/obj/wave_tests/%: tests/wave/%.c build/lib/lensmat-wave.so src/wave/wave.h \
                         $(wildcard tests/wave/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(OPT) -Itests -o $@ $< build/lib/lensmat-wave.so \
-	    -Wl,-rpath,$(abspath build/lib) -lgsl -lgslcblas -lm
+	    -Wl,-rpath,$(abspath build/lib) -lfftw3 -lgsl -lgslcblas -lm
 build/asan/wave_tests/%: tests/wave/%.c build/asan/lib/lensmat-wave.so src/wave/wave.h \
                          $(wildcard tests/wave/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(SAN) -Itests -o $@ $< build/asan/lib/lensmat-wave.so \
-	    -Wl,-rpath,$(abspath build/asan/lib) -lgsl -lgslcblas -lm
+	    -Wl,-rpath,$(abspath build/asan/lib) -lfftw3 -lgsl -lgslcblas -lm
 
 all: build/lib/lensmat-wave.so
 MODULE_TEST_BINS  += build/lib/lensmat-wave.so build/asan/lib/lensmat-wave.so $(WV_TBIN)
