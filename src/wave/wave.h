@@ -117,6 +117,11 @@ typedef struct wave_api {
      * frequency axes at samples k = 0..nk-1 (k/n of the cutoff; nk <= n + 1), either
      * output may be NULL. */
     int (*mtf)(wave_ctx *c, int nk, double *tan, double *sag);
+    /* The same cuts as the complex OTF, referred to the PSF's centre sample (the
+     * chief ray's image point): re/im pairs, any output may be NULL.  For summing
+     * wavelengths whose chief rays land apart (lateral colour). */
+    int (*otf)(wave_ctx *c, int nk, double *tan_re, double *tan_im, double *sag_re,
+               double *sag_im);
     /* The aberration-free MTF of a circular pupil (2/pi)(phi - cos phi sin phi),
      * phi = acos(nu / cutoff), at normalised frequency v = nu / cutoff. */
     double (*mtf_diffraction)(double v);

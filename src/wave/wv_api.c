@@ -27,6 +27,7 @@ static const wave_api api = {
     wv_psf,
     wv_energy,
     wv_mtf,
+    wv_otf,
     wv_mtf_diffraction,
     wv_resolution,
     wv_kirchhoff,

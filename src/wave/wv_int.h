@@ -36,6 +36,7 @@ int wv_psf(wave_ctx *c, const wave_pupil *p, int m, double defocus, double *psf,
            wave_quality *q);
 int wv_energy(wave_ctx *c, const double *r, int nr, int square, double *frac);
 int wv_mtf(wave_ctx *c, int nk, double *tan, double *sag);
+int wv_otf(wave_ctx *c, int nk, double *tr, double *ti, double *sr, double *si);
 double wv_mtf_diffraction(double v);
 int wv_resolution(wave_ctx *c, int tan, double *rayleigh, double *sparrow);
 

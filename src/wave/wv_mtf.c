@@ -9,18 +9,45 @@
 #include <string.h>
 #include "wv_int.h"
 
-int wv_mtf(wave_ctx *c, int nk, double *tan, double *sag)
+/* The PSF's transform, normalised to 1 at frequency 0; the PSF's centre is sample
+ * (m/2, m/2), so the raw transform carries (-1)^k, taken off here. */
+static int transform(wave_ctx *c)
 {
-    int m;
-    if (!c || !c->have || nk < 1 || nk > c->n + 1) return WAVE_EINVAL;
-    m = c->m;
+    int m = c->m;
     for (size_t i = 0; i < (size_t)m * m; i++) {
         c->buf[i][0] = c->psf[i];
         c->buf[i][1] = 0;
     }
     fftw_execute(c->plan);
-    double z = hypot(c->buf[0][0], c->buf[0][1]);
-    if (!(z > 0)) return WAVE_EINVAL;
+    double z = c->buf[0][0];
+    return z > 0 ? WAVE_OK : WAVE_EINVAL;
+}
+
+int wv_otf(wave_ctx *c, int nk, double *tr, double *ti, double *sr, double *si)
+{
+    int m, rc;
+    if (!c || !c->have || nk < 1 || nk > c->n + 1) return WAVE_EINVAL;
+    if ((rc = transform(c)) != WAVE_OK) return rc;
+    m = c->m;
+    double z = c->buf[0][0];
+    for (int k = 0; k < nk; k++) {
+        const double *t = c->buf[(size_t)k * m], *s = c->buf[k];
+        double sg = k % 2 ? -1.0 / z : 1.0 / z;
+        if (tr) tr[k] = t[0] * sg;
+        if (ti) ti[k] = t[1] * sg;
+        if (sr) sr[k] = s[0] * sg;
+        if (si) si[k] = s[1] * sg;
+    }
+    return WAVE_OK;
+}
+
+int wv_mtf(wave_ctx *c, int nk, double *tan, double *sag)
+{
+    int m, rc;
+    if (!c || !c->have || nk < 1 || nk > c->n + 1) return WAVE_EINVAL;
+    if ((rc = transform(c)) != WAVE_OK) return rc;
+    m = c->m;
+    double z = c->buf[0][0];
     for (int k = 0; k < nk; k++) {
         const double *t = c->buf[(size_t)k * m], *s = c->buf[k];
         if (tan) tan[k] = hypot(t[0], t[1]) / z;
