@@ -48,6 +48,8 @@ const lm_dialogue lm_dialogues[] = {
      lm_to_thickness, lm_to_thickness_example, NULL, 0},
     {"--pupil", "a lens file's pupils, chief rays, spots and fans of rays aimed at the stop",
      lm_pupil, lm_pupil_example, "trace", 0},
+    {"--wave", "wave optics of a lens file: wavefront, Zernike, PSF, Strehl, EE, MTF (42-45)",
+     lm_wave, lm_wave_example, "wave", 0},
 };
 const size_t lm_ndialogues = sizeof lm_dialogues / sizeof lm_dialogues[0];
 
