@@ -81,3 +81,23 @@ wave_quad() (
          END { print "largest difference", m, "over", n, "rows"; exit !(n == 22 && m < 2.5e-3) }' q.out
 )
 check "--wave: triplet MTF = pupil autocorrelation by quadrature (independent) within 2.5e-3" wave_quad
+# Pictures through the imaging module: per field the wavefront and PSF maps (PNG) and
+# the MTF, through-focus and Zernike plots (PNG and SVG); a name with an extension is
+# refused
+wave_pics() (
+    wave_dir && cd "$WORK/wv" &&
+    printf 'doc/pupil-triplet.rx\n32\nnoll\n11\n0\n0.02\n1\n40\npic/tw\n' > pic.in && mkdir -p pic &&
+    "$BIN" --wave -i pic.in pic.rec > pic.out 2>&1 || return 1
+    for f in 1 2 3; do
+        for p in wavefront psf psf-log mtf focus zernike; do
+            head -c 8 "pic/tw-f$f-$p.png" | od -An -c | grep -q 'P   N   G' || { echo "pic/tw-f$f-$p.png"; return 1; }
+        done
+        for p in mtf focus zernike; do grep -q '<svg' "pic/tw-f$f-$p.svg" || return 1; done
+    done
+    [ "$(grep -c '^Pictures: ' pic.rec)" = 3 ] || return 1
+    printf 'doc/pupil-triplet.rx\n32\nnoll\n11\n0\n0\nx.png\n' > pb.in
+    "$BIN" --wave -i pb.in pb.rec > /dev/null 2> pb.err; [ $? = 2 ] && grep -q 'pb.in:7' pb.err
+)
+if [ -f "$TOP/build/lib/lensmat-imaging.so" ]; then
+    check "--wave: pictures (wavefront, PSF linear and log, MTF, through focus, Zernike; PNG, SVG)" wave_pics
+else fail "--wave pictures: build/lib/lensmat-imaging.so not built"; fi
