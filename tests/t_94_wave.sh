@@ -101,3 +101,35 @@ wave_pics() (
 if [ -f "$TOP/build/lib/lensmat-imaging.so" ]; then
     check "--wave: pictures (wavefront, PSF linear and log, MTF, through focus, Zernike; PNG, SVG)" wave_pics
 else fail "--wave pictures: build/lib/lensmat-imaging.so not built"; fi
+# --beam and --polar: their examples replay exactly; --beam against the closed forms
+# (a waist w0 at the front focal plane of a lens f images to a waist lambda f/(pi w0)
+# at the back focal plane; zR = pi w0^2/lambda), --polar against the seed's circular
+# polarization (45-degree light through a quarter-wave plate: Stokes 1 0 0 1), the
+# TIR phase formula, and a quarter-wave MgF2 layer's closed form
+calc_replay() (
+    wave_dir && cd "$WORK/wv" && "$BIN" --$1 --example $1.rec > $1.out 2>&1 &&
+    grep input: $1.rec | sed 's/^input: //' > $1.in && "$BIN" --$1 $1-2.rec < $1.in > /dev/null 2>&1 &&
+    cmp $1.rec $1-2.rec
+)
+check "--beam: example replays exactly" calc_replay beam
+check "--polar: example replays exactly" calc_replay polar
+wave_beam() (
+    wave_dir && cd "$WORK/wv" &&
+    printf 'mm\n632.8\n0.5\n1\n3\nd\n100\nf\n100\nd\n100\n' | "$BIN" --beam bm.rec > bm.out 2>&1 &&
+    grep -q 'Rayleigh range 1241.15 mm' bm.out &&
+    grep 'after element 3' bm.out | awk '{ w = $9 + 0; want = 632.8e-6 * 100 / (3.14159265358979 * 0.5);
+        exit !(w / want - 1 < 1e-5 && w / want - 1 > -1e-5) }' &&
+    grep -q 'after element 3 .*R infinite (flat); waist 0.0402853 mm at 0 mm' bm.out
+)
+check "--beam: a waist at the front focus images to lambda f/(pi w0) at the back focus" wave_beam
+wave_polar() (
+    wave_dir && cd "$WORK/wv" &&
+    printf 'jones\nd\n1\nqwp\n0\n' | "$BIN" --polar pj.rec > pj.out 2>&1 &&
+    grep -q '1 qwp 0: .*Stokes 1 0 0 1 $' pj.out &&
+    printf 'fresnel\n1.5\n1\n60\n' | "$BIN" --polar pf.rec > pf.out 2>&1 &&
+    grep 'total internal' pf.out | sed 's/.*is \(-*[0-9.]*\) deg.*: \(-*[0-9.]*\) deg.*/\1 \2/' |
+        awk '{ exit !($1 == $2 && $1 != "") }' &&
+    printf 'film\n1\n1.5168\n550\n1\n1.38\n0\n0\n' | "$BIN" --polar pm.rec > pm.out 2>&1 &&
+    grep -q '^   550.0 nm: Rs 1.28354%' pm.out && grep -q '= 1.28354%' pm.out
+)
+check "--polar: circular light from a quarter-wave plate, the TIR phase, a quarter-wave MgF2 coating" wave_polar

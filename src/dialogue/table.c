@@ -50,6 +50,10 @@ const lm_dialogue lm_dialogues[] = {
      lm_pupil, lm_pupil_example, "trace", 0},
     {"--wave", "wave optics of a lens file: wavefront, Zernike, PSF, Strehl, EE, MTF (42-45)",
      lm_wave, lm_wave_example, "wave", 0},
+    {"--beam", "Gaussian beam: waist, M^2, q through free space and thin lenses (46)", lm_beam,
+     lm_beam_example, "wave", 0},
+    {"--polar", "polarization and thin films: Jones calculus, Fresnel and TIR phases, coatings (40, 67-71)",
+     lm_polar, lm_polar_example, "wave", 0},
 };
 const size_t lm_ndialogues = sizeof lm_dialogues / sizeof lm_dialogues[0];
 
