@@ -133,3 +133,20 @@ wave_polar() (
     grep -q '^   550.0 nm: Rs 1.28354%' pm.out && grep -q '= 1.28354%' pm.out
 )
 check "--polar: circular light from a quarter-wave plate, the TIR phase, a quarter-wave MgF2 coating" wave_polar
+# SIGINT during a 512-cell run (seconds of aimed rays): the chunked rx_opd calls poll
+# the stop flag, lensmat exits 130, no field report and no picture left behind
+wave_stop() {
+    wave_dir
+    printf 'doc/pupil-triplet.rx\n512\nfringe\n37\n0\n0\nstop/tw\n' > "$WORK/wv/ws.in"
+    mkdir -p "$WORK/wv/stop"
+    (cd "$WORK/wv" && exec "$TOP/lensmat" --wave ws.rec < ws.in > ws.out 2> ws.err) &
+    p=$!
+    sleep 0.5
+    kill -INT "$p"
+    wait "$p"
+    rc=$?
+    [ "$rc" -eq 130 ] || { echo "exit $rc"; cat "$WORK/wv/ws.err"; return 1; }
+    ! grep -q "Strehl ratio" "$WORK/wv/ws.out" && [ -z "$(ls "$WORK/wv/stop")" ] &&
+        grep -q "stopped by signal 2" "$WORK/wv/ws.err" && grep -q "^Stopped by signal 2" "$WORK/wv/ws.out"
+}
+check "--wave stops on SIGINT mid-trace (exit 130, no report, no picture)" wave_stop

@@ -187,6 +187,10 @@ int lm_wave(lm_io *io)
     rc = lr_ask_lens(&d->L, &d->c, &d->t);
     if (rc == LM_GO) rc = ask_all(d);
     if (rc == LM_GO) rc = lm_stop_requested() ? LM_FAIL : compute(d);
+    if (lm_stop_requested()) {
+        lm_say(io, LM_BOTH, P(STOPPED), lm_stop_requested());
+        fprintf(stderr, "lensmat: --wave stopped by signal %d\n", lm_stop_requested());
+    }
     if (rc == LM_GO) rc = calc_done(&d->c);
     for (int k = 0; k < LN_WL_MAX; k++) {
         free(d->wl[k].otf);
