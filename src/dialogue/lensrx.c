@@ -213,12 +213,7 @@ int lr_prepare(lr_lens *L, char *why, size_t cap)
         L->z_image = zl + l->surf[l->nsurf - 1].t;
         L->image_from_file = 1;
     } else {
-        if (!isfinite(L->prim.z_img)) {
-            snprintf(why, cap, "the image is at infinity (afocal at the image): give the "
-                     "last surface a thickness to an image plane");
-            return -1;
-        }
-        L->z_image = L->prim.z_img;
+        L->z_image = L->prim.z_img;        /* infinite: afocal, the caller refuses */
         L->image_from_file = 0;
     }
     return 0;

@@ -31,7 +31,8 @@ typedef struct lr_lens {
     char names[PX_PUPIL_MAXSURF + 1][LN_NAME_MAX];
     const char *obj;
     px_pupil prim;             /* the primary wavelength's pupils */
-    double z_image;            /* the image plane rays are carried to */
+    double z_image;            /* the image plane rays are carried to (not finite:
+                                  afocal at the image, no plane to carry them to) */
     int image_from_file;       /* 1: the file's last thickness; 0: paraxial focus */
     double scale;              /* the lens's size (efl, stop) */
 } lr_lens;
@@ -48,7 +49,7 @@ typedef struct lr_wl {
 int lr_ask_lens(lr_lens *L, calc *c, const lr_texts *t);
 /* A whole number lo..hi (t->count_what, t->count_bad). */
 int lr_ask_count(lr_lens *L, const char *q, const char *bad, int lo, int hi, int *v);
-/* Pupils and image plane at the primary wavelength: 0, or -1 with why. */
+/* Pupils and image plane at the primary wavelength: 0 (check z_image), or -1 with why. */
 int lr_prepare(lr_lens *L, char *why, size_t cap);
 /* Wavelength lambda (um): its pupils and trace_rx.  0, or -1 with why. */
 int lr_at(const lr_lens *L, double lambda, lr_wl *w, char *why, size_t cap);

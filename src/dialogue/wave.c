@@ -144,6 +144,7 @@ static int compute(wd *d)
              l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
              l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
     if (d->L.image_from_file) calc_say(&d->c, P(IMAGE_FILE), d->L.z_image, d->c.uname);
+    else if (!isfinite(d->L.z_image)) return refuse(d, P(NO_IMAGE));
     else calc_say(&d->c, P(IMAGE_PARAXIAL), lm_clean(d->io, d->L.z_image), d->c.uname, lp * 1000);
     /* Q 4 up to a 256-cell grid (m = 4n <= 1024), Q 2 above: m >= 2n keeps the MTF
      * unaliased; the field is n lambda F whatever Q */
