@@ -101,6 +101,30 @@ int main(void)
         pupil_release(&p);
     }
 
+    /* the OTF's phase: a tilt that moves the PSF by exactly s samples along x (Noll Z2
+     * = 2 rho cos theta: W = 2c x, a phase ramp of 4 pi c / n per cell, which the
+     * FFT of size m turns into a shift of -4 c m / n samples) multiplies the sagittal
+     * OTF by exp(-2 pi i k s / m); the tangential cut keeps phase 0 */
+    {
+        int n = 64, m = 256, s = -8;
+        double c2 = -s * n / (4.0 * m), tr[65], ti[65], sr[65], si[65], worst = 0;
+        wave_pupil p;
+        wave_quality q;
+        pupil_alloc(&p, n);
+        wv->pupil_mask(&p, 0, 0);
+        wv->pupil_add_zernike(&p, WAVE_Z_NOLL, 2, c2);
+        wv->psf(c, &p, m, 0, NULL, &q);
+        wv->otf(c, n + 1, tr, ti, sr, si);
+        for (int k = 0; k < n / 2; k++) {
+            double a = -2 * PI_ * k * s / m, mag = hypot(sr[k], si[k]);
+            worst = fmax(worst, fabs(sr[k] - mag * cos(a)) + fabs(si[k] - mag * sin(a)));
+            worst = fmax(worst, fabs(ti[k]));
+        }
+        CHECK(q.peak_x == s && q.peak_y == 0 && worst < 1e-9, "a tilt of %.3g waves moves the PSF "
+              "to x = %g samples; the OTF's phase is exp(-2 pi i k s/m) within %.2g", c2, q.peak_x, worst);
+        pupil_release(&p);
+    }
+
     /* Zernike orderings */
     {
         int n, m, ok = 1;
