@@ -115,13 +115,22 @@ check "--beam: example replays exactly" calc_replay beam
 check "--polar: example replays exactly" calc_replay polar
 wave_beam() (
     wave_dir && cd "$WORK/wv" &&
-    printf 'mm\n632.8\n0.5\n1\n3\nd\n100\nf\n100\nd\n100\n' | "$BIN" --beam bm.rec > bm.out 2>&1 &&
+    printf 'mm\n632.8\n0.5\n1\n3\nd\n100\nf\n100\nd\n100\n500\n' | "$BIN" --beam bm.rec > bm.out 2>&1 &&
     grep -q 'Rayleigh range 1241.15 mm' bm.out &&
     grep 'after element 3' bm.out | awk '{ w = $9 + 0; want = 632.8e-6 * 100 / (3.14159265358979 * 0.5);
         exit !(w / want - 1 < 1e-5 && w / want - 1 > -1e-5) }' &&
-    grep -q 'after element 3 .*R infinite (flat); waist 0.0402853 mm at 0 mm' bm.out
+    grep -q 'after element 3 .*R infinite (flat); waist 0.0402853 mm at 0 mm' bm.out &&
+    grep 'small on both planes' bm.out | sed 's/.*= \([0-9.]*\) mm midway.*sqrt 2 w0 = \([0-9.]*\) mm.*/\1 \2/' |
+        awk '{ w = sqrt(632.8e-6 * 500 / (2 * 3.14159265358979)); r = $1 / w - 1; q = $2 / ($1 * sqrt(2)) - 1
+               exit !(NF == 2 && r < 1e-5 && r > -1e-5 && q < 1e-5 && q > -1e-5) }'
 )
-check "--beam: a waist at the front focus images to lambda f/(pi w0) at the back focus" wave_beam
+check "--beam: a waist at the front focus images to lambda f/(pi w0) at the back focus; the two-plane balance" wave_beam
+asan_replay() (
+    wave_dir && cd "$WORK/wv" && "$ASAN" --$1 --example a$1.rec > /dev/null 2>&1 &&
+    grep input: a$1.rec | sed 's/^input: //' | "$ASAN" --$1 a$1-2.rec > /dev/null 2>&1 && cmp a$1.rec a$1-2.rec
+)
+check "--beam: example replays exactly under ASan/UBSan" asan_replay beam
+check "--polar: example replays exactly under ASan/UBSan" asan_replay polar
 wave_polar() (
     wave_dir && cd "$WORK/wv" &&
     printf 'jones\nd\n1\nqwp\n0\n' | "$BIN" --polar pj.rec > pj.out 2>&1 &&

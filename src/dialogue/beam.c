@@ -2,7 +2,9 @@
  * waist, wavelength and M^2, then free-space gaps and thin lenses; at each plane the
  * beam radius, wavefront radius, the next waist and its Rayleigh range, from the q
  * parameter carried by the system matrix (the paraxial engine's matrices, in air) and
- * the wave module's beam_abcd.  Texts in prompts/beam.txt. */
+ * the wave module's beam_abcd; then the seed's trade-off, a beam small on two planes
+ * at once (the cornea and the detector): the waist that balances them.  Texts in
+ * prompts/beam.txt. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,6 +69,8 @@ int lm_beam(lm_io *io)
                 return rc;
         }
     }
+    double span;
+    if ((rc = calc_num(&c, P(SPAN), P(SPAN_WHAT), LM_NONNEG, &span))) return rc;
     wave_get_api_fn get = (wave_get_api_fn)lm_engine_symbol("wave", WAVE_API_SYMBOL);
     const wave_api *wv = get ? get(WAVE_ABI) : NULL;
     if (!wv) return LM_FAIL;
@@ -90,6 +94,17 @@ int lm_beam(lm_io *io)
         calc_say(&c, P(PLANE), i + 1, el, o.w, u, rs, o.w0, u, lm_clean(io, fabs(o.z_waist)), u,
                  o.z_waist >= 0 ? P(AFTER) : P(BEFORE), o.zR, u, lm_clean(io, sys.a),
                  lm_clean(io, sys.b), lm_clean(io, sys.c), lm_clean(io, sys.d));
+    }
+    if (span > 0) {
+        /* w(L/2) for a waist midway is w0 sqrt(1 + (L / 2 zR)^2): smallest, d/dw0 = 0, at
+         * zR = L/2, where it is sqrt 2 w0; the beam_at calls give the figures */
+        double best = sqrt(m2 * lam * span / (2 * 3.14159265358979323846));
+        wave_beam e, e1, e2;
+        if (wv->beam_at(best, lam, m2, span / 2, &e) != WAVE_OK ||
+            wv->beam_at(best / 2, lam, m2, span / 2, &e1) != WAVE_OK ||
+            wv->beam_at(best * 2, lam, m2, span / 2, &e2) != WAVE_OK)
+            return calc_fail(&c, P(SPAN_WHAT));
+        calc_say(&c, P(BALANCE), span, u, best, u, e.w, u, e1.w, e2.w, u);
     }
     return calc_done(&c);
 }
