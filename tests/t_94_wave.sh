@@ -1,10 +1,11 @@
 # t_94_wave.sh -- the wave-optics engine (src/wave/): closed forms (t_closed: Airy,
 # its encircled energy, the diffraction-limited MTF, FFT against Kirchhoff, Strehl
 # against Marechal, Rayleigh and Sparrow, Zernike orderings and fit), the calculators
-# (t_calc: thin films, Fresnel and TIR phases, Jones, Gaussian beams), the triplet's
-# MTF against an independent quadrature (t_triplet); normal and sanitizer builds; the
+# (t_calc: thin films, Fresnel and TIR phases, Jones, Gaussian beams), the trace
+# module's rx_opd against a Cartesian ellipsoid (t_opd), the triplet's
+# MTF against an independent quadrature (mtf_quad.py); normal and sanitizer builds; the
 # module's exports; lensmat itself not linking FFTW; the --wave dialogue.
-for b in t_closed t_calc; do
+for b in t_closed t_calc t_opd; do
     unit "$TOP/build/obj/wave_tests/$b"
     unit "$TOP/build/asan/wave_tests/$b"
 done

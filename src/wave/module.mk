@@ -45,3 +45,13 @@ all: build/lib/lensmat-wave.so
 MODULE_TEST_BINS  += build/lib/lensmat-wave.so build/asan/lib/lensmat-wave.so $(WV_TBIN)
 MODULE_BENCH_BINS += build/lib/lensmat-wave.so $(WV_BBIN)
 -include $(WV_OBJ:.o=.d) $(WV_SOBJ:.o=.d)
+# t_opd checks the trace module's rx_opd (the wavefront this engine is fed): it links
+# lensmat-trace.so alone.
+build/obj/wave_tests/t_opd: tests/wave/t_opd.c build/lib/lensmat-trace.so src/trace/trace.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -Itests -o $@ $< build/lib/lensmat-trace.so \
+	    -Wl,-rpath,$(abspath build/lib) -lm
+build/asan/wave_tests/t_opd: tests/wave/t_opd.c build/asan/lib/lensmat-trace.so src/trace/trace.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -Itests -o $@ $< build/asan/lib/lensmat-trace.so \
+	    -Wl,-rpath,$(abspath build/asan/lib) -lm
