@@ -123,10 +123,16 @@ int wd_pictures(wd *d, int fi, const wave_zfit *z, const double *fq, const doubl
         rc = plot(d, fi, "focus", &p, plots, sizeof plots);
     }
     if (!rc) {
-        double x[WAVE_MAXZ], y[WAVE_MAXZ];
+        /* bars as stems: one line out of the zero line to each coefficient and back
+         * (the plot joins a series' points, so the stems share the baseline) */
+        double x[3 * WAVE_MAXZ], y[3 * WAVE_MAXZ];
         int j0 = z->order == WAVE_Z_ANSI ? 0 : 1;
-        for (int t = 0; t < z->nterm; t++) { x[t] = j0 + t; y[t] = z->c[t]; }
-        im_series s[1] = {{"coefficient", z->nterm, x, y, IM_MARKERS}};
+        for (int t = 0; t < z->nterm; t++) {
+            x[3 * t] = x[3 * t + 1] = x[3 * t + 2] = j0 + t;
+            y[3 * t] = y[3 * t + 2] = 0;
+            y[3 * t + 1] = z->c[t];
+        }
+        im_series s[1] = {{"coefficient", 3 * z->nterm, x, y, IM_LINES}};
         snprintf(title, sizeof title, "Zernike coefficients (%s), field %d, %g nm",
                  z->order == WAVE_Z_FRINGE ? "Fringe" : z->order == WAVE_Z_NOLL ? "Noll" : "ANSI",
                  fi + 1, r->lambda * 1000);
