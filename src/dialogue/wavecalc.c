@@ -3,7 +3,8 @@
  * SIGINT stops it promptly), the PSF, Strehl ratio, OTF cuts and energy curve (the
  * wave module); then the Zernike fit at the primary wavelength and the polychromatic
  * sums: MTF (each wavelength's OTF carried by its chief ray's offset from the
- * primary's, lateral colour kept), Strehl (weights / lambda^2: the aberration-free
+ * primary's, lateral colour kept; the cuts toward the field's image point and across
+ * it), Strehl (weights / lambda^2: the aberration-free
  * peak of equal power goes as 1/(lambda F)^2), encircled energy (each about its own
  * chief ray), resolving power and the through-focus MTF. */
 #include <math.h>
@@ -80,7 +81,9 @@ static double poly_mtf(const wd *d, int sag, double nu)
         double re, im;
         if (!r->ok) continue;
         otf_at(d, r, sag, nu, &re, &im);
-        double s = sag ? r->chief[0] - d->wl[0].chief[0] : r->chief[1] - d->wl[0].chief[1];
+        double dx = r->chief[0] - d->wl[0].chief[0], dy = r->chief[1] - d->wl[0].chief[1];
+        double ca = cos(d->az), sa = sin(d->az);
+        double s = sag ? -dx * sa + dy * ca : dx * ca + dy * sa;   /* along the cut */
         double ph = -2 * PI_ * nu * s, c = cos(ph), sn = sin(ph);
         sr += r->weight * (re * c - im * sn);
         si += r->weight * (re * sn + im * c);
@@ -148,8 +151,9 @@ static int psf_figures(wd *d, wd_wl *r, double defocus, double *psf)
     r->strehl = q.strehl;
     r->strehl_c = q.strehl_centre;
     if (!r->otf && !(r->otf = malloc(sizeof(double) * 4 * (size_t)(n + 1)))) return -1;
-    double *o = r->otf;
-    if (d->wv->otf(d->ctx, n + 1, o, o + (n + 1), o + 2 * (n + 1), o + 3 * (n + 1)) != WAVE_OK)
+    double *o = r->otf, h = 3.14159265358979323846 / 2;
+    if (d->wv->otf_dir(d->ctx, d->az, n + 1, o, o + (n + 1)) != WAVE_OK ||
+        d->wv->otf_dir(d->ctx, d->az + h, n + 1, o + 2 * (n + 1), o + 3 * (n + 1)) != WAVE_OK)
         return -1;
     d->wave_ms += wd_now_ms() - t0;
     /* the aberration-free PSF's rings alone put about 2/(pi^2 r) of the energy beyond
@@ -168,13 +172,14 @@ int wd_field(wd *d, int fi)
     int have_z = 0, rc = LM_GO;
     lr_wl *w = malloc(sizeof *w);
     if (!w) return LM_FAIL;
+    /* tangential: toward the field's image point (y on the axis); sagittal across */
+    d->az = f->x == 0 && f->y == 0 ? PI_ / 2 : atan2(f->y, f->x);
     if (f->x == 0) {
         if (isinf(l->object)) calc_say(&d->c, P(FIELD_HEAD_ANGLE), fi + 1, f->y);
         else calc_say(&d->c, P(FIELD_HEAD_HEIGHT), fi + 1, f->y);
     } else {
-        char b[64];
-        snprintf(b, sizeof b, "%g, %g", f->x, f->y);
-        calc_say(&d->c, "Field %d: %s\n", fi + 1, b);
+        if (isinf(l->object)) calc_say(&d->c, P(FIELD_HEAD_ANGLE_XY), fi + 1, f->x, f->y);
+        else calc_say(&d->c, P(FIELD_HEAD_HEIGHT_XY), fi + 1, f->x, f->y);
     }
     for (int k = 0; k < d->nwl && rc == LM_GO; k++) {
         wd_wl *r = &d->wl[k];

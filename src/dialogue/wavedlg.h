@@ -35,6 +35,8 @@ typedef struct wd {
     wave_ctx *ctx;
     int n, m, Q, order, nterm, steps, ncell;
     double fmax, focus, ffreq;
+    double az;                     /* this field's tangential direction (radians from
+                                      +x toward +y; 90 degrees on the axis) */
     char pic[WD_WORD];             /* picture name base, "" for none */
     double *cx, *cy;               /* the pupil cells' centres (ncell) */
     int *cidx;                     /* ... their index in the n x n grid */

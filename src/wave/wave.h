@@ -122,6 +122,11 @@ typedef struct wave_api {
      * wavelengths whose chief rays land apart (lateral colour). */
     int (*otf)(wave_ctx *c, int nk, double *tan_re, double *tan_im, double *sag_re,
                double *sag_im);
+    /* The complex OTF along any direction `angle` (radians, from +x toward +y) at
+     * frequencies k/n of the cutoff, k = 0..nk-1: bilinear between the transform's
+     * samples (exact at 0 and 90 degrees, where it equals otf's cuts).  For the
+     * tangential and sagittal MTF of a field off both axes. */
+    int (*otf_dir)(wave_ctx *c, double angle, int nk, double *re, double *im);
     /* The aberration-free MTF of a circular pupil (2/pi)(phi - cos phi sin phi),
      * phi = acos(nu / cutoff), at normalised frequency v = nu / cutoff. */
     double (*mtf_diffraction)(double v);

@@ -28,6 +28,7 @@ static const wave_api api = {
     wv_energy,
     wv_mtf,
     wv_otf,
+    wv_otf_dir,
     wv_mtf_diffraction,
     wv_resolution,
     wv_kirchhoff,

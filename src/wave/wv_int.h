@@ -15,6 +15,7 @@ struct wave_ctx {
     int n;                     /* its pupil's grid */
     double total;              /* its total energy in PSF units (sum of psf) */
     int have;                  /* psf holds a PSF */
+    double cx, cy;             /* its centroid, samples from the centre */
 };
 
 /* Cell centre j of an n-cell axis across [-1, 1]. */
@@ -37,6 +38,7 @@ int wv_psf(wave_ctx *c, const wave_pupil *p, int m, double defocus, double *psf,
 int wv_energy(wave_ctx *c, const double *r, int nr, int square, double *frac);
 int wv_mtf(wave_ctx *c, int nk, double *tan, double *sag);
 int wv_otf(wave_ctx *c, int nk, double *tr, double *ti, double *sr, double *si);
+int wv_otf_dir(wave_ctx *c, double angle, int nk, double *re, double *im);
 double wv_mtf_diffraction(double v);
 int wv_resolution(wave_ctx *c, int tan, double *rayleigh, double *sparrow);
 

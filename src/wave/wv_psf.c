@@ -83,6 +83,8 @@ int wv_psf(wave_ctx *c, const wave_pupil *p, int m, double defocus, double *psf,
         }
     c->n = n;
     c->total = tot;
+    c->cx = sx / tot;
+    c->cy = sy / tot;
     c->have = 1;
     if (psf) memcpy(psf, c->psf, sizeof(double) * (size_t)m * m);
     if (q) {

@@ -89,6 +89,11 @@ int main(void)
               fsq[0], fr[0]);
         double t[129], s[129];
         wv->mtf(c, n + 1, t, s);
+        double dre[129], dim[129], e45 = 0;
+        wv->otf_dir(c, PI_ / 4, n + 1, dre, dim);
+        for (int k = 0; k <= n; k++) e45 = fmax(e45, fabs(hypot(dre[k], dim[k]) - difflimit((double)k / n)));
+        CHECK(e45 < 3e-3, "MTF along 45 degrees (bilinear between samples) = the closed form "
+              "within %.2g", e45);
         CHECK(fabs(t[n / 2] - difflimit(0.5)) < 1e-3 && t[n] < 1e-6,
               "MTF at half the cutoff %.5f (closed form %.5f), %.2g at the cutoff", t[n / 2],
               difflimit(0.5), t[n]);
@@ -122,6 +127,12 @@ int main(void)
         }
         CHECK(q.peak_x == s && q.peak_y == 0 && worst < 1e-9, "a tilt of %.3g waves moves the PSF "
               "to x = %g samples; the OTF's phase is exp(-2 pi i k s/m) within %.2g", c2, q.peak_x, worst);
+        double dr[65], di[65], e0 = 0, e90 = 0;
+        wv->otf_dir(c, 0, n + 1, dr, di);
+        for (int k = 0; k <= n; k++) e0 = fmax(e0, fabs(dr[k] - sr[k]) + fabs(di[k] - si[k]));
+        wv->otf_dir(c, PI_ / 2, n + 1, dr, di);
+        for (int k = 0; k <= n; k++) e90 = fmax(e90, fabs(dr[k] - tr[k]) + fabs(di[k] - ti[k]));
+        CHECK(e0 == 0 && e90 == 0, "otf_dir at 0 and 90 degrees = the sagittal and tangential cuts");
         pupil_release(&p);
     }
 
