@@ -4,8 +4,7 @@
  * marginal and chief rays (src/paraxial/pupil.c), then per field the real chief ray,
  * the spot of real rays aimed at the stop (grid or hexapolar pupil sampling; RMS
  * about the chief ray and about the centroid) and, if asked, ray fans (the trace
- * module's rx_aim, loaded on first use).  The lens file and its missing answers are
- * lensrx.c's (shared with --wave).  Texts in prompts/pupil.txt. */
+ * module's rx_aim, loaded on first use).  Texts in prompts/pupil.txt. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,20 +12,25 @@
 #include "calcio.h"
 #include "dialogues.h"
 #include "engine.h"
-#include "lensrx.h"
+#include "../lens/lens.h"
+#include "../paraxial/paraxial.h"
+#include "../trace/trace.h"
 #include "prompts_pupil.h"
 
 #define P(k) pupil_prompts[PUPIL_##k]
 #define CL(v) lm_clean(d->io, snap(d, (v)))
 #define WORD 4096
+#define MAXFIELD 16
 #define MAXSAMPLE 4096
+#define FILE_MAX (16 << 20)
 #define DEG (3.14159265358979323846 / 180)
 
 typedef struct pdlg {
     lm_io *io;
     calc c;
-    lr_lens L;                 /* the lens file and its answers (lensrx.c) */
-    lr_texts t;
+    ln_lens lens;
+    int have;                  /* lens holds the accepted file */
+    ln_notes notes;
     const trace_api *tr;
     int sampling, nsamp_arg, fans, fan_rays;
     int nsamp;
@@ -39,6 +43,164 @@ typedef struct pdlg {
 static double snap(const pdlg *d, double v)
 {
     return fabs(v) <= 1e-13 * d->scale ? 0.0 : v;
+}
+
+/* ---- the lens file ---------------------------------------------------------------- */
+
+static char *slurp(const char *path, size_t *len, char *msg, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    size_t n = 0, got;
+    if (!f) { snprintf(msg, cap, "%s: cannot be read", path); return NULL; }
+    buf = malloc(FILE_MAX + 1);
+    if (!buf) { fclose(f); snprintf(msg, cap, "out of memory"); return NULL; }
+    while ((got = fread(buf + n, 1, FILE_MAX + 1 - n, f)) > 0) n += got;
+    fclose(f);
+    if (n > FILE_MAX) {
+        free(buf);
+        snprintf(msg, cap, "%s: larger than 16 MiB: not a lens file", path);
+        return NULL;
+    }
+    buf[n] = '\0';
+    *len = n;
+    return buf;
+}
+
+static int check_file(void *ctx, const char *word, char *msg, size_t cap)
+{
+    pdlg *d = ctx;
+    size_t len;
+    char err[LN_ERR_MAX];
+    char *text = slurp(word, &len, msg, cap);
+    ln_lens l;
+    ln_notes notes = {0};
+    int r, read_ok;
+    if (!text) return 1;
+    if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
+    else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
+    free(text);
+    read_ok = r == LN_OK;
+    if (r == LN_OK && ln_check(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
+    if (r == LN_OK && isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_HEIGHT) {
+        snprintf(err, sizeof err, "%s: object heights as fields need a finite object "
+                 "(the object is at infinity: give field angles)", word);
+        r = LN_BAD;
+    }
+    if (r == LN_OK && !isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_ANGLE) {
+        snprintf(err, sizeof err, "%s: field angles with a finite object: give the "
+                 "fields as object heights", word);
+        r = LN_BAD;
+    }
+    if (r == LN_OK && !isinf(l.object) && !(l.object > 0)) {
+        snprintf(err, sizeof err, "%s: the object lies %s surface 1 (a virtual object): "
+                 "rays are aimed only from a real object left of it, or from infinity",
+                 word, l.object == 0 ? "on" : "right of");
+        r = LN_BAD;
+    }
+    if (r == LN_OK && l.nsurf > PX_PUPIL_MAXSURF) {
+        snprintf(err, sizeof err, "%s: %d surfaces: at most %d", word, l.nsurf,
+                 PX_PUPIL_MAXSURF);
+        r = LN_BAD;
+    }
+    if (r != LN_OK) {
+        if (read_ok) ln_free(&l);
+        ln_notes_free(&notes);
+        snprintf(msg, cap, "%s", err);
+        return 1;
+    }
+    if (d->have) ln_free(&d->lens);
+    ln_notes_free(&d->notes);
+    d->lens = l;
+    d->notes = notes;
+    d->have = 1;
+    return 0;
+}
+
+/* ---- small questions -------------------------------------------------------------- */
+
+typedef struct count_ctx { int lo, hi, value; const char *bad; } count_ctx;
+static int check_count(void *ctx, const char *w, char *msg, size_t cap)
+{
+    count_ctx *k = ctx;
+    char *end;
+    long v = strtol(w, &end, 10);
+    if (end == w || *end || v < k->lo || v > k->hi) {
+        snprintf(msg, cap, k->bad, w, k->lo, k->hi);
+        return 1;
+    }
+    k->value = (int)v;
+    return 0;
+}
+
+static int ask_count(pdlg *d, const char *q, const char *bad, int lo, int hi, int *v)
+{
+    char buf[32];
+    count_ctx k = {lo, hi, 0, bad};
+    int rc = lm_ask_word(d->io, q, q, P(COUNT_WHAT), check_count, &k, buf, sizeof buf);
+    *v = k.value;
+    return rc;
+}
+
+static int check_stop(void *ctx, const char *w, char *msg, size_t cap)
+{
+    count_ctx *k = ctx;
+    char *end;
+    long v = strtol(w, &end, 10);
+    if (end == w || *end || v < 1 || v > k->hi) {
+        snprintf(msg, cap, P(STOP_BAD), w, k->hi);
+        return 1;
+    }
+    k->value = (int)v;
+    return 0;
+}
+
+/* Whatever the file leaves out: the stop, the aperture, the fields. */
+static int ask_missing(pdlg *d)
+{
+    ln_lens *l = &d->lens;
+    char q[256], buf[32];
+    int rc;
+    if (l->stop < 0) {
+        count_ctx k = {1, l->nsurf, 0, NULL};
+        snprintf(q, sizeof q, P(STOP), l->nsurf);
+        if ((rc = lm_ask_word(d->io, q, q, P(STOP_WHAT), check_stop, &k, buf, sizeof buf)))
+            return rc;
+        l->stop = k.value - 1;
+    }
+    if (l->ap_kind == LN_AP_NONE) {
+        static const char *const kinds[] = {"epd", "fnum", "na", NULL};
+        int i = 0;
+        double v;
+        if ((rc = calc_choice(&d->c, P(AP_KIND), P(AP_KIND_WHAT), kinds, &i)) ||
+            (rc = calc_num(&d->c, P(AP_VALUE), P(AP_VALUE_WHAT), LM_POSITIVE, &v)))
+            return rc;
+        l->ap_kind = i == 0 ? LN_AP_EPD : i == 1 ? LN_AP_FNUM : LN_AP_NA;
+        l->ap_value = v;
+    }
+    if (l->nfield == 0) {
+        int n, inf = isinf(l->object);
+        if ((rc = ask_count(d, P(NFIELD), P(NFIELD_BAD), 1, MAXFIELD, &n))) return rc;
+        l->field_kind = inf ? LN_FIELD_ANGLE : LN_FIELD_HEIGHT;
+        for (int i = 0; i < n; i++) {
+            double v;
+            for (;;) {
+                lm_mark m;
+                snprintf(q, sizeof q, inf ? P(FIELD_ANGLE) : P(FIELD_HEIGHT), i + 1);
+                calc_mark(&d->c, &m);
+                if ((rc = calc_num(&d->c, q, P(FIELD_WHAT), 0, &v))) return rc;
+                if (!inf || fabs(v) < 90) break;
+                if ((rc = calc_reject(&d->c, &m, P(FIELD_WHAT), q, P(AGAIN_FIELD), "%s",
+                                      P(FIELD_BAD))))
+                    return rc;
+            }
+            l->field[i].x = 0;
+            l->field[i].y = v;
+            l->field[i].weight = 1;
+        }
+        l->nfield = n;
+    }
+    return LM_GO;
 }
 
 /* Grid: cell centres of n x n across [-1, 1]^2 inside the unit circle; hexapolar: the
@@ -73,11 +235,11 @@ static int ask_sampling(pdlg *d)
     int rc;
     if ((rc = calc_choice(&d->c, P(SAMPLING), P(SAMPLING_WHAT), kinds, &d->sampling)))
         return rc;
-    if (d->sampling == 0) rc = lr_ask_count(&d->L, P(GRID), P(COUNT_BAD), 2, 64, &d->nsamp_arg);
-    else rc = lr_ask_count(&d->L, P(HEX), P(COUNT_BAD), 1, 32, &d->nsamp_arg);
+    if (d->sampling == 0) rc = ask_count(d, P(GRID), P(COUNT_BAD), 2, 64, &d->nsamp_arg);
+    else rc = ask_count(d, P(HEX), P(COUNT_BAD), 1, 32, &d->nsamp_arg);
     if (rc) return rc;
     if ((rc = calc_yn(&d->c, P(FANS_Q), P(FANS_Q_WHAT), &d->fans))) return rc;
-    if (d->fans && (rc = lr_ask_count(&d->L, P(FAN_RAYS), P(COUNT_BAD), 3, 101, &d->fan_rays)))
+    if (d->fans && (rc = ask_count(d, P(FAN_RAYS), P(COUNT_BAD), 3, 101, &d->fan_rays)))
         return rc;
     make_samples(d);
     return LM_GO;
@@ -113,7 +275,76 @@ static const char *status_word(int st)
     }
 }
 
-typedef lr_wl wl_ctx;       /* unit field: 45 degrees (tan 1) or height 1 */
+typedef struct wl_ctx {
+    px_pupil p;                /* unit field: 45 degrees (tan 1) or height 1 */
+    trace_rx rx;
+    trace_rx_surface surf[PX_PUPIL_MAXSURF];
+    double s;                  /* marginal-ray scale: primary stop size / this one */
+} wl_ctx;
+
+static int pupil_at(pdlg *d, const px_csurf *cs, const char *obj, double lambda, px_pupil *p,
+                    char *why, size_t cap)
+{
+    const ln_lens *l = &d->lens;
+    px_pupil_in in = {cs, l->nsurf, l->stop, obj, lambda, PX_AP_EPD, l->ap_value,
+                      isinf(l->object) ? INFINITY : l->object, isinf(l->object) ? 45 : 1};
+    in.aperture = l->ap_kind == LN_AP_FNUM ? PX_AP_FNUM : l->ap_kind == LN_AP_NA ? PX_AP_NA
+                                                                              : PX_AP_EPD;
+    if (px_pupil_run(&in, p) != PX_OK) {
+        snprintf(why, cap, "%s", p->why);
+        return -1;
+    }
+    return 0;
+}
+
+static int build_rx(pdlg *d, wl_ctx *w, double lambda, double r_stop, double z_image,
+                    char *why, size_t cap)
+{
+    const ln_lens *l = &d->lens;
+    double z = 0;
+    memset(w->surf, 0, sizeof w->surf);
+    if (ln_index(l, -1, lambda, &w->rx.n_object, NULL, why, cap) != LN_OK) return -1;
+    for (int i = 0; i < l->nsurf; i++) {
+        const ln_surface *s = &l->surf[i];
+        trace_rx_surface *t = &w->surf[i];
+        t->z = z;
+        t->radius = isfinite(s->r) ? s->r : 0;
+        t->conic = s->conic;
+        t->nasph = s->nasph < TRACE_MAXASPH ? s->nasph : TRACE_MAXASPH;
+        for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
+        t->semi_diameter = s->semi;
+        if (ln_index(l, i, lambda, &t->n_right, NULL, why, cap) != LN_OK) return -1;
+        z += s->t;
+    }
+    w->rx.nsurf = l->nsurf;
+    w->rx.surf = w->surf;
+    w->rx.stop = l->stop;
+    w->rx.stop_radius = r_stop;
+    w->rx.z_image = z_image;
+    return 0;
+}
+
+/* The request for pupil point (px, py) of field f. */
+static void request(const pdlg *d, const wl_ctx *w, const ln_field *f, double px, double py,
+                    trace_aim_req *rq)
+{
+    const px_pupil *p = &w->p;
+    memset(rq, 0, sizeof *rq);
+    rq->px = px;
+    rq->py = py;
+    if (isinf(d->lens.object)) {
+        double tx = tan(f->x * DEG), ty = tan(f->y * DEG), n = sqrt(tx * tx + ty * ty + 1);
+        rq->infinite = 1;
+        rq->dir[0] = tx / n; rq->dir[1] = ty / n; rq->dir[2] = 1 / n;
+        rq->z_ref = 0;
+        rq->guess[0] = tx * p->yb[0] + px * p->y[0] * w->s;
+        rq->guess[1] = ty * p->yb[0] + py * p->y[0] * w->s;
+    } else {
+        rq->obj[0] = f->x; rq->obj[1] = f->y; rq->obj[2] = -d->lens.object;
+        rq->guess[0] = f->x * p->ub[0] + px * p->u[0] * w->s;
+        rq->guess[1] = f->y * p->ub[0] + py * p->u[0] * w->s;
+    }
+}
 
 typedef struct aim_tally { int maxit; double maxres; } aim_tally;
 
@@ -122,7 +353,7 @@ static int aim(pdlg *d, const wl_ctx *w, const ln_field *f, double px, double py
 {
     trace_aim_req rq;
     char err[256];
-    lr_request(&d->L, w, f, px, py, &rq);
+    request(d, w, f, px, py, &rq);
     if (d->tr->rx_aim(&w->rx, &rq, out, err, sizeof err) != TRACE_OK) {
         calc_say(&d->c, P(FAIL_TRACE), err);
         return -1;
@@ -184,7 +415,7 @@ static void wavefront_init(const pdlg *d, const wl_ctx *w, const trace_aim_ray *
     if (!isfinite(p->z_xp) || !(chief->img_dir[2] > 0)) return;
     double t = (p->z_xp - chief->img[2]) / chief->img_dir[2];
     if (!(fabs(t) > 0)) return;
-    wf->inf = isinf(d->L.lens.object);
+    wf->inf = isinf(d->lens.object);
     memcpy(wf->c, chief->img, sizeof wf->c);
     wf->R = fabs(t);
     wf->sign = t < 0 ? 1 : -1;
@@ -198,7 +429,7 @@ static void wavefront_init(const pdlg *d, const wl_ctx *w, const trace_aim_ray *
 
 static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
 {
-    const ln_lens *l = &d->L.lens;
+    const ln_lens *l = &d->lens;
     const ln_field *f = &l->field[fi];
     const px_pupil *p = &w->p;
     trace_aim_ray chief, r;
@@ -308,7 +539,7 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
 static void report_pupil(pdlg *d, const wl_ctx *w, double fbig)
 {
     const px_pupil *p = &w->p;
-    const ln_lens *l = &d->L.lens;
+    const ln_lens *l = &d->lens;
     int inf = isinf(l->object), N = l->nsurf - 1;
     double k = inf ? tan(fbig * DEG) : fbig;
     char a[32], b[32], c[32], e[32];
@@ -350,13 +581,18 @@ static int refuse(pdlg *d, const char *why)
 
 static int compute(pdlg *d)
 {
-    const ln_lens *l = &d->L.lens;
-    char why[LN_ERR_MAX], ob[64];
+    const ln_lens *l = &d->lens;
+    px_csurf cs[PX_PUPIL_MAXSURF];
+    char names[PX_PUPIL_MAXSURF + 1][LN_NAME_MAX], why[LN_ERR_MAX], ob[64];
+    const char *obj;
     wl_ctx *w;
-    double lp = ln_primary(l), z_image, fbig = 0;
+    px_pupil prim;
+    double lp = ln_primary(l), z_image, zl = 0, fbig = 0;
     int nwl = l->nwl ? l->nwl : 1, rc = LM_GO;
-    if (lr_prepare(&d->L, why, sizeof why)) return refuse(d, why);
-    d->scale = d->L.scale;
+    if (ln_to_csurf(l, cs, names, &obj, why, sizeof why) != LN_OK) return refuse(d, why);
+    if (pupil_at(d, cs, obj, lp, &prim, why, sizeof why)) return refuse(d, why);
+    d->scale = fmax(fabs(prim.efl), prim.r_stop);
+    for (int i = 0; i + 1 < l->nsurf; i++) zl += l->surf[i].t;
     for (int i = 0; i < l->nfield; i++)
         if (fabs(l->field[i].y) > fabs(fbig)) fbig = l->field[i].y;
     if (isinf(l->object)) snprintf(ob, sizeof ob, "%s", P(OBJ_INF));
@@ -364,11 +600,12 @@ static int compute(pdlg *d)
     calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
              l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
              l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
-    z_image = d->L.z_image;
-    if (d->L.image_from_file) {
+    if (l->surf[l->nsurf - 1].t > 0) {
+        z_image = zl + l->surf[l->nsurf - 1].t;
         calc_say(&d->c, P(IMAGE_FILE), z_image, d->c.uname);
     } else {
-        if (!isfinite(z_image)) return refuse(d, P(NO_IMAGE));
+        if (!isfinite(prim.z_img)) return refuse(d, P(NO_IMAGE));
+        z_image = prim.z_img;
         calc_say(&d->c, P(IMAGE_PARAXIAL), CL(z_image), d->c.uname, lp * 1000);
     }
     calc_say(&d->c, P(SAMPLING_ECHO), d->sampling ? "hexapolar" : "grid", d->nsamp);
@@ -376,10 +613,12 @@ static int compute(pdlg *d)
     if (!(w = malloc(sizeof *w))) return LM_FAIL;
     for (int k = 0; k < nwl && rc == LM_GO; k++) {
         double lambda = l->nwl ? l->wl[k] : lp;
-        if (lr_at(&d->L, lambda, w, why, sizeof why)) {
+        if (pupil_at(d, cs, obj, lambda, &w->p, why, sizeof why) ||
+            build_rx(d, w, lambda, prim.r_stop, z_image, why, sizeof why)) {
             rc = refuse(d, why);
             break;
         }
+        w->s = prim.r_stop / w->p.r_stop;
         calc_say(&d->c, P(WL_HEAD), lambda * 1000);
         report_pupil(d, w, fbig);
         for (int f = 0; f < l->nfield && rc == LM_GO; f++) rc = one_field(d, w, f, lambda);
@@ -391,23 +630,34 @@ static int compute(pdlg *d)
 int lm_pupil(lm_io *io)
 {
     pdlg dd, *d = &dd;
+    char name[WORD];
     int rc;
     memset(d, 0, sizeof *d);
     d->io = io;
     d->c.io = io;
     d->c.unit = PX_MM;
     d->c.uname = "mm";
-    d->t = (lr_texts){P(FILE), P(FILE_WHAT), P(NOTE), P(STOP), P(STOP_WHAT), P(STOP_BAD),
-                      P(AP_KIND), P(AP_KIND_WHAT), P(AP_VALUE), P(AP_VALUE_WHAT), P(NFIELD),
-                      P(NFIELD_WHAT), P(NFIELD_BAD), P(FIELD_ANGLE), P(FIELD_HEIGHT),
-                      P(FIELD_WHAT), P(FIELD_BAD), P(AGAIN_FIELD), P(COUNT_WHAT), P(COUNT_BAD)};
-    rc = lr_ask_lens(&d->L, &d->c, &d->t);
-    if (rc == LM_GO && (rc = ask_sampling(d)) == LM_GO) {
-        if (lm_stop_requested()) rc = LM_FAIL;
-        else rc = compute(d);
+    rc = lm_ask_word(io, P(FILE), P(FILE), P(FILE_WHAT), check_file, d, name, sizeof name);
+    if (rc == LM_GO) {
+        if (d->notes.s && d->notes.len) {
+            char *s = d->notes.s, *e;
+            while (*s) {
+                e = strchr(s, '\n');
+                if (e) *e = '\0';
+                calc_say(&d->c, P(NOTE), s);
+                if (!e) break;
+                s = e + 1;
+            }
+        }
+        d->c.uname = d->lens.unit[0] ? d->lens.unit : "mm";
+        if ((rc = ask_missing(d)) == LM_GO && (rc = ask_sampling(d)) == LM_GO) {
+            if (lm_stop_requested()) rc = LM_FAIL;
+            else rc = compute(d);
+        }
     }
     if (rc == LM_GO) rc = calc_done(&d->c);
-    lr_free(&d->L);
+    if (d->have) ln_free(&d->lens);
+    ln_notes_free(&d->notes);
     return rc;
 }
 const char *lm_pupil_example(void) { return P(EXAMPLE); }
