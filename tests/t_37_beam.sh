@@ -29,7 +29,7 @@ check "--beam is listed by --help" sh -c "'$BIN' --help | grep -q -- '--beam'"
 # leaves a virtual waist where Self's formula puts it, and the beam 100 mm on is the
 # far-field closed form's (an independent awk model)
 beam_cornea() {
-    printf 'mm\n632.8\n1\n1\n1\n0\nmirror\n0\n7.8\nplane\n100\nend\n' > "$BM/c.in"
+    printf 'mm\n632.8\n1\n1\n1\n0\nmirror\n0\n7.8\nplane\n100\nend\n0\n' > "$BM/c.in"
     (cd "$BM" && "$BIN" --beam -i c.in c.rec > /dev/null) || return 1
     awk 'BEGIN { pi = 3.14159265358979; l = 632.8e-6; w0 = 1; f = -3.9
                  zr = pi * w0 * w0 / l; s = 0

@@ -109,6 +109,27 @@ int lm_beam(lm_io *io)
         zprev = z;
         first = 0;
     }
+    /* the seed's trade-off: the beam small on two planes L apart at once is smallest
+       with its waist midway and zR = L/2 (w = sqrt 2 w0 on both); any other waist
+       is larger on one of them */
+    double span;
+    if ((rc = calc_num(c, BM(SPAN), BM(SPAN_WHAT), LM_NONNEG, &span))) return rc;
+    if (span > 0) {
+        double n = b.n, wb = sqrt(m2 * lambda * span / (2 * 3.14159265358979323846 * n));
+        double w_half, w_two;
+        px_beam t;
+        px_beam_at a;
+        px_beam_waist(wb / 2, span / 2, lambda, m2, n, &t);
+        px_beam_props(&t, &a);
+        w_half = a.w;
+        px_beam_waist(2 * wb, span / 2, lambda, m2, n, &t);
+        px_beam_props(&t, &a);
+        w_two = a.w;
+        char s1[40], s2[40], s3[40], s4[40], s5[40], s6[40];
+        calc_say(c, BM(BALANCE), num(c, span, s1, sizeof s1), num(c, n, s2, sizeof s2),
+                 num(c, wb, s3, sizeof s3), num(c, sqrt(2) * wb, s4, sizeof s4),
+                 num(c, w_half, s5, sizeof s5), num(c, w_two, s6, sizeof s6));
+    }
     return calc_done(c);
 }
 

@@ -35,6 +35,8 @@ int lm_colour(lm_io *io);       const char *lm_colour_example(void);   /* colour
 int lm_pupil(lm_io *io);        const char *lm_pupil_example(void);    /* pupil.c */
 int lm_optimise(lm_io *io);     const char *lm_optimise_example(void); /* optimise.c */
 int lm_tolerance(lm_io *io);    const char *lm_tolerance_example(void); /* tolerance.c */
+int lm_wave(lm_io *io);         const char *lm_wave_example(void);     /* wave.c */
+int lm_polar(lm_io *io);        const char *lm_polar_example(void);    /* polar.c */
 
 /* A lens read from a file (prescription.c): a classic record, its grep'd or plain
  * answers, or a prescription file.  lm_read_lens: LM_GO, or LM_FAIL with

@@ -54,6 +54,10 @@ const lm_dialogue lm_dialogues[] = {
      lm_optimise, lm_optimise_example, "design", 0},
     {"--tolerance", "a lens file's tolerances: sensitivities, Monte Carlo of built lenses, yield",
      lm_tolerance, lm_tolerance_example, "design", 0},
+    {"--wave", "wave optics of a lens file: wavefront, Zernike, PSF, Strehl, EE, MTF (42-45)",
+     lm_wave, lm_wave_example, "wave", 0},
+    {"--polar", "polarization and thin films: Jones calculus, Fresnel and TIR phases, coatings (40, 67-71)",
+     lm_polar, lm_polar_example, "wave", 0},
 };
 const size_t lm_ndialogues = sizeof lm_dialogues / sizeof lm_dialogues[0];
 

@@ -1,6 +1,7 @@
 /* tr_engine.c -- the function table the trace module exports (trace_get_api): the
  * scene (tr_scene.c), the run (tr_pool.c, tr_lanes.c, tr_trace.c), optics
- * (tr_optics.c), lenses (tr_lens.c) and aimed rays (tr_aim.c) behind one ABI-checked table. */
+ * (tr_optics.c), lenses (tr_lens.c), aimed rays (tr_aim.c) and their wave aberration
+ * (tr_opd.c) behind one ABI-checked table. */
 #include "tr_eng.h"
 
 /* ---------------- the table ---------------- */
@@ -40,6 +41,7 @@ static const trace_api api = {
     tr_set_absorption,
     tr_rx_trace,
     tr_rx_aim,
+    tr_rx_opd,
 };
 
 const trace_api *trace_get_api(int abi)

@@ -285,6 +285,9 @@ int tr_rx_trace(const trace_rx *rx, const double o[3], const double d[3], double
                 trace_aim_ray *out, char *err, size_t cap);
 int tr_rx_aim(const trace_rx *rx, const trace_aim_req *rq, trace_aim_ray *out, char *err,
               size_t cap);
+int tr_rx_opd(const trace_rx *rx, const trace_aim_req *rq, int n, double z_xp, double lambda,
+              double *w, int *st, trace_aim_ray *chief, double *R_ref, char *err,
+              size_t errcap);
 
 /* Lens hints (tr_scene.c): after refraction at surface id a forward ray can only
  * meet cand[0..n-1] (-1 entries skipped); valid until another surface is added. */

@@ -408,6 +408,21 @@ typedef struct trace_api {
                     double *pts, trace_aim_ray *out, char *err, size_t errcap);
     int (*rx_aim)(const trace_rx *rx, const trace_aim_req *rq, trace_aim_ray *out,
                   char *err, size_t errcap);
+
+    /* The wave aberration of aimed rays (tr_opd.c; added after rx_aim): rq[0] the chief
+     * ray, rq[1..n-1] pupil rays, each aimed as rx_aim does.  w[i] (waves of lambda,
+     * lambda in the lens's unit) is Welford's W: the chief ray's optical path to the
+     * reference sphere minus ray i's, positive where the wavefront leads the sphere;
+     * the sphere is centred on the chief ray's image point and passes through the
+     * chief ray's crossing of the plane z = z_xp (the exit pupil's).  Paths count from
+     * the object point, or (rq->infinite) from the plane wavefront through the origin.
+     * w[i] is NaN where ray i is not TRACE_AIM_OK or misses the sphere; st (may be
+     * NULL) gets each status; chief (may be NULL) the chief ray; *R_ref (may be NULL)
+     * the sphere's radius.  TRACE_OK, or TRACE_EINVAL (bad rx or request, the chief
+     * ray does not pass, no sphere: err says why). */
+    int (*rx_opd)(const trace_rx *rx, const trace_aim_req *rq, int n, double z_xp,
+                  double lambda, double *w, int *st, trace_aim_ray *chief, double *R_ref,
+                  char *err, size_t errcap);
 } trace_api;
 
 typedef const trace_api *(*trace_get_api_fn)(int abi);

@@ -1,0 +1,61 @@
+/* lensrx.h -- a lens file made ready for rays aimed at its stop, for the dialogues
+ * that need real rays through a prescription (--wave): the file asked and read
+ * (src/lens), whatever it leaves out asked (stop, aperture, fields), the primary
+ * wavelength's first-order pupils and image plane (src/paraxial), and per wavelength
+ * the trace module's trace_rx and aim requests.  The same steps as --pupil's
+ * (pupil.c), with the questions' texts from the calling dialogue's prompts. */
+#ifndef LENSRX_H
+#define LENSRX_H
+#include "calcio.h"
+#include "../lens/lens.h"
+#include "../paraxial/paraxial.h"
+#include "../trace/trace.h"
+
+#define LR_MAXFIELD 16
+
+typedef struct lr_texts {
+    const char *file, *file_what, *note, *stop, *stop_what, *stop_bad, *ap_kind,
+        *ap_kind_what, *ap_value, *ap_value_what, *nfield, *nfield_what, *nfield_bad,
+        *field_angle, *field_height, *field_what, *field_bad, *again_field, *count_what,
+        *count_bad;
+} lr_texts;
+
+typedef struct lr_lens {
+    calc *c;
+    const lr_texts *t;
+    ln_lens lens;
+    int have;
+    ln_notes notes;
+    /* lr_prepare: */
+    px_csurf cs[PX_PUPIL_MAXSURF];
+    char names[PX_PUPIL_MAXSURF + 1][LN_NAME_MAX];
+    const char *obj;
+    px_pupil prim;             /* the primary wavelength's pupils */
+    double z_image;            /* the image plane rays are carried to (not finite:
+                                  afocal at the image, no plane to carry them to) */
+    int image_from_file;       /* 1: the file's last thickness; 0: paraxial focus */
+    double scale;              /* the lens's size (efl, stop) */
+} lr_lens;
+
+typedef struct lr_wl {
+    double lambda;             /* um */
+    px_pupil p;
+    trace_rx rx;
+    trace_rx_surface surf[PX_PUPIL_MAXSURF];
+    double s;                  /* marginal-ray scale: primary stop size / this one */
+} lr_wl;
+
+/* Ask the lens file and what it leaves out; print its notes.  LM_GO, LM_QUIT, LM_FAIL. */
+int lr_ask_lens(lr_lens *L, calc *c, const lr_texts *t);
+/* A whole number lo..hi (t->count_what, t->count_bad). */
+int lr_ask_count(lr_lens *L, const char *q, const char *bad, int lo, int hi, int *v);
+/* Pupils and image plane at the primary wavelength: 0 (check z_image), or -1 with why. */
+int lr_prepare(lr_lens *L, char *why, size_t cap);
+/* Wavelength lambda (um): its pupils and trace_rx.  0, or -1 with why. */
+int lr_at(const lr_lens *L, double lambda, lr_wl *w, char *why, size_t cap);
+/* The aim request for pupil point (px, py) (stop coordinates, 1 at its rim) of field f. */
+void lr_request(const lr_lens *L, const lr_wl *w, const ln_field *f, double px, double py,
+                trace_aim_req *rq);
+void lr_free(lr_lens *L);
+
+#endif
