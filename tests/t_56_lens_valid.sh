@@ -46,3 +46,12 @@ check "--draw: semi 12 on the crossing lens refused at its answer, same words as
     lv_draw 12 "surfaces 1 and 2 would cross at height $H (edge thickness -6 at the semi-diameter 12): give at most $H"
 check "--draw: semi 25 on a radius-20 sphere refused at its answer, same words" \
     lv_draw 25 "surface 1 has radius 20, so its semi-diameter can be at most 20 (not 25)"
+# --wave reads its lens file through lensrx.c: the same refusal, the same words
+lv_wave() {
+    lv_setup
+    (cd "$LV" && printf 'cross.rx\n' > w.in && "$ASAN" --wave -i w.in w.rec > out 2> err); rc=$?
+    [ $rc -eq 2 ] || { echo "exit $rc"; cat "$LV/err"; return 1; }
+    grep -qF "lensmat: w.in:1: the lens file: cross.rx:4: surfaces 1 and 2 would cross at height $H" "$LV/err" ||
+        { cat "$LV/err"; return 1; }
+}
+check "--wave: the crossing lens refused at the file's line, as --pupil refuses it" lv_wave

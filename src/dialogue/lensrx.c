@@ -35,16 +35,19 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
     lr_lens *L = ctx;
     size_t len;
     char err[LN_ERR_MAX];
-    char *text = slurp(word, &len, msg, cap);
+    char *text;
     ln_lens l;
     ln_notes notes = {0};
     int r, read_ok;
-    if (!text) return 1;
+    /* the session's file registry (an input may not be an output of this session) */
+    if (lm_check_input(L->c->io, word, "the lens file", msg, cap)) return 1;
+    if (!(text = slurp(word, &len, msg, cap))) return 1;
     if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
     else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
     free(text);
     read_ok = r == LN_OK;
     if (r == LN_OK && ln_check(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
+    if (r == LN_OK && ln_check_shape(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
     if (r == LN_OK && isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_HEIGHT) {
         snprintf(err, sizeof err, "%s: object heights as fields need a finite object "
                  "(the object is at infinity: give field angles)", word);
@@ -171,7 +174,7 @@ int lr_ask_lens(lr_lens *L, calc *c, const lr_texts *t)
     int rc;
     L->c = c;
     L->t = t;
-    rc = lm_ask_word(c->io, t->file, t->file, t->file_what, check_file, L, name, sizeof name);
+    rc = lm_ask_file(c->io, t->file, t->file, t->file_what, check_file, L, name, sizeof name);
     if (rc != LM_GO) return rc;
     if (L->notes.s && L->notes.len) {
         char *s = L->notes.s, *e;
