@@ -429,7 +429,7 @@ int lm_draw(lm_io *io)
     free(d);
     if (rc) return rc;
     lm_check_leftover(io);
-    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_shown);
     return LM_GO;
 }
 

@@ -646,7 +646,7 @@ int lm_trace(lm_io *io)
     if (t.have_scene) t.api->free(&t.scene);
     if (rc) return rc;
     lm_check_leftover(io);
-    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_shown);
     return LM_GO;
 }
 

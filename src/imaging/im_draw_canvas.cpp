@@ -275,39 +275,10 @@ int Canvas::write(const im_out *out, char *err, size_t cap) const
     return rc;
 }
 
+/* the engine's one writer (im_frame.c, on src/common/lm_out.h) */
 int write_atomic(const char *path, const void *data, size_t len, char *err, size_t cap)
 {
-    std::string tmp = std::string(path) + ".part.XXXXXX";
-    std::vector<char> t(tmp.begin(), tmp.end());
-    t.push_back('\0');
-    int fd = mkstemp(t.data());
-    if (fd < 0) {
-        set_err(err, cap, "%s: cannot write: %s", path, strerror(errno));
-        return IM_EIO;
-    }
-    const char *p = (const char *)data;
-    size_t left = len;
-    while (left > 0) {
-        ssize_t n = ::write(fd, p, left);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            set_err(err, cap, "%s: cannot write: %s", path, n < 0 ? strerror(errno) : "short write");
-            close(fd);
-            unlink(t.data());
-            return IM_EIO;
-        }
-        p += n;
-        left -= (size_t)n;
-    }
-    mode_t mask = umask(0);   /* a picture gets the modes fopen would give it */
-    umask(mask);
-    fchmod(fd, 0666 & ~mask);
-    if (close(fd) != 0 || rename(t.data(), path) != 0) {
-        set_err(err, cap, "%s: cannot write: %s", path, strerror(errno));
-        unlink(t.data());
-        return IM_EIO;
-    }
-    return IM_OK;
+    return im_write_atomic(path, data, len, err, cap);
 }
 
 double nice_step(double span, int target)

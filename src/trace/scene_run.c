@@ -14,6 +14,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "common/lm_out.h"
 #include "paraxial/paraxial.h"
 #include "scene.h"
 
@@ -323,7 +324,7 @@ oom:
 
 typedef struct out {
     FILE *seg, *hit;
-    char *seg_part, *hit_part;
+    lm_out seg_out, hit_out;    /* where seg and hit go (src/common/lm_out.h) */
     int tty;
     double t0, last;
     int shown;
@@ -399,34 +400,22 @@ static int w_progress(void *ctx, uint64_t done, uint64_t total)
     return 0;
 }
 
-static char *part_name(const char *name)
+/* An output through the shared writer: a unique temporary beside a regular file, in
+ * place for a device or FIFO, "-" for standard output (src/common/lm_out.h). */
+static FILE *open_part(const char *name, lm_out *o, char *err)
 {
-    char *p = malloc(strlen(name) + 6);
-    if (p) sprintf(p, "%s.part", name);
-    return p;
+    if (lm_out_open(o, name, 0, err, SC_ERRMAX)) return NULL;
+    return o->f;
 }
 
-static FILE *open_part(const char *name, char **part, char *err)
+/* Commit o when ok, else keep what was written as NAME.part (never under its name);
+ * 0 or -1, with a message in err unless one is there already. */
+static int finish(lm_out *o, int ok, char *err)
 {
-    FILE *f;
-    if (!(*part = part_name(name))) {
-        snprintf(err, SC_ERRMAX, "out of memory");
-        return NULL;
-    }
-    if (!(f = fopen(*part, "w")))
-        snprintf(err, SC_ERRMAX, "%s: cannot write: %s", *part, strerror(errno));
-    return f;
-}
-
-/* Close f and rename part to name when ok (else leave the .part); 0 or -1, with a
- * message in err unless one is there already. */
-static int finish(FILE *f, const char *part, const char *name, int ok, char *err)
-{
-    int bad = ferror(f) | fclose(f);
-    if (bad && !err[0]) snprintf(err, SC_ERRMAX, "%s: write error", part);
-    if (!ok || bad) return -1;
-    if (rename(part, name) && !err[0]) {
-        snprintf(err, SC_ERRMAX, "%s: cannot rename to %s: %s", part, name, strerror(errno));
+    char why[SC_ERRMAX];
+    if (!ok) { lm_out_abort(o, 1); return -1; }
+    if (lm_out_commit(o, why, sizeof why)) {
+        if (!err[0]) snprintf(err, SC_ERRMAX, "%s", why);
         return -1;
     }
     return 0;
@@ -462,10 +451,9 @@ static void add_summary(trace_summary *a, const trace_summary *b)
 static int write_summary(const sc_scene *sc, const trace_summary *s, const double *wl,
                          const trace_summary *per, int nwl, char *err)
 {
-    char *part;
-    FILE *f = open_part(sc->out_summary, &part, err);
-    int rc;
-    if (!f) { free(part); return -1; }
+    lm_out o;
+    FILE *f = open_part(sc->out_summary, &o, err);
+    if (!f) return -1;
     fprintf(f, "scene %s\nrays %llu\nsegments %llu\ninteractions %llu\ntir %llu\n"
             "hits %llu\ncut_depth %llu\ncut_power %llu\ncut_reflection %llu\n"
             "failures %llu\nmedium_mismatch %llu\nemitted %.17g\ndetected %.17g\n"
@@ -483,9 +471,7 @@ static int write_summary(const sc_scene *sc, const trace_summary *s, const doubl
                 (unsigned long long)per[k].rays, (unsigned long long)per[k].hits,
                 per[k].emitted, per[k].detected, per[k].absorbed, per[k].escaped,
                 per[k].cutoff);
-    rc = finish(f, part, sc->out_summary, 1, err);
-    free(part);
-    return rc;
+    return finish(&o, 1, err);
 }
 
 /* The engine's scene at wavelength l (0: none named): every surface with its media at
@@ -557,11 +543,11 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     sink.ctx = &o;
     sink.progress = w_progress;
     if (sc->out_segments) {
-        if (!(o.seg = open_part(sc->out_segments, &o.seg_part, err))) goto out;
+        if (!(o.seg = open_part(sc->out_segments, &o.seg_out, err))) goto out;
         sink.segment = w_segment;
     }
     if (sc->out_hits) {
-        if (!(o.hit = open_part(sc->out_hits, &o.hit_part, err))) goto out;
+        if (!(o.hit = open_part(sc->out_hits, &o.hit_out, err))) goto out;
         fputs(o.wl ? hit_header_wl : hit_header, o.hit);
         sink.hit = w_hit;
     }
@@ -594,10 +580,8 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     }
 out:
     /* finish() leaves a message in err on any failure */
-    if (o.seg) finish(o.seg, o.seg_part, sc->out_segments, !err[0], err);
-    if (o.hit) finish(o.hit, o.hit_part, sc->out_hits, !err[0], err);
-    free(o.seg_part);
-    free(o.hit_part);
+    if (o.seg) finish(&o.seg_out, !err[0], err);
+    if (o.hit) finish(&o.hit_out, !err[0], err);
     if (ts) tr->scene_free(ts);
     if (!err[0] && sc->out_summary) write_summary(sc, &res->sum, wl, per, nwl, err);
     return err[0] ? -1 : 0;
