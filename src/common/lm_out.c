@@ -278,7 +278,8 @@ int lm_out_save(const char *path, const void *data, size_t len, char *err, size_
             char *name = o.name;
             o.name = NULL;
             lm_out_abort(&o, 0);
-            fail(err, cap, name ? name : path, "write error", e);
+            fail(err, cap, !strcmp(path, "-") ? "standard output" : name ? name : path,
+                 "write error", e);
             free(name);
             return -1;
         }

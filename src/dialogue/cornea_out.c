@@ -186,3 +186,46 @@ out:
     free(grid); free(xy); free(pv); free(px); free(py); free(mk);
     return rc;
 }
+
+void cs_manifest_name(const char *pattern, char *name, size_t cap)
+{
+    const char *dot = strrchr(pattern, '.');
+    size_t o = 0;
+    if (!cap) return;
+    for (const char *p = pattern; *p && p != dot && o + 1 < cap; p++) {
+        if (*p == '%' && p[1] == '%') { name[o++] = '%'; p++; continue; }
+        if (*p == '%') {                /* %d, %04d: the frame number */
+            while (*p && *p != 'd') p++;
+            if (!*p) break;
+            o += (size_t)snprintf(name + o, cap - o, "-frames");
+            if (o >= cap) { o = cap - 1; break; }
+            continue;
+        }
+        name[o++] = *p;
+    }
+    name[o] = '\0';
+    snprintf(name + o, cap - o, ".txt");
+}
+
+int cs_write_manifest(const char *pattern, const int *seq, int n, int nplanned,
+                      const char *status, char *msg, size_t cap)
+{
+    char path[1100], one[1100];
+    size_t need = 512 + strlen(pattern) + strlen(status) + (size_t)n * (sizeof one), len;
+    char *buf = malloc(need);
+    int rc;
+    if (!buf) { snprintf(msg, cap, "out of memory"); return -1; }
+    cs_manifest_name(pattern, path, sizeof path);
+    len = (size_t)snprintf(buf, need, "# lensmat --cornea-scan: the frames of one scan, "
+                           "saved as %s.\n# A frame that pattern names but this list does "
+                           "not is not this scan's.\nscan %s\nframes %d of %d\n",
+                           pattern, status, n, nplanned);
+    for (int i = 0; i < n && len < need; i++) {
+        snprintf(one, sizeof one, pattern, seq[i]);
+        len += (size_t)snprintf(buf + len, need - len, "%s\n", one);
+    }
+    rc = len < need ? lm_out_save(path, buf, len, msg, cap) : -1;
+    if (len >= need) snprintf(msg, cap, "manifest too long");
+    free(buf);
+    return rc;
+}

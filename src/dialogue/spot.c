@@ -269,7 +269,14 @@ static int stream(sdlg *d)
                    s[0].snr, fl);
         d->fa->frame_free(f);
         n++;
-        if (lm_stop_requested()) { rc = LM_FAIL; break; }
+        fflush(stdout);                 /* each frame's line as it is computed */
+        if (lm_stop_requested()) {      /* say where, on stderr and in the record */
+            lm_say(d->io, LM_BOTH, P(SINTERRUPTED), n, count, lm_stop_requested());
+            fprintf(stderr, "lensmat: ");
+            fprintf(stderr, P(SINTERRUPTED), n, count, lm_stop_requested());
+            rc = LM_FAIL;
+            break;
+        }
     }
     if (rc == LM_GO && n == count) {
         im_frame *f;

@@ -2,6 +2,7 @@
  * BGR image (anti-aliased lines with 8 bits of sub-pixel position) and appended to
  * an SVG document with the same coordinates; atomic writes of both files. */
 #include "im_draw.hpp"
+#include "common/lm_out.h"
 #include <opencv2/imgproc.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <cerrno>
@@ -275,10 +276,11 @@ int Canvas::write(const im_out *out, char *err, size_t cap) const
     return rc;
 }
 
-/* the engine's one writer (im_frame.c, on src/common/lm_out.h) */
+/* pictures go through the shared writer (src/common/lm_out.h), like frames: a unique
+ * temporary renamed over a regular file, a device or FIFO in place, a link's target */
 int write_atomic(const char *path, const void *data, size_t len, char *err, size_t cap)
 {
-    return im_write_atomic(path, data, len, err, cap);
+    return lm_out_save(path, data, len, err, cap) ? IM_EIO : IM_OK;
 }
 
 double nice_step(double span, int target)
