@@ -249,3 +249,30 @@ scan_int() {
     [ "$new" = "$(grep '^fr/g' "$m" | sort)" ] || { echo "the list is not the scan's frames"; return 1; }
 }
 check "outputs: an interrupted scan over an earlier scan's frames: its manifest, where it stopped, no report" scan_int
+
+# A long scan shows how far it is on a terminal (stderr only when it is one).
+scan_progress() {
+    d=$OW/progress; mkdir -p "$d"
+    printf 'biconic\n-\nspiral\n60\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n1\n14\n1\n0\n-\n' > "$d/p.in"
+    (cd "$d" && "$BIN" --cornea-scan -i p.in f.rec > f.out 2> f.err) || return 1
+    ! grep -q 'measuring' "$d/f.err" || { echo "progress on a stderr that is a file"; return 1; }
+    python3 - "$BIN" "$d" <<'PYEOF'
+import os, pty, subprocess, sys
+m, s = pty.openpty()
+p = subprocess.Popen([sys.argv[1], "--cornea-scan", "-i", "p.in", "t.rec"], cwd=sys.argv[2],
+                     stdout=open(os.path.join(sys.argv[2], "t.out"), "w"), stderr=s)
+os.close(s)
+buf = b""
+while True:
+    try: chunk = os.read(m, 4096)
+    except OSError: break
+    if not chunk: break
+    buf += chunk
+p.wait()
+ok = p.returncode == 0 and b"lensmat: measuring: point " in buf
+print("exit %d, terminal saw %r" % (p.returncode, buf[:200]))
+sys.exit(0 if ok else 1)
+PYEOF
+    cmp "$d/f.rec" "$d/t.rec" || { echo "the record differs with a terminal"; return 1; }
+}
+check "outputs: a scan's progress on a terminal's stderr only, the record unchanged" scan_progress

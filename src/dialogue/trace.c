@@ -84,12 +84,20 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
     return 0;
 }
 
+static void report_output(tdlg *t, const char *name, const char *what)
+{
+    char shown[4 * WORD + 4];           /* a scene's name for a file, escaped */
+    if (!name) return;
+    lm_escape(name, shown, sizeof shown);
+    lm_say(t->io, LM_BOTH, P(WRITTEN), shown, what);
+}
+
 static void report_outputs(tdlg *t)
 {
     const sc_scene *sc = &t->scene;
-    if (sc->out_segments) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_segments, P(WRITTEN_SEGMENTS));
-    if (sc->out_hits) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_hits, P(WRITTEN_HITS));
-    if (sc->out_summary) lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_summary, P(WRITTEN_SUMMARY));
+    report_output(t, sc->out_segments, P(WRITTEN_SEGMENTS));
+    report_output(t, sc->out_hits, P(WRITTEN_HITS));
+    report_output(t, sc->out_summary, P(WRITTEN_SUMMARY));
 }
 
 static void report_summary(tdlg *t, const trace_summary *s)
