@@ -256,7 +256,7 @@ scan_progress() {
     printf 'biconic\n-\nspiral\n60\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n1\n14\n1\n0\n-\n' > "$d/p.in"
     (cd "$d" && "$BIN" --cornea-scan -i p.in f.rec > f.out 2> f.err) || return 1
     ! grep -q 'measuring' "$d/f.err" || { echo "progress on a stderr that is a file"; return 1; }
-    python3 - "$BIN" "$d" <<'PYEOF'
+    python3 - "$BIN" "$d" <<'PYEOF' || return 1
 import os, pty, subprocess, sys
 m, s = pty.openpty()
 p = subprocess.Popen([sys.argv[1], "--cornea-scan", "-i", "p.in", "t.rec"], cwd=sys.argv[2],
