@@ -276,3 +276,20 @@ PYEOF
     cmp "$d/f.rec" "$d/t.rec" || { echo "the record differs with a terminal"; return 1; }
 }
 check "outputs: a scan's progress on a terminal's stderr only, the record unchanged" scan_progress
+
+# The many-eyes study's tables (scripts/cornea-study.sh) by the same rules: a link to
+# its table stays and its target gets the table; a FIFO there carries it.
+study_outputs() {
+    d=$OW/study; mkdir -p "$d/st"
+    ln -s ../keep.tsv "$d/st/study.tsv"; mkfifo "$d/st/percentiles.tsv"
+    timeout 120 cat "$d/st/percentiles.tsv" > "$d/pct.got" & cpid=$!
+    timeout 120 "$TOP/scripts/cornea-study.sh" -M 2 -p 100 -s 8 -o "$d/st" > "$d/log" 2>&1; rc=$?
+    release "$d/st" percentiles.tsv; wait $cpid
+    [ "$rc" -eq 0 ] || { echo "exit $rc"; tail -5 "$d/log"; return 1; }
+    [ -L "$d/st/study.tsv" ] && [ -p "$d/st/percentiles.tsv" ] || { ls -l "$d/st"; return 1; }
+    [ "$(head -c 9 "$d/keep.tsv")" = "$(printf 'eye\ttrue_')" ] && [ "$(wc -l < "$d/keep.tsv")" -eq 3 ] &&
+        head -n 1 "$d/pct.got" | grep -q '^parameter' && [ -z "$(ls "$d/st" | grep part)" ]
+}
+if command -v parallel > /dev/null 2>&1 && parallel --version 2>/dev/null | grep -q 'GNU parallel'; then
+    check "outputs: cornea-study.sh's tables through a link and into a FIFO" study_outputs
+fi
