@@ -154,17 +154,6 @@ static int io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_nam
     return 0;
 }
 
-int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
-               int original)
-{
-    return io_open(io, rec_name, in, in_name, original, 0);
-}
-
-int lm_io_open_whole(lm_io *io, const char *out_name, FILE *in, const char *in_name)
-{
-    return io_open(io, out_name, in, in_name, 0, 1);
-}
-
 int lm_check_output(const lm_io *io, const char *path, char *msg, size_t cap)
 {
     struct stat st;
@@ -224,6 +213,17 @@ int lm_stdout_check(void)
         said = 1;
     }
     return -1;
+}
+
+int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
+               int original)
+{
+    return io_open(io, rec_name, in, in_name, original, 0);
+}
+
+int lm_io_open_whole(lm_io *io, const char *out_name, FILE *in, const char *in_name)
+{
+    return io_open(io, out_name, in, in_name, 0, 1);
 }
 
 void lm_say(lm_io *io, int where, const char *fmt, ...)
