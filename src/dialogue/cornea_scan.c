@@ -258,7 +258,9 @@ static int cs_files(cs *s, const cl_run *r, int maps, const cs_truth *tr)
         fprintf(stderr, "lensmat: ");
         fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
     } else {
-        lm_say(s->cc.io, LM_OUT, CS(REPORT_WRITTEN), s->report, s->report, s->report);
+        char shown[4 * sizeof s->report + 4];   /* the name, control bytes escaped */
+        lm_escape(s->report, shown, sizeof shown);
+        lm_say(s->cc.io, LM_OUT, CS(REPORT_WRITTEN), shown, shown, shown);
     }
     free(sp);
     return rc;

@@ -120,7 +120,9 @@ static int synthesise(sdlg *d)
         if ((rc = lm_ask_word(d->io, P(SAVE_FILE), P(SAVE_FILE), P(SAVE_FILE_WHAT), check_write,
                               d, name, sizeof name)))
             return rc;
-        lm_say(d->io, LM_BOTH, P(SAVED), name);
+        char shown[4 * sizeof name + 4];    /* the name, control bytes escaped */
+        lm_escape(name, shown, sizeof shown);
+        lm_say(d->io, LM_BOTH, P(SAVED), shown);
     }
     return LM_GO;
 }
