@@ -49,7 +49,8 @@ WRITERS="summary hits draw spot report rig to-zmx to-thickness to-prescription"
 for w in $WRITERS; do
     writer $w "$OW/ref/$w" "$(out_name $w ref)" || echo "t_52: the reference run of $w failed: $(cat "$OW/ref/$w/$w.err")"
 done
-ref_of() { echo "$OW/ref/$1/$(out_name $1 ref)"; }
+REF52=$OW/ref
+ref_of() { echo "$REF52/$1/$(out_name $1 ref)"; }
 # the reference run: a plain file, exit 0 (or the rest means nothing)
 ref_ok() { [ -s "$(ref_of $1)" ]; }
 
@@ -125,6 +126,22 @@ for w in $WRITERS; do
     check "outputs: $w into /dev/full: the error is said, exit 2, no Written" w_full $w
     check "outputs: $w into a read-only folder: exit 2 with a message, nothing left" w_readonly $w
 done
+
+# The same under ASan/UBSan (the sanitizer build with its modules), for the writers
+# in each of the core, the trace, imaging and rig modules.
+if [ -x "$ASAN" ] && [ -d "$TOP/build/asan/lib" ]; then
+    OW52=$OW; BIN52=$BIN
+    OW=$WORK/outputs-asan; BIN=$ASAN; LENSMAT_LIBDIR=$TOP/build/asan/lib; export LENSMAT_LIBDIR
+    for w in summary hits spot rig to-zmx; do
+        check "outputs (asan): $w into a FIFO" w_fifo $w
+        check "outputs (asan): $w through a symlink" w_link $w
+        check "outputs (asan): $w into /dev/full" w_full $w
+        check "outputs (asan): $w into a read-only folder" w_readonly $w
+    done
+    OW=$OW52; BIN=$BIN52; unset LENSMAT_LIBDIR
+else
+    fail "outputs (asan): build/asan/lensmat or build/asan/lib not built"
+fi
 
 # Two traces writing the same hits file at once: one complete output, never a mix.
 concurrent() {
