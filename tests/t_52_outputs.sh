@@ -11,6 +11,9 @@
 # The reference of each writer is its output to a plain new file in a fresh folder.
 OW=$WORK/outputs
 mkdir -p "$OW"
+# the writer alone (tests/unit_out.c): modes, inodes, parts, links, devices, long names
+unit "$TOP/build/obj/unit_out"
+unit "$TOP/build/asan/unit_out"
 RX52=$TOP/doc/triplet.rx
 RIG52=$TOP/golden/rig/example.rig
 
