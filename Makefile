@@ -22,7 +22,8 @@ GEN     := $(patsubst prompts/%.txt,build/gen/prompts_%.h,$(PROMPTS))
 # The glass catalogue (data/glass.txt), compiled in like the prompts.
 GEN     += build/gen/glass_data.h
 # The core: the dialogue layer, paraxial engine, lens model (libc, libm, readline only).
-CORE    := $(wildcard src/dialogue/*.c src/paraxial/*.c src/lens/*.c)
+# src/common: the output writer every part shares (lm_out.c).
+CORE    := $(wildcard src/dialogue/*.c src/paraxial/*.c src/lens/*.c src/common/*.c)
 LIBCORE := $(filter-out src/dialogue/main.c,$(CORE))
 OBJ     := $(patsubst src/%.c,build/obj/%.o,$(CORE))
 SANOBJ  := $(patsubst src/%.c,build/asan/%.o,$(CORE))

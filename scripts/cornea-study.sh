@@ -49,7 +49,17 @@ if [ -n "$SSH" ] && [ "$SSH" != : ]; then
 fi
 mkdir -p "$DIR"
 cd "$DIR"
-rm -f eye-*.in eye-*.rec eye-*.txt eye-*.csv eye-*.json eye-*.out study.tsv percentiles.tsv joblog.txt
+# The tables as lensmat writes files (doc/outputs.md): made in a unique temporary
+# beside the name, with a plain create's modes, then renamed over a regular file (or
+# a link's target); a device or FIFO there is written in place, never replaced.
+part() { t=$(mktemp "$1.part.XXXXXX") && chmod "$(printf '%o' $((0666 & ~$(umask))))" "$t" && echo "$t"; }
+put() {
+    t=$2; [ -L "$t" ] && t=$(readlink -f -- "$t")
+    if [ -e "$t" ] && [ ! -f "$t" ]; then cat "$1" > "$t" && rm -f "$1"; else mv -f "$1" "$t"; fi
+}
+rm -f eye-*.in eye-*.rec eye-*.txt eye-*.csv eye-*.json eye-*.out joblog.txt
+# an earlier study's tables go; a link or a device the user put there stays
+for f in study.tsv percentiles.tsv; do [ -f "$f" ] && [ ! -L "$f" ] && rm -f "$f"; done
 
 # 1. the population: one answers file per eye (awk's generator, seeded)
 awk -v M="$M" -v seed="$SEED" -v pts="$POINTS" -v model="$MODEL" '
@@ -95,7 +105,7 @@ study_stop() {
     trap '' INT TERM HUP
     kill -TERM "$par" 2> /dev/null || true
     wait "$par" 2> /dev/null || true   # (set -e: parallel's non-zero status must not end the trap)
-    rm -f eyes.list study.tsv.part percentiles.tsv.part
+    rm -f eyes.list "${tsv:-}" "${pct:-}"
     done_n=$(awk 'NR > 1 && $7 == 0' joblog.txt 2> /dev/null | wc -l)
     echo "$0: interrupted ($1): the running eyes were stopped; $done_n of $M eyes had finished (their files are in $DIR)" >&2
     exit "$2"
@@ -112,6 +122,8 @@ failed=$(awk 'NR > 1 && $7 != 0' joblog.txt | wc -l)
 # 3. one table: the truth, the errors and the reported uncertainties of every eye
 cols="true_R true_Q true_cyl true_dx true_dy true_tilt_x true_tilt_y scan_noise"
 errs="err_R err_R_flat err_R_steep err_Q err_Km err_cyl err_axis err_dx err_dy err_tilt_x err_tilt_y"
+tsv=$(part study.tsv)
+trap 'rm -f "$tsv" "${pct:-}"' EXIT
 {
     printf 'eye'
     for c in $cols; do printf '\t%s' "$c"; done
@@ -128,10 +140,11 @@ errs="err_R err_R_flat err_R_steep err_Q err_Km err_cyl err_axis err_dx err_dy e
             printf "\t%s\t%s\t%s\n", v["zKm"], v["poor_fit"], und == "" ? "-" : und
         }' "$f"
     done
-} > study.tsv.part && mv study.tsv.part study.tsv
-neyes=$(($(wc -l < study.tsv) - 1))
+} > "$tsv"
+neyes=$(($(wc -l < "$tsv") - 1))
 
 # 4. percentiles of |error| per parameter (nearest rank), and |error|/sd at the 95th
+pct=$(part percentiles.tsv)
 awk -F'\t' '
 NR == 1 { for (i = 1; i <= NF; i++) { col[$i] = i; if ($i ~ /^err_/) names[++np] = $i }; next }
 { for (p = 1; p <= np; p++) { e = $(col[names[p]]); if (e == "") continue
@@ -153,14 +166,18 @@ END {
                pct(p, a, m, .5), pct(p, a, m, .9), pct(p, a, m, .95), pct(p, a, m, .99),
                a[p, m], zn[p] ? sprintf("%.3g", pct(p, z, zn[p], .95)) : "-"
     }
-}' study.tsv > percentiles.tsv.part && mv percentiles.tsv.part percentiles.tsv
+}' "$tsv" > "$pct"
 
 cpu=$(sed -n 's/^model name[^:]*: //p' /proc/cpuinfo 2>/dev/null | head -1)
 awk -v t0="$t0" -v t1="$t1" -v cpu="${cpu:-unknown}" -v n="$(nproc 2>/dev/null || echo ?)" \
     'NR > 1 { s += $4; k++ } END { printf "# wall %.2f s for %d eyes, %.3f s per eye and job (joblog); here: %s, %s cores\n", t1 - t0, k, k ? s / k : 0, cpu, n }' joblog.txt
 echo "# $neyes eyes reported, $failed failed (joblog: $DIR/joblog.txt); |error| percentiles;"
 echo "# z_p95: the 95th percentile of |error| / reported sd (1.96 when the sd is honest)"
-column -t -s "$(printf '\t')" percentiles.tsv 2>/dev/null || cat percentiles.tsv
+column -t -s "$(printf '\t')" "$pct" 2>/dev/null || cat "$pct"
+# (the tables are read from their temporaries, then put in place: a FIFO there is
+# only written)
+put "$tsv" study.tsv
+put "$pct" percentiles.tsv
 if [ -x "$PLOT" ]; then
     "$PLOT" study.tsv study.png && echo "# plot: $DIR/study.png"
 else

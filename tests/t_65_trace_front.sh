@@ -149,7 +149,7 @@ check "bad: unknown directive" bad_case unknown "unknown.scene:2: unknown direct
 mk noout.scene "$DET" "$SRC" "output segments $TW/no/such/dir/p.l"
 check "bad: unwritable output stops with exit 2" sh -c "cd '$TW/bad' &&
     printf 'scene\nnoout.scene\n' | '$BIN' --trace noout.rec > noout.out 2> noout.err;
-    [ \$? -eq 2 ] && grep -q 'p.l.part: cannot write' noout.err && ! grep -q '^Written' noout.out"
+    [ \$? -eq 2 ] && grep -q 'p.l: cannot write' noout.err && ! grep -q '^Written' noout.out"
 
 # ---- replay round trips: record -> grep input: -> replay -> identical record --------
 # (timings go to stdout only, so records compare byte for byte)

@@ -73,12 +73,14 @@ rig_eof() {   # the answers end mid-session: an error in a replay, the machine c
 check "rig: end of input closes the machine: laser off, drivers disabled" rig_eof
 
 # signals mid-exposure: laser off first, then drivers, exit 128+N
+# log_growing LOG: the simulator writes LOG in a unique LOG.part.XXXXXX until it closes
+log_growing() { for f in "$1".part.*; do [ -e "$f" ] && return 0; done; return 1; }
 rig_signal() {   # rig_signal SIG N
     s=$D/sig$1; mkdir -p "$s"
     { echo "$D/rt.rig"; echo sim; echo s.log; echo home
       for i in $(seq 40); do echo expose; echo 200; done; echo quit; } > "$s/in"
     (cd "$s" && exec "$BIN" --rig -i in r.rec > out 2> err) & pid=$!
-    i=0; while [ ! -e "$s/s.log.part" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
+    i=0; while ! log_growing "$s/s.log" && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
     sleep 1; kill -"$1" $pid; wait $pid; rc=$?
     [ "$rc" -eq $((128 + $2)) ] || { echo "exit $rc"; return 1; }
     [ -e "$s/s.log" ] && [ ! -e "$s/s.log.part" ] || { echo "log not completed"; return 1; }
@@ -110,7 +112,7 @@ rig_sigkill() {
     rm -f "$s/k.log.state"
     "$WD" "$s/k.log.state" 20 > "$s/wd.out" 2>&1 & wpid=$!
     (cd "$s" && exec "$BIN" --rig -i in r.rec > out 2> err) & pid=$!
-    i=0; while [ ! -e "$s/k.log.part" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
+    i=0; while ! log_growing "$s/k.log" && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
     sleep 1; kill -KILL $pid; wait $pid; rc=$?
     wait $wpid || { echo "watchdog failed:"; cat "$s/wd.out"; return 1; }
     cat "$s/wd.out"

@@ -174,7 +174,9 @@ cl_term_frames() {
     [ "$rc" -eq 143 ] || { echo "exit $rc"; cat "$CL/tf.err"; return 1; }
     n=$(ls "$CL/tf" | grep -c '^g[0-9]*\.png$')
     [ ! -e "$CL/tf/rep.txt" ] && [ "$n" -gt 0 ] && [ "$n" -lt 10000 ] &&
-        [ "$(ls "$CL/tf" | grep -v '^g[0-9]*\.png$' | wc -l)" -eq 0 ] && ! grep -q '^Spots: ' "$CL/tf.out"
+        [ "$(ls "$CL/tf" | grep -v '^g[0-9]*\.png$' | grep -vx 'g-frames.txt' | wc -l)" -eq 0 ] &&
+        ! grep -q '^Spots: ' "$CL/tf.out" &&
+        grep -q '^scan interrupted (signal 15)' "$CL/tf/g-frames.txt"    # its frames' list
 }
 check "cornea loop: SIGTERM while frames are saved: exit 143, no report, no half-written frame" cl_term_frames
 # 11. the same loop on the kernel's gpio-sim chip in qemu (../shared/tools/gpio-vm/run;

@@ -17,6 +17,7 @@
 #include <readline/readline.h>
 #include <readline/history.h>
 #include "ask.h"
+#include "common/lm_out.h"
 
 static char history_path[4096];
 
@@ -91,10 +92,16 @@ static void history_setup(void)
     read_history(history_path);
 }
 
-int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
-               int original)
+static int io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
+                   int original, int whole)
 {
     memset(io, 0, sizeof *io);
+    io->whole = whole;
+    {   /* the name as messages show it ("Output was written to file X") */
+        size_t cap = 4 * strlen(rec_name) + 4;
+        if ((io->rec_shown = malloc(cap))) lm_escape(rec_name, io->rec_shown, cap);
+        else io->rec_shown = (char *)"the record file";
+    }
     io->original = original;
     io->rec_name = rec_name;
     io->in = in;
@@ -116,7 +123,9 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
             return -1;
         }
     }
-    io->rec = fopen(rec_name, "w");
+    /* a whole output is made in memory and written through lm_out by lm_io_close,
+     * only after a run that succeeded (a failed one leaves an earlier file as it was) */
+    io->rec = whole ? open_memstream(&io->whole_buf, &io->whole_len) : fopen(rec_name, "w");
     if (!io->rec) {
         fprintf(stderr, "lensmat: cannot write the record file %s: %s\n", rec_name,
                 strerror(errno));
@@ -150,14 +159,57 @@ int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
 
 int lm_io_close(lm_io *io)
 {
-    int bad = fflush(stdout) != 0;
+    int bad = 0;
+    if (io->whole && io->rec) {
+        char why[1200], shown[4 * sizeof why];
+        int lost = ferror(io->rec) | fclose(io->rec);   /* whole_buf is complete now */
+        io->rec = NULL;
+        if (lost) {
+            fprintf(stderr, "lensmat: %s: out of memory\n", io->rec_shown);
+            bad = 1;
+        } else if (!io->discard &&
+                   lm_out_save(io->rec_name, io->whole_buf, io->whole_len, why, sizeof why)) {
+            lm_escape(why, shown, sizeof shown);
+            fprintf(stderr, "lensmat: %s\n", shown);
+            bad = 1;
+        }
+        free(io->whole_buf);
+        io->whole_buf = NULL;
+    }
+    if (lm_stdout_check() < 0) bad = 1;
     if (io->rec && (ferror(io->rec) | fclose(io->rec))) {
-        fprintf(stderr, "lensmat: error writing the record file %s\n", io->rec_name);
+        fprintf(stderr, "lensmat: error writing the record file %s\n", io->rec_shown);
         bad = 1;
     }
     free(io->buf);
+    if (io->rec_shown && strcmp(io->rec_shown, "the record file")) free(io->rec_shown);
+    io->rec_shown = NULL;
     io->rec = NULL;
     return bad ? -1 : 0;
+}
+
+int lm_stdout_check(void)
+{
+    static int said;
+    errno = 0;
+    if (fflush(stdout) == 0 && !ferror(stdout)) return 0;
+    if (!said) {
+        fprintf(stderr, "lensmat: error writing standard output%s%s\n", errno ? ": " : "",
+                errno ? strerror(errno) : "");
+        said = 1;
+    }
+    return -1;
+}
+
+int lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
+               int original)
+{
+    return io_open(io, rec_name, in, in_name, original, 0);
+}
+
+int lm_io_open_whole(lm_io *io, const char *out_name, FILE *in, const char *in_name)
+{
+    return io_open(io, out_name, in, in_name, 0, 1);
 }
 
 void lm_say(lm_io *io, int where, const char *fmt, ...)

@@ -25,6 +25,12 @@ typedef struct lm_io {
     int in_known, rec_known;   /* in_dev/in_ino, rec_dev/rec_ino are valid */
     unsigned long long in_dev, in_ino, rec_dev, rec_ino;
     int word_alone;         /* lm_ask_file: the word must end its line */
+    char *rec_shown;        /* rec_name for messages, control bytes escaped */
+    int whole;              /* lm_io_open_whole: rec is a memory stream */
+    int discard;            /* set by the caller before lm_io_close: the run failed,
+                               a whole output is not written */
+    char *whole_buf;
+    size_t whole_len;
 } lm_io;
 
 /* Output streams for lm_say. */
@@ -34,7 +40,16 @@ enum { LM_OUT = 1, LM_REC = 2, LM_BOTH = 3 };
  * read with readline.  Returns 0, or -1 (message printed) if OUTFILE cannot be made. */
 int  lm_io_open(lm_io *io, const char *rec_name, FILE *in, const char *in_name,
                 int original);
-int  lm_io_close(lm_io *io);          /* flushes and closes; 0 or -1 */
+/* For a dialogue whose OUTFILE is one document made from its input (--to-zmx,
+ * --to-thickness, --to-prescription): what it writes to the record (io->rec) is kept
+ * in memory and lm_io_close writes it through src/common/lm_out.h ("-" is standard
+ * output; a device or FIFO in place; else a temporary renamed over OUTFILE) unless
+ * io->discard is set, so a failed run leaves an earlier OUTFILE as it was. */
+int  lm_io_open_whole(lm_io *io, const char *out_name, FILE *in, const char *in_name);
+int  lm_io_close(lm_io *io);          /* flushes and closes; 0 or -1 (said on stderr) */
+/* Flushes standard output: 0, or -1 after saying once on stderr that it failed
+ * (`lensmat ... > /dev/full`); main turns that into exit status 2. */
+int  lm_stdout_check(void);
 void lm_say(lm_io *io, int where, const char *fmt, ...);
 void lm_matrix(lm_io *io, int where, const char *elem_fmt, double a, double b,
                double c, double d);

@@ -86,6 +86,6 @@ int calc_fail(calc *c, const char *msg)
 int calc_done(calc *c)
 {
     lm_check_leftover(c->io);
-    lm_say(c->io, LM_OUT, P(WRITTEN_OUT), c->io->rec_name);
+    lm_say(c->io, LM_OUT, P(WRITTEN_OUT), c->io->rec_shown);
     return LM_GO;
 }

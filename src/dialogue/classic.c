@@ -237,7 +237,7 @@ static int classic_run(classic *c)
             return rc;
     } while (more);
     lm_check_leftover(io);
-    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_shown);
     return LM_GO;
 }
 

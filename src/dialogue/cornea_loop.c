@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 #include "cornea_loop.h"
 #include "../common/lm_rand.h"
 #include "../imaging/imaging.h"
@@ -21,6 +22,8 @@
 #define GOLDEN 2.399963229728653        /* the golden angle, rad */
 #define PLANCK_HC 1.98644586e-25        /* h c, J m */
 #define LAMBDA_M 633e-9
+
+static int progress_tty;         /* stderr is a terminal: show how far a scan is */
 
 static double now(void)
 {
@@ -274,6 +277,7 @@ static int frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, in
             F->frame_free(f);
             return -1;
         }
+        q->saved = 1;
     }
     if (hit)
         locate(r, cz, f, c->read_noise / s.gain,
@@ -295,6 +299,8 @@ typedef struct job {
     rg_geometry gt, gf;         /* true eye; fitted eye */
     int err;                    /* a worker could not start its centroider (1) or
                                    save a frame (2) */
+    int done;                   /* points finished (progress) */
+    double shown;               /* when progress was last shown (s; 0: never) */
 } job;
 
 static void fail_job(job *j)
@@ -305,9 +311,20 @@ static void fail_job(job *j)
     pthread_mutex_unlock(&j->mu);
 }
 
-static int take(job *j)
+/* The next point to work on (-1: none).  On a terminal, every ~0.2 s, how far the
+ * phase is (stderr only: the record and stdout stay as a replay makes them). */
+static int take(job *j, int finished)
 {
     pthread_mutex_lock(&j->mu);
+    j->done += finished;
+    if (progress_tty && j->r->npoints >= 50) {
+        double t = now();
+        if (t - j->shown > 0.2) {
+            fprintf(stderr, "\rlensmat: %s: point %d of %d ", j->phase ? "checking" :
+                    "measuring", j->done, j->r->npoints);
+            j->shown = t;
+        }
+    }
     int k = j->stopped ? -1 : j->next < j->r->npoints ? j->next++ : -1;
     pthread_mutex_unlock(&j->mu);
     return k;
@@ -403,15 +420,17 @@ static void *worker(void *arg)
             return NULL;
         }
     }
-    for (int k; (k = take(j)) >= 0;) {
+    for (int k, fin = 0; (k = take(j, fin)) >= 0; fin = 1) {
         if (r->stop && r->stop(r->stop_ctx)) {
             pthread_mutex_lock(&j->mu);
             j->stopped = 1;
             pthread_mutex_unlock(&j->mu);
             break;
         }
-        if (j->phase == 0) measure_one(j, cz, k);
-        else r->pt[k].spot.nres = check_one(j, k);   /* nres: scratch, reset below */
+        if (j->phase == 0) {
+            measure_one(j, cz, k);
+            r->pt[k].measured = 1;
+        } else r->pt[k].spot.nres = check_one(j, k);   /* nres: scratch, reset below */
     }
     if (cz) r->im->frame->centroider_free(cz);
     return NULL;
@@ -423,10 +442,13 @@ static int run_workers(job *j)
     pthread_t tid[16];
     int started = 0;
     j->next = 0;
+    j->done = 0;
+    j->shown = 0;
     for (int t = 1; t < nt; t++)
         if (pthread_create(&tid[started], NULL, worker, j) == 0) started++;
     worker(j);
     for (int t = 0; t < started; t++) pthread_join(tid[t], NULL);
+    if (j->shown > 0) fputs("\r\033[K", stderr);     /* the progress line cleared */
     return j->stopped;
 }
 
@@ -464,6 +486,8 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     r->fitted = 0;
     r->check_max = NAN;
     r->check_n = 0;
+    r->phase = "planning";
+    progress_tty = isatty(2);
     if (r->source == CL_SRC_FRAMES && (!r->im || !r->im->frame)) {
         snprintf(err, cap, "frames need the imaging engine");
         return CN_EINVAL;
@@ -525,6 +549,7 @@ int cl_measure(cl_run *r, char *err, size_t cap)
             return CN_EINVAL;
         }
     }
+    r->phase = "the scan on the machine";
     if (r->m) {
         for (int k = 0; k < n; k++) {
             cl_point *q = &r->pt[k];
@@ -560,6 +585,8 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     for (int k = 0, seq = 0; k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
     r->tm.machine = now() - t;
     /* detect: the traced spot of each exposure, its frame and centroid */
+    r->phase = r->source == CL_SRC_FRAMES ? "the frames and their centroids"
+             : "the traced spots";
     job j;
     memset(&j, 0, sizeof j);
     pthread_mutex_init(&j.mu, NULL);
@@ -582,6 +609,7 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     }
     if (st || stopped(r)) { snprintf(err, cap, "stopped"); goto stop; }
     /* fit */
+    r->phase = "the fit";
     t = now();
     cn_spot *sp = malloc(sizeof *sp * (size_t)(n ? n : 1));
     int *of = malloc(sizeof *of * (size_t)(n ? n : 1)), m = 0;
@@ -613,6 +641,7 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     r->fitted = 1;
     /* check: the fitted cornea through the tracer for every fitted pose */
     if (r->tr) {
+        r->phase = "the check against the tracer";
         t = now();
         j.phase = 1;
         j.gf = *r->g;

@@ -42,6 +42,8 @@ typedef struct cl_point {
     int seq;                    /* frame number (1, 2, ...: the planned points in scan
                                    order; 0: none) */
     char why[96];               /* why the point gave no spot */
+    int measured;               /* 1: its spot was made (traced, framed, located) */
+    int saved;                  /* 1: its frame was written (r->save) */
 } cl_point;
 
 typedef struct cl_times {       /* seconds of wall clock, per part */
@@ -92,6 +94,8 @@ typedef struct cl_run {
     double check_max;           /* mm, largest |traced - model| over the fitted spots */
     int check_n;                /* spots traced in the check */
     cl_times tm;
+    const char *phase;          /* the part of the loop running (or where it stopped):
+                                   "planning", "the scan on the machine", ... */
 } cl_run;
 
 /* Scan pattern: n targets (theta, phi) within zone; returns the count written. */

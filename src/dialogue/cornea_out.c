@@ -3,14 +3,15 @@
  * settings, the simulated truth, the errors) and the maps of the fit (elevation
  * against the best-fit sphere, axial and tangential curvature in diopters in 0.25-0.5
  * D steps, the residual map of the spots), drawn by the imaging engine, which is
- * loaded only when maps are asked for.  Every file is written as FILE.part and
- * renamed when complete. */
+ * loaded only when maps are asked for.  Every file goes through the shared writer
+ * (src/common/lm_out.h: a unique temporary renamed over the name when complete). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "common/lm_out.h"
 #include "cornea_out.h"
 #include "engine.h"
 #include "../imaging/imaging.h"
@@ -42,24 +43,6 @@ int cs_check_name(void *io, const char *word, char *msg, size_t cap)
     return 0;
 }
 
-/* data to path.part; 0, or -1 with why (and no .part left) */
-static int write_part(const char *path, const char *data, size_t len, char *msg, size_t cap)
-{
-    char part[1200];
-    snprintf(part, sizeof part, "%s.part", path);
-    FILE *f = fopen(part, "w");
-    if (!f) { snprintf(msg, cap, "%s: %s", part, strerror(errno)); return -1; }
-    int ok = fwrite(data, 1, len, f) == len;
-    ok &= fflush(f) == 0;
-    ok &= fclose(f) == 0;
-    if (!ok) {
-        snprintf(msg, cap, "%s: %s", part, strerror(errno));
-        remove(part);
-        return -1;
-    }
-    return 0;
-}
-
 static const char *fmtnum(double v, int json, char *b)
 {
     if (isfinite(v)) snprintf(b, 32, "%.10g", v);
@@ -72,51 +55,39 @@ int cs_write_report(const cornea_api *cn, const char *name, const char *text, si
                     int nrows, char *msg, size_t cap)
 {
     static const char *const ext[] = {".txt", ".csv", ".json"};
-    char path[3][1100], part[sizeof path + 8], a[32], b[32];   /* as gcc counts path[i] */
+    char path[3][1100], a[32], b[32];
     size_t need = cn->report_csv(r, sp, n, NULL, 0) + cn->report_json(r, sp, n, NULL, 0) +
-                  (size_t)nrows * 200 + 64;
-    char *buf = malloc(need);
-    int done = 0, rc = -1;
-    if (!buf) { snprintf(msg, cap, "out of memory"); return -1; }
+                  (size_t)nrows * 200 + 64, lc, lj;
+    char *csv = malloc(need), *json = malloc(need);
+    int rc = -1;
+    if (!csv || !json) { snprintf(msg, cap, "out of memory"); goto out; }
     for (int i = 0; i < 3; i++)         /* names are at most 1000 (cs_check_name) */
         snprintf(path[i], sizeof path[i], "%.1000s%s", name, ext[i]);
-    if (write_part(path[0], text ? text : "", text ? len : 0, msg, cap)) goto out;
-    done = 1;
-    size_t l = cn->report_csv(r, sp, n, buf, need);
-    for (int i = 0; i < nrows && l < need; i++)
-        l += snprintf(buf + l, need - l, "%s,%s,%s,%s\n", rows[i].name,
-                      fmtnum(rows[i].v, 0, a), fmtnum(rows[i].sd, 0, b), rows[i].unit);
-    if (l >= need) { snprintf(msg, cap, "report too long"); goto out; }
-    if (write_part(path[1], buf, l, msg, cap)) goto out;
-    done = 2;
-    l = cn->report_json(r, sp, n, buf, need);
-    while (l > 0 && buf[l - 1] == '\n') l--;
-    if (l > 0 && buf[l - 1] == '}') l--;       /* reopen the top-level object */
-    l += snprintf(buf + l, need - l, ",\n \"dialogue\": {");
-    for (int i = 0; i < nrows && l < need; i++)
-        l += snprintf(buf + l, need - l, "%s\n  \"%s\": {\"value\": %s, \"sd\": %s, "
-                      "\"unit\": \"%s\"}", i ? "," : "", rows[i].name,
-                      fmtnum(rows[i].v, 1, a), fmtnum(rows[i].sd, 1, b), rows[i].unit);
-    l += snprintf(buf + l, need > l ? need - l : 0, "}}\n");
-    if (l >= need) { snprintf(msg, cap, "report too long"); goto out; }
-    if (write_part(path[2], buf, l, msg, cap)) goto out;
-    done = 3;
+    lc = cn->report_csv(r, sp, n, csv, need);
+    for (int i = 0; i < nrows && lc < need; i++)
+        lc += snprintf(csv + lc, need - lc, "%s,%s,%s,%s\n", rows[i].name,
+                       fmtnum(rows[i].v, 0, a), fmtnum(rows[i].sd, 0, b), rows[i].unit);
+    if (lc >= need) { snprintf(msg, cap, "report too long"); goto out; }
+    lj = cn->report_json(r, sp, n, json, need);
+    while (lj > 0 && json[lj - 1] == '\n') lj--;
+    if (lj > 0 && json[lj - 1] == '}') lj--;       /* reopen the top-level object */
+    lj += snprintf(json + lj, need - lj, ",\n \"dialogue\": {");
+    for (int i = 0; i < nrows && lj < need; i++)
+        lj += snprintf(json + lj, need - lj, "%s\n  \"%s\": {\"value\": %s, \"sd\": %s, "
+                       "\"unit\": \"%s\"}", i ? "," : "", rows[i].name,
+                       fmtnum(rows[i].v, 1, a), fmtnum(rows[i].sd, 1, b), rows[i].unit);
+    lj += snprintf(json + lj, need > lj ? need - lj : 0, "}}\n");
+    if (lj >= need) { snprintf(msg, cap, "report too long"); goto out; }
     if (lm_stop_requested()) { snprintf(msg, cap, "stopped"); goto out; }
-    for (int i = 0; i < 3; i++) {
-        snprintf(part, sizeof part, "%s.part", path[i]);
-        if (rename(part, path[i])) {
-            snprintf(msg, cap, "%s: %s", path[i], strerror(errno));
-            goto out;
-        }
-    }
-    done = 0;
+    /* each through the shared writer (src/common/lm_out.h): complete under its name or
+     * not there, a device or FIFO written in place, never a temporary left behind */
+    if (lm_out_save(path[0], text ? text : "", text ? len : 0, msg, cap) ||
+        lm_out_save(path[1], csv, lc, msg, cap) || lm_out_save(path[2], json, lj, msg, cap))
+        goto out;
     rc = 0;
 out:
-    for (int i = 0; i < done; i++) {     /* the .part files not renamed */
-        snprintf(part, sizeof part, "%s.part", path[i]);
-        remove(part);
-    }
-    free(buf);
+    free(csv);
+    free(json);
     return rc;
 }
 
@@ -213,5 +184,48 @@ int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
     }
 out:
     free(grid); free(xy); free(pv); free(px); free(py); free(mk);
+    return rc;
+}
+
+void cs_manifest_name(const char *pattern, char *name, size_t cap)
+{
+    const char *dot = strrchr(pattern, '.');
+    size_t o = 0;
+    if (!cap) return;
+    for (const char *p = pattern; *p && p != dot && o + 1 < cap; p++) {
+        if (*p == '%' && p[1] == '%') { name[o++] = '%'; p++; continue; }
+        if (*p == '%') {                /* %d, %04d: the frame number */
+            while (*p && *p != 'd') p++;
+            if (!*p) break;
+            o += (size_t)snprintf(name + o, cap - o, "-frames");
+            if (o >= cap) { o = cap - 1; break; }
+            continue;
+        }
+        name[o++] = *p;
+    }
+    name[o] = '\0';
+    snprintf(name + o, cap - o, ".txt");
+}
+
+int cs_write_manifest(const char *pattern, const int *seq, int n, int nplanned,
+                      const char *status, char *msg, size_t cap)
+{
+    char path[1100], one[1100];
+    size_t need = 512 + strlen(pattern) + strlen(status) + (size_t)n * (sizeof one), len;
+    char *buf = malloc(need);
+    int rc;
+    if (!buf) { snprintf(msg, cap, "out of memory"); return -1; }
+    cs_manifest_name(pattern, path, sizeof path);
+    len = (size_t)snprintf(buf, need, "# lensmat --cornea-scan: the frames of one scan, "
+                           "saved as %s.\n# A frame that pattern names but this list does "
+                           "not is not this scan's.\nscan %s\nframes %d of %d\n",
+                           pattern, status, n, nplanned);
+    for (int i = 0; i < n && len < need; i++) {
+        snprintf(one, sizeof one, pattern, seq[i]);
+        len += (size_t)snprintf(buf + len, need - len, "%s\n", one);
+    }
+    rc = len < need ? lm_out_save(path, buf, len, msg, cap) : -1;
+    if (len >= need) snprintf(msg, cap, "manifest too long");
+    free(buf);
     return rc;
 }

@@ -1,6 +1,6 @@
 /* cornea_out.h -- the --cornea-scan dialogue's files: the report (the text the session
- * said, CSV and JSON) and the maps (PNG, through the imaging engine), each written as
- * FILE.part and renamed. */
+ * said, CSV and JSON), the maps (PNG, through the imaging engine) and the frames'
+ * manifest, each through the shared writer (src/common/lm_out.h). */
 #ifndef CORNEA_OUT_H
 #define CORNEA_OUT_H
 #include <stddef.h>
@@ -33,4 +33,13 @@ int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
                   const cn_result *r, const cn_spot *sp, int n,
                   int (*stop)(void *), void (*say)(void *ctx, const char *line),
                   void *ctx, char *msg, size_t cap);
+/* The manifest of one scan's frames: PATTERN with its %d made "-frames" and its
+ * extension ".txt" (frames/g%04d.png: frames/g-frames.txt), in name (cap bytes). */
+void cs_manifest_name(const char *pattern, char *name, size_t cap);
+/* Writes it: which frames this scan wrote (seq numbers seq[0..n-1], in order) of the
+ * nplanned it would write, and how the scan ended (status: "complete", "interrupted
+ * during ...").  Frames of an earlier scan that the same pattern names but the list
+ * does not are not this scan's.  0, or -1 with why in msg. */
+int cs_write_manifest(const char *pattern, const int *seq, int n, int nplanned,
+                      const char *status, char *msg, size_t cap);
 #endif

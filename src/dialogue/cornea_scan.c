@@ -79,6 +79,7 @@ static void say(cs *s, const char *fmt, ...)
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
     calc_say(&s->cc, "%s", line);
+    fflush(stdout);                     /* each line as it is computed, also in a pipe */
     size_t n = strlen(line);
     if (s->len + n + 1 > s->cap) {
         size_t cap = (s->cap + n + 1) * 2;
@@ -192,6 +193,7 @@ static double check_tol_um(void)
 /* ---- the dialogue ----------------------------------------------------------------- */
 
 static int run(cs *s, cl_run *r, rg_machine **m);
+static int scan_end(cs *s, const cl_run *r, int rc);
 
 /* What the report adds beside the engine's numbers: the scan's settings and, for a
  * synthetic eye, its truth and the errors. */
@@ -257,7 +259,9 @@ static int cs_files(cs *s, const cl_run *r, int maps, const cs_truth *tr)
         fprintf(stderr, "lensmat: ");
         fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
     } else {
-        lm_say(s->cc.io, LM_OUT, CS(REPORT_WRITTEN), s->report, s->report, s->report);
+        char shown[4 * sizeof s->report + 4];   /* the name, control bytes escaped */
+        lm_escape(s->report, shown, sizeof shown);
+        lm_say(s->cc.io, LM_OUT, CS(REPORT_WRITTEN), shown, shown, shown);
     }
     free(sp);
     return rc;
@@ -438,7 +442,7 @@ int lm_cornea_scan(lm_io *io)
         r->m = m;
     }
     rc = run(s, r, &m);
-    if (rc == LM_GO && r->save) say(s, CS(SAVED), r->save, r->nplanned);
+    rc = scan_end(s, r, rc);
     double axis_err = model == CN_BICONIC
                       ? remainder(r->res.k.K1_axis - fmod(axis + 360, 180), 180.0) : 0.0;
     if (rc == LM_GO && r->have_truth) {
@@ -452,7 +456,13 @@ int lm_cornea_scan(lm_io *io)
             rc = LM_FAIL;
         }
     }
-    if (m) { rg->close(m); m = NULL; }       /* laser off, then drivers disabled */
+    if (m) {                                  /* laser off, then drivers disabled */
+        if (rg->close(m) && strcmp(s->log, "-")) {
+            fprintf(stderr, CS(LOG_FAILED), s->log);
+            rc = LM_FAIL;
+        }
+        m = NULL;
+    }
     if (rc == LM_GO && strcmp(s->report, "-")) {
         const cs_truth tr = {&eye, &t, &cone, km, cyl, axis_err, np, zone, noise, pitch, seed};
         rc = cs_files(s, r, maps, &tr);
@@ -465,6 +475,38 @@ out:
     free(r);
     free(s->text);
     free(s);
+    return rc;
+}
+
+/* After the loop: an interruption says where it stopped (stdout, the record and
+ * stderr); saved frames get their manifest, so that frames an earlier scan left under
+ * the same pattern are never taken for this one's.  rc, or LM_FAIL. */
+static int scan_end(cs *s, const cl_run *r, int rc)
+{
+    int sig = lm_stop_requested(), nm = 0, ns = 0;
+    int *seq = r->save ? malloc(sizeof *seq * (size_t)(r->npoints ? r->npoints : 1)) : NULL;
+    char status[200], msg[1200], man[1100];
+    for (int k = 0; k < r->npoints; k++) {
+        nm += r->pt[k].measured;
+        if (r->pt[k].saved && seq) seq[ns++] = r->pt[k].seq;
+    }
+    if (sig) {
+        char line[400];
+        snprintf(line, sizeof line, CS(INTERRUPTED), sig, r->phase ? r->phase : "planning",
+                 r->nexposed, r->nplanned, nm, r->nplanned, ns);
+        say(s, "%s", line);
+        fprintf(stderr, "lensmat: %s", line);
+        snprintf(status, sizeof status, "interrupted (signal %d) during %s", sig,
+                 r->phase ? r->phase : "planning");
+    } else snprintf(status, sizeof status, "%s", rc == LM_GO ? "complete" : "failed");
+    if (r->save) {
+        cs_manifest_name(r->save, man, sizeof man);
+        if (!seq || cs_write_manifest(r->save, seq, ns, r->nplanned, status, msg, sizeof msg)) {
+            fprintf(stderr, CS(MANIFEST_FAILED), man, seq ? msg : "out of memory");
+            rc = LM_FAIL;
+        } else if (rc == LM_GO) say(s, CS(SAVED), r->save, r->nplanned, man);
+    }
+    free(seq);
     return rc;
 }
 

@@ -395,7 +395,10 @@ static int picture(dsess *d, int what)
         return io->interactive ? LM_GO : LM_FAIL;
     }
     lm_say(io, LM_OUT, P(TIMING_OUT), now_ms() - t0, load_ms, trace_ms);
-    lm_say(io, LM_BOTH, P(WRITTEN), png, p.svg,
+    char ep[4200], es[4200];           /* the names, control bytes escaped */
+    lm_escape(png, ep, sizeof ep);
+    lm_escape(p.svg, es, sizeof es);
+    lm_say(io, LM_BOTH, P(WRITTEN), ep, es,
            what == W_LAYOUT ? P(WRITTEN_LAYOUT) : what == W_SPOT ? P(WRITTEN_SPOT)
            : what == W_FAN ? P(WRITTEN_FAN) : P(WRITTEN_TABLE));
     if (what == W_TABLE) report_table(d, rows);
@@ -435,7 +438,7 @@ int lm_draw(lm_io *io)
     free(d);
     if (rc) return rc;
     lm_check_leftover(io);
-    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_shown);
     return LM_GO;
 }
 

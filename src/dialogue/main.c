@@ -59,8 +59,14 @@ static int parse_args(int argc, char **argv, options *o)
             continue;
         }
         if (!strcmp(a, "--")) { operands = 1; continue; }
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { help(); return 0; }
-        if (!strcmp(a, "--version")) { printf(P(VERSION), LENSMAT_VERSION); return 0; }
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            help();
+            return lm_stdout_check() ? 2 : 0;
+        }
+        if (!strcmp(a, "--version")) {
+            printf(P(VERSION), LENSMAT_VERSION);
+            return lm_stdout_check() ? 2 : 0;
+        }
         if (!strcmp(a, "--original")) { o->original = 1; continue; }
         if (!strcmp(a, "--example")) { o->example = 1; continue; }
         if (!strcmp(a, "-i") || !strcmp(a, "--input")) {
@@ -172,11 +178,15 @@ int main(int argc, char **argv)
 
     if (rc >= 0) return rc;
     if (!o.outfile) {
-        if (argc == 1 + o.original) {   /* the original's usage text */
+        if (argc == 1 + o.original) {   /* the original's usage text; no OUTFILE: 1 */
             printf("%s%s", lm_classic_usage(), o.original ? "" : lm_classic_usage_more());
-            return 0;
+            return lm_stdout_check() ? 2 : 1;
         }
         fprintf(stderr, "%s", P(NEED_OUTFILE));
+        return 1;
+    }
+    if (!strcmp(o.outfile, "-") && !lm_whole_output(o.dlg)) {
+        fprintf(stderr, P(DASH_OUTFILE), o.dlg->option);
         return 1;
     }
     /* before the first question: a session that could not finish is not begun */
@@ -201,13 +211,15 @@ int main(int argc, char **argv)
         }
     }
     if (!(in = open_answers(&o, &in_name))) return 1;
-    if (lm_io_open(&io, o.outfile, in, in_name, o.original) < 0) {
+    if ((lm_whole_output(o.dlg) ? lm_io_open_whole(&io, o.outfile, in, in_name)
+                             : lm_io_open(&io, o.outfile, in, in_name, o.original)) < 0) {
         if (in != stdin) fclose(in);
         return 1;
     }
     io.show_answers = o.example;
     rc = o.dlg->run(&io);
-    if (lm_io_close(&io) < 0 && rc == LM_GO) rc = LM_FAIL;
+    io.discard = rc != LM_GO || lm_stop_requested();
+    if (lm_io_close(&io) < 0) rc = LM_FAIL;
     if (in != stdin) fclose(in);
     free(example_buf);
     if (lm_stop_requested()) {

@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <errno.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -506,11 +507,18 @@ int lm_rig(lm_io *io)
     }
     /* every way out: laser off, then drivers disabled */
     if (d->m) {
-        d->api->close(d->m);
+        int lost = d->api->close(d->m) != 0;    /* the simulator's log lost lines */
         d->m = NULL;
         lm_say(io, LM_BOTH, "%s", P(CLOSED));
         if (d->state[0]) unlink(d->state);
-        if (d->sim && strcmp(d->log, "-")) lm_say(io, LM_OUT, P(WRITTEN_OUT), d->log);
+        if (d->sim && strcmp(d->log, "-")) {
+            char shown[4 * sizeof d->log + 4];
+            lm_escape(d->log, shown, sizeof shown);
+            if (lost) {                 /* never "Written:" for a log that lost lines */
+                fprintf(stderr, P(LOG_FAILED), shown);
+                rc = LM_FAIL;
+            } else lm_say(io, LM_OUT, P(WRITTEN_OUT), shown);
+        }
     }
     lm_on_stop_remove(laser_off_hook, NULL);
     lm_rigcam_free(&d->cam);
@@ -519,7 +527,7 @@ int lm_rig(lm_io *io)
     free(d);
     if (rc == LM_FAIL || rc == LM_QUIT) return rc;
     lm_check_leftover(io);
-    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_shown);
     return LM_GO;
 }
 

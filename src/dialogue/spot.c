@@ -121,7 +121,9 @@ static int synthesise(sdlg *d)
         if ((rc = lm_ask_file(d->io, P(SAVE_FILE), P(SAVE_FILE), P(SAVE_FILE_WHAT), check_write,
                               d, name, sizeof name)))
             return rc;
-        lm_say(d->io, LM_BOTH, P(SAVED), name);
+        char shown[4 * sizeof name + 4];    /* the name, control bytes escaped */
+        lm_escape(name, shown, sizeof shown);
+        lm_say(d->io, LM_BOTH, P(SAVED), shown);
     }
     return LM_GO;
 }
@@ -272,7 +274,14 @@ static int stream(sdlg *d)
                    s[0].snr, fl);
         d->fa->frame_free(f);
         n++;
-        if (lm_stop_requested()) { rc = LM_FAIL; break; }
+        fflush(stdout);                 /* each frame's line as it is computed */
+        if (lm_stop_requested()) {      /* say where, on stderr and in the record */
+            lm_say(d->io, LM_BOTH, P(SINTERRUPTED), n, count, lm_stop_requested());
+            fprintf(stderr, "lensmat: ");
+            fprintf(stderr, P(SINTERRUPTED), n, count, lm_stop_requested());
+            rc = LM_FAIL;
+            break;
+        }
     }
     if (rc == LM_GO && n == count) {
         im_frame *f;

@@ -76,3 +76,8 @@ const lm_dialogue *lm_find_dialogue(const char *option)
         if (!strcmp(option, lm_dialogues[i].option)) return &lm_dialogues[i];
     return NULL;
 }
+
+int lm_whole_output(const lm_dialogue *d)
+{
+    return d->run == lm_to_zmx || d->run == lm_to_thickness || d->run == lm_to_prescription;
+}

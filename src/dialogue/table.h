@@ -32,5 +32,9 @@ extern const lm_option lm_options[];
 extern const size_t lm_noptions;
 
 const lm_dialogue *lm_find_dialogue(const char *option);   /* NULL if none */
+/* 1 if d's OUTFILE is one document made from its input (the converters), not a
+ * record: written at the end, only after a run that succeeded, "-" is standard output
+ * (lm_io_open_whole). */
+int lm_whole_output(const lm_dialogue *d);
 
 #endif

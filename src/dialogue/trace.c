@@ -97,21 +97,24 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
     return 0;
 }
 
+static void report_output(tdlg *t, const char *name, const char *what)
+{
+    char shown[4 * WORD + 4];           /* a scene's name for a file, escaped */
+    if (!name) return;
+    lm_escape(name, shown, sizeof shown);
+    lm_say(t->io, LM_BOTH, P(WRITTEN), shown, what);
+}
+
 static void report_outputs(tdlg *t)
 {
     const sc_scene *sc = &t->scene;
     const int *f = sc->out_format;   /* what each file holds, in its format */
-    if (sc->out_segments)
-        lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_segments, f[0] == SC_OUT_NPY ?
-               P(WRITTEN_SEGMENTS_NPY) : f[0] == SC_OUT_H5 ? P(WRITTEN_SEGMENTS_H5) :
-               P(WRITTEN_SEGMENTS));
-    if (sc->out_hits)
-        lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_hits, f[1] == SC_OUT_NPY ?
-               P(WRITTEN_HITS_NPY) : f[1] == SC_OUT_H5 ? P(WRITTEN_HITS_H5) :
-               P(WRITTEN_HITS));
-    if (sc->out_summary)
-        lm_say(t->io, LM_BOTH, P(WRITTEN), sc->out_summary, f[2] == SC_OUT_H5 ?
-               P(WRITTEN_SUMMARY_H5) : P(WRITTEN_SUMMARY));
+    report_output(t, sc->out_segments, f[0] == SC_OUT_NPY ? P(WRITTEN_SEGMENTS_NPY) :
+                  f[0] == SC_OUT_H5 ? P(WRITTEN_SEGMENTS_H5) : P(WRITTEN_SEGMENTS));
+    report_output(t, sc->out_hits, f[1] == SC_OUT_NPY ? P(WRITTEN_HITS_NPY) :
+                  f[1] == SC_OUT_H5 ? P(WRITTEN_HITS_H5) : P(WRITTEN_HITS));
+    report_output(t, sc->out_summary, f[2] == SC_OUT_H5 ? P(WRITTEN_SUMMARY_H5) :
+                  P(WRITTEN_SUMMARY));
 }
 
 static void report_summary(tdlg *t, const trace_summary *s)
@@ -669,7 +672,7 @@ int lm_trace(lm_io *io)
     if (t.have_scene) t.api->free(&t.scene);
     if (rc) return rc;
     lm_check_leftover(io);
-    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_name);
+    lm_say(io, LM_OUT, P(WRITTEN_OUT), io->rec_shown);
     return LM_GO;
 }
 

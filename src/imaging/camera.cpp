@@ -4,12 +4,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include "common/lm_out.h"
 #include "imaging/im_camera.h"
 
 namespace {
@@ -133,7 +135,17 @@ int cam_write_video(const char *path, const uint16_t *const *frames, int n, int 
     try {
         cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
         cv::VideoWriter w;
-        std::string tmp = std::string(path) + ".part.avi";
+        // The encoder wants a file named .avi: a unique one beside the output (so two
+        // writers never share it), then its bytes go through the shared writer
+        // (src/common/lm_out.h: a device or FIFO in place, a link's target, "-").
+        std::string tmpl = std::string(path) + ".part.XXXXXX.avi";
+        std::vector<char> tv(tmpl.begin(), tmpl.end());
+        tv.push_back('\0');
+        int tfd = mkstemps(tv.data(), 4);
+        if (tfd < 0) return say(err, cap, -3, "%s: cannot write a video%s", path);
+        close(tfd);
+        std::string tmp(tv.data());
+        struct unlink_tmp { std::string p; ~unlink_tmp() { unlink(p.c_str()); } } guard{tmp};
         // FFmpeg's MJPEG encoder; OpenCV's own one (no FFmpeg) asserts on smooth frames.
         bool ok = w.open(tmp, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
                          fps > 0 ? fps : 10, cv::Size(width, height), true);
@@ -148,10 +160,19 @@ int cam_write_video(const char *path, const uint16_t *const *frames, int n, int 
             w.write(c);
         }
         w.release();
-        if (rename(tmp.c_str(), path) != 0) {
-            unlink(tmp.c_str());
-            return say(err, cap, -3, "%s: cannot rename into place%s", path);
-        }
+        std::FILE *f = std::fopen(tmp.c_str(), "rb");
+        if (!f) return say(err, cap, -3, "%s: cannot write a video%s", path);
+        std::vector<char> bytes;
+        char chunk[65536];
+        size_t got;
+        while ((got = std::fread(chunk, 1, sizeof chunk, f)) > 0)
+            bytes.insert(bytes.end(), chunk, chunk + got);
+        bool bad = std::ferror(f);
+        std::fclose(f);
+        if (bad) return say(err, cap, -3, "%s: cannot write a video%s", path);
+        char why[512];
+        if (lm_out_save(path, bytes.data(), bytes.size(), why, sizeof why))
+            return say(err, cap, -3, "%s%s", why);
         return 0;
     } catch (const cv::Exception &e) {
         return say(err, cap, -3, "%s: cannot write a video: %s", path, e.msg.c_str());

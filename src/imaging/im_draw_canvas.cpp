@@ -2,6 +2,7 @@
  * BGR image (anti-aliased lines with 8 bits of sub-pixel position) and appended to
  * an SVG document with the same coordinates; atomic writes of both files. */
 #include "im_draw.hpp"
+#include "common/lm_out.h"
 #include <opencv2/imgproc.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <cerrno>
@@ -275,39 +276,11 @@ int Canvas::write(const im_out *out, char *err, size_t cap) const
     return rc;
 }
 
+/* pictures go through the shared writer (src/common/lm_out.h), like frames: a unique
+ * temporary renamed over a regular file, a device or FIFO in place, a link's target */
 int write_atomic(const char *path, const void *data, size_t len, char *err, size_t cap)
 {
-    std::string tmp = std::string(path) + ".part.XXXXXX";
-    std::vector<char> t(tmp.begin(), tmp.end());
-    t.push_back('\0');
-    int fd = mkstemp(t.data());
-    if (fd < 0) {
-        set_err(err, cap, "%s: cannot write: %s", path, strerror(errno));
-        return IM_EIO;
-    }
-    const char *p = (const char *)data;
-    size_t left = len;
-    while (left > 0) {
-        ssize_t n = ::write(fd, p, left);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            set_err(err, cap, "%s: cannot write: %s", path, n < 0 ? strerror(errno) : "short write");
-            close(fd);
-            unlink(t.data());
-            return IM_EIO;
-        }
-        p += n;
-        left -= (size_t)n;
-    }
-    mode_t mask = umask(0);   /* a picture gets the modes fopen would give it */
-    umask(mask);
-    fchmod(fd, 0666 & ~mask);
-    if (close(fd) != 0 || rename(t.data(), path) != 0) {
-        set_err(err, cap, "%s: cannot write: %s", path, strerror(errno));
-        unlink(t.data());
-        return IM_EIO;
-    }
-    return IM_OK;
+    return lm_out_save(path, data, len, err, cap) ? IM_EIO : IM_OK;
 }
 
 double nice_step(double span, int target)

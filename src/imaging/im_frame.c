@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
+#include "common/lm_out.h"
 #include "im_int.h"
 
 int im_err(char *err, size_t cap, int code, const char *fmt, ...)
@@ -94,48 +95,13 @@ int im_read_file(const char *path, size_t maxlen, void **buf, size_t *len,
     return IM_OK;
 }
 
+/* Every file the imaging engine writes (frames, pictures, videos) goes through the
+ * shared writer (src/common/lm_out.h): a unique temporary renamed over a regular file,
+ * a device or FIFO written in place, a link's target, "-" standard output. */
 int im_write_atomic(const char *path, const void *buf, size_t len, char *err, size_t cap)
 {
-    struct stat st;
-    size_t plen = strlen(path), done = 0;
-    char *tmp;
-    int fd;
-    if (!plen) return im_err(err, cap, IM_EINVAL, "empty output file name");
-    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
-        return im_err(err, cap, IM_EIO, "%s: exists and is not a regular file", path);
-    tmp = malloc(plen + 16);
-    if (!tmp) return im_err(err, cap, IM_ENOMEM, "%s: out of memory", path);
-    memcpy(tmp, path, plen);
-    memcpy(tmp + plen, ".part-XXXXXX", 13);
-    fd = mkstemp(tmp);
-    if (fd < 0) {
-        int e = errno;
-        free(tmp);
-        return im_err(err, cap, IM_EIO, "%s: cannot write: %s", path, strerror(e));
-    }
-    fchmod(fd, 0644);
-    while (done < len) {
-        ssize_t w = write(fd, (const char *)buf + done, len - done);
-        if (w < 0 && errno == EINTR) continue;
-        if (w <= 0) {
-            int e = w < 0 ? errno : ENOSPC;
-            close(fd); unlink(tmp); free(tmp);
-            return im_err(err, cap, IM_EIO, "%s: write error: %s", path, strerror(e));
-        }
-        done += (size_t)w;
-    }
-    if (fsync(fd) != 0 || close(fd) != 0) {
-        int e = errno;
-        unlink(tmp); free(tmp);
-        return im_err(err, cap, IM_EIO, "%s: write error: %s", path, strerror(e));
-    }
-    if (rename(tmp, path) != 0) {
-        int e = errno;
-        unlink(tmp); free(tmp);
-        return im_err(err, cap, IM_EIO, "%s: cannot rename into place: %s", path,
-                      strerror(e));
-    }
-    free(tmp);
+    if (!*path) return im_err(err, cap, IM_EINVAL, "empty output file name");
+    if (lm_out_save(path, buf, len, err, cap)) return IM_EIO;
     return IM_OK;
 }
 

@@ -46,18 +46,18 @@ build/asan/imaging/%.o: src/imaging/%.cpp $(IM_HDR) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CXX) $(IM_CXXBASE) $(SAN) -MMD -MP -c $< -o $@
 
-build/lib/lensmat-imaging.so: $(IM_OBJ)
+build/lib/lensmat-imaging.so: $(IM_OBJ) $(LM_COMMON_PIC)
 	@mkdir -p $(@D)
-	$(CXX) -shared $(OPT) -o $@ $(IM_OBJ) $(IM_LIBS)
-build/asan/lib/lensmat-imaging.so: $(IM_SOBJ)
+	$(CXX) -shared $(OPT) -o $@ $(IM_OBJ) $(LM_COMMON_PIC) $(IM_LIBS)
+build/asan/lib/lensmat-imaging.so: $(IM_SOBJ) $(LM_COMMON_SPIC)
 	@mkdir -p $(@D)
-	$(CXX) -shared $(SAN) -o $@ $(IM_SOBJ) $(IM_LIBS)
-build/lib/lensmat-camera.so: build/obj/imaging/camera.o
+	$(CXX) -shared $(SAN) -o $@ $(IM_SOBJ) $(LM_COMMON_SPIC) $(IM_LIBS)
+build/lib/lensmat-camera.so: build/obj/imaging/camera.o $(LM_COMMON_PIC)
 	@mkdir -p $(@D)
-	$(CXX) -shared $(OPT) -o $@ $< $(CAM_CVLIBS) -pthread
-build/asan/lib/lensmat-camera.so: build/asan/imaging/camera.o
+	$(CXX) -shared $(OPT) -o $@ $^ $(CAM_CVLIBS) -pthread
+build/asan/lib/lensmat-camera.so: build/asan/imaging/camera.o $(LM_COMMON_SPIC)
 	@mkdir -p $(@D)
-	$(CXX) -shared $(SAN) -o $@ $< $(CAM_CVLIBS) -pthread
+	$(CXX) -shared $(SAN) -o $@ $^ $(CAM_CVLIBS) -pthread
 
 # Engine tests and benches talk to the module through imaging.h only (linked to the .so;
 # the camera module is found beside it at run time).
@@ -85,7 +85,7 @@ build/obj/imaging_tests/bench_load: tests/imaging/bench_load.c $(IM_HDR) | $(DEP
 # libFuzzer target for the frame readers (PNG, TIFF, raw): our decoding and checking
 # code instrumented by clang, OpenCV's decoders as they ship.
 IM_FUZZSRC := src/imaging/im_frame_io.cpp src/imaging/im_frame.c src/imaging/im_centroid.c \
-              src/imaging/im_fit.c
+              src/imaging/im_fit.c src/common/lm_out.c
 IM_FUZZC   := $(filter %.c,$(IM_FUZZSRC))
 build/fuzz_frame: tests/imaging/fuzz_frame.c $(IM_FUZZSRC) $(IM_HDR) | $(DEPS)
 	@mkdir -p $(@D)/fuzz_frame.d
@@ -96,7 +96,7 @@ build/fuzz_frame: tests/imaging/fuzz_frame.c $(IM_FUZZSRC) $(IM_HDR) | $(DEPS)
 	$(CLANG)++ -std=c++17 -Isrc -O1 -g -fsanitize=fuzzer-no-link,address,undefined \
 	    $(IM_CVFLAGS) -c src/imaging/im_frame_io.cpp -o $(@D)/fuzz_frame.d/im_frame_io.o
 	$(CLANG)++ -O1 -g -fsanitize=fuzzer,address,undefined -Isrc -x c++ \
-	    tests/imaging/fuzz_frame.c -x none $(patsubst src/imaging/%.c,$(@D)/fuzz_frame.d/%.o,$(IM_FUZZC)) \
+	    tests/imaging/fuzz_frame.c -x none $(addprefix $(@D)/fuzz_frame.d/,$(notdir $(IM_FUZZC:.c=.o))) \
 	    $(@D)/fuzz_frame.d/im_frame_io.o -o $@ $(IM_CVLIBS) -lgsl -lgslcblas -lz -ldl -lm
 
 all: build/lib/lensmat-imaging.so build/lib/lensmat-camera.so

@@ -23,12 +23,12 @@ build/asan/rig/%.o: src/rig/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(SAN) -fPIC -fvisibility=hidden -pthread -MMD -MP -c $< -o $@
 
-build/lib/lensmat-rig.so: $(RIG_OBJ)
+build/lib/lensmat-rig.so: $(RIG_OBJ) $(LM_COMMON_PIC)
 	@mkdir -p $(@D)
-	$(CC) -shared $(OPT) -o $@ $(RIG_OBJ) $(RIG_LIBS)
-build/asan/lib/lensmat-rig.so: $(RIG_SOBJ)
+	$(CC) -shared $(OPT) -o $@ $(RIG_OBJ) $(LM_COMMON_PIC) $(RIG_LIBS)
+build/asan/lib/lensmat-rig.so: $(RIG_SOBJ) $(LM_COMMON_SPIC)
 	@mkdir -p $(@D)
-	$(CC) -shared $(SAN) -o $@ $(RIG_SOBJ) $(RIG_LIBS)
+	$(CC) -shared $(SAN) -o $@ $(RIG_SOBJ) $(LM_COMMON_SPIC) $(RIG_LIBS)
 
 # Tests link both modules (the trace engine checks the geometry independently).
 build/obj/rig_tests/%: tests/rig/%.c build/lib/lensmat-rig.so build/lib/lensmat-trace.so \
@@ -54,7 +54,7 @@ MODULE_BENCH_BINS += build/lib/lensmat-rig.so $(RIG_BBIN)
 build/fuzz_rig_geom: tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c src/rig/*.h) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-	    -o $@ tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c) -lgpiod -lgsl \
+	    -o $@ tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c) src/common/lm_out.c -lgpiod -lgsl \
 	    -lgslcblas -lm -pthread
 fuzz-rig-geom: build/fuzz_rig_geom
 	@mkdir -p build/fuzz-rig-geom-corpus

@@ -184,7 +184,7 @@ static void g_emergency(rg_chip *cc)
     }
 }
 
-static void g_close(rg_chip *cc)
+static int g_close(rg_chip *cc)
 {
     gchip *c = (gchip *)cc;
     for (int gi = 0; gi < RG_NGROUPS; gi++)
@@ -192,6 +192,7 @@ static void g_close(rg_chip *cc)
     if (c->in.requested) gpiod_line_release_bulk(&c->in.bulk);
     if (c->chip) gpiod_chip_close(c->chip);
     free(c);
+    return 0;
 }
 
 static const rg_chip_ops gpiod_ops = {g_set, g_inputs, g_now, g_sleep_until, g_emergency,

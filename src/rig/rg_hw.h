@@ -33,7 +33,7 @@ typedef struct rg_chip_ops {
     /* Async-signal-safe: laser inactive, then every ENABLE inactive. */
     void (*emergency)(rg_chip *c);
     /* Release everything (after the caller switched laser and drivers off). */
-    void (*close)(rg_chip *c);
+    int (*close)(rg_chip *c);       /* 0, or RG_EIO: a simulator's log lost lines */
     /* Moves and exposures tell the simulator what they do (log lines); may be NULL. */
     void (*note)(rg_chip *c, const char *what);
     /* The motors' positions where the chip knows them (simulator): 1, else 0. */

@@ -72,10 +72,10 @@ int rg_close(rg_machine *m)
     rg_laser_off(m);
     m->chip->ops->set(m->chip, RG_G_ENABLE, (1u << RG_NJOINTS) - 1, 0);
     rg_safety_register(m, 0);
-    m->chip->ops->close(m->chip);
+    int rc = m->chip->ops->close(m->chip);
     free(m->late);
     free(m);
-    return 0;
+    return rc;
 }
 
 static int cmpf(const void *a, const void *b)

@@ -5,8 +5,9 @@
  * heartbeat toggled within the pump's hold time).  Time is simulated: a wait moves the
  * clock to its deadline, so a replay writes the same event log byte for byte (with
  * sim_realtime the waits also sleep on the real clock; the stamps stay simulated).
- * The log is written with write(2) as events happen (LOG.part, renamed when the chip
- * closes or stops), so it survives a kill; its formatter is async-signal-safe for the
+ * The log is written with write(2) as events happen (through src/common/lm_out.h: a
+ * unique LOG.part.XXXXXX beside a regular file, renamed when the chip closes or stops;
+ * a device or FIFO in place), so it survives a kill; its formatter is async-signal-safe for the
  * emergency path.  The chip state may live in a shared file (rg_sim_shared) that a
  * watchdog outside the process reads (tests/rig/rig_watchdog.c).
  * Safety (doc/rig-safety.md): limit switches (tripped beyond travel, or from
@@ -28,6 +29,7 @@
 #include <sys/mman.h>
 #include <time.h>
 #include <unistd.h>
+#include "common/lm_out.h"
 #include "rig/rg_hw.h"
 
 static const char *const jname[RG_NJOINTS] = {"m1a", "m1b", "u", "v", "m2a", "m2b"};
@@ -38,8 +40,9 @@ typedef struct sim {
     rg_sim_shared *sh;
     int shared;                 /* sh is a mapping of a file */
     size_t shlen;
-    int log;                    /* fd of LOG.part, or -1 */
-    char log_part[512], log_final[512];
+    int log;                    /* fd of the log (lo.fd), or -1 */
+    lm_out lo;                  /* the log's writer */
+    int log_errno;              /* the first write error of the log, or 0 */
     int realclock;              /* null chip: real clock, no log */
     int64_t t0_real;            /* real-time pacing base */
     unsigned val[RG_NGROUPS];   /* logical output levels */
@@ -102,7 +105,10 @@ static void emit(sim *s, lbuf *l)
         while (n) {
             ssize_t w = write(s->log, p, n);
             if (w < 0 && errno == EINTR) continue;
-            if (w <= 0) break;
+            if (w <= 0) {
+                if (!s->log_errno) s->log_errno = w < 0 ? errno : ENOSPC;
+                break;
+            }
             p += w; n -= (size_t)w;
         }
     }
@@ -445,10 +451,12 @@ static void final_states(sim *s, const char *why)
 
 static void finish_log(sim *s)
 {
+    /* async-signal-safe (the emergency path): close and rename, nothing freed; a log
+     * that lost lines stays LOG.part, never under its name */
     if (s->log < 0) return;
-    close(s->log);
     s->log = -1;
-    if (s->log_final[0]) rename(s->log_part, s->log_final);
+    if (s->log_errno) lm_out_abort_fd_now(&s->lo);
+    else if (lm_out_commit_fd_now(&s->lo)) s->log_errno = errno ? errno : EIO;
 }
 
 static void sim_emergency(rg_chip *c)
@@ -495,17 +503,21 @@ static void sim_note(rg_chip *c, const char *what)
     emit(s, &l);
 }
 
-static void sim_close(rg_chip *c)
+static int sim_close(rg_chip *c)
 {
     sim *s = (sim *)c;
+    int rc;
     if (!s->closed) {
         final_states(s, "final");
         finish_log(s);
     }
     s->closed = 1;
+    lm_out_free(&s->lo);
     if (s->shared) munmap(s->sh, s->shlen);
     else free(s->sh);
+    rc = s->log_errno ? RG_EIO : 0;
     free(s);
+    return rc;
 }
 
 static int sim_motors(rg_chip *c, long steps[RG_NJOINTS])
@@ -522,20 +534,19 @@ static const rg_chip_ops sim_ops = {sim_set, sim_inputs, sim_now, sim_sleep_unti
  * mapping it earlier would fault): made as PATH.part, renamed when it is mapped. */
 static int open_shared(sim *s, const char *path, const rg_rig *rig, char *err, size_t cap)
 {
-    char part[600];
-    int fd;
-    snprintf(part, sizeof part, "%s.part", path);
-    fd = open(part, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    lm_out o;
+    /* a mapped file: a regular one (a unique temporary, renamed when mapped) */
+    if (lm_out_open(&o, path, LM_OUT_FD | LM_OUT_REGULAR, err, cap)) return RG_EIO;
     s->shlen = sizeof(rg_sim_shared);
-    if (fd < 0 || ftruncate(fd, (off_t)s->shlen)) {
+    if (ftruncate(o.fd, (off_t)s->shlen)) {
         snprintf(err, cap, "%s: %s", path, strerror(errno));
-        if (fd >= 0) close(fd);
+        lm_out_abort(&o, 0);
         return RG_EIO;
     }
-    s->sh = mmap(NULL, s->shlen, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-    close(fd);
+    s->sh = mmap(NULL, s->shlen, PROT_READ | PROT_WRITE, MAP_SHARED, o.fd, 0);
     if (s->sh == MAP_FAILED) {
         snprintf(err, cap, "%s: %s", path, strerror(errno));
+        lm_out_abort(&o, 0);
         s->sh = NULL;
         return RG_EIO;
     }
@@ -545,8 +556,7 @@ static int open_shared(sim *s, const char *path, const rg_rig *rig, char *err, s
      * a hold of 0 */
     s->sh->timeout_ns = (int64_t)llround(rig->heartbeat_timeout_ms * 1e6);
     s->sh->pump = rig->heartbeat.offset >= 0;
-    if (rename(part, path)) {
-        snprintf(err, cap, "%s: %s", path, strerror(errno));
+    if (lm_out_commit(&o, err, cap)) {
         munmap(s->sh, s->shlen);
         s->sh = NULL;
         return RG_EIO;
@@ -588,21 +598,11 @@ static int sim_make(const rg_rig *rig, const rg_open_opts *o, int realclock, rg_
     }
     s->sh->interlock = interlock_closed(s);
     if (o && o->sim_log && !realclock) {
-        size_t n = strlen(o->sim_log);
-        if (n + 6 > sizeof s->log_part) {
-            snprintf(err, cap, "%s: the name is too long", o->sim_log);
-            sim_close(&s->base);
-            return RG_EINVAL;
-        }
-        memcpy(s->log_final, o->sim_log, n + 1);
-        memcpy(s->log_part, o->sim_log, n);
-        memcpy(s->log_part + n, ".part", 6);
-        s->log = open(s->log_part, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-        if (s->log < 0) {
-            snprintf(err, cap, "%s: %s", s->log_part, strerror(errno));
+        if (lm_out_open(&s->lo, o->sim_log, LM_OUT_FD, err, cap)) {
             sim_close(&s->base);
             return RG_EIO;
         }
+        s->log = s->lo.fd;
     }
     if (rig->sim_realtime || realclock) s->t0_real = real_ns();
     if (s->log >= 0) {

@@ -325,8 +325,11 @@ enum rg_backend { RG_BACKEND_SIM, RG_BACKEND_GPIOD, RG_BACKEND_NULL };
 typedef struct rg_open_opts {
     int backend;                /* enum rg_backend; NULL: do-nothing lines, real clock */
     const char *chip;           /* gpiod: overrides the rig file's chip; NULL: keep */
-    const char *sim_log;        /* simulator: event log (written as LOG.part, renamed
-                                   when the machine closes or stops); NULL: none */
+    const char *sim_log;        /* simulator: event log (written as a unique
+                                   LOG.part.XXXXXX, renamed when the machine closes or
+                                   stops; a device or FIFO in place: src/common/lm_out.h);
+                                   NULL: none.  A log that lost a line (a write
+                                   error) makes close return RG_EIO */
     const char *sim_state;      /* simulator: its chip state in this shared file, so a
                                    watchdog outside the process sees the lines; NULL */
     int realtime;               /* 1: try SCHED_FIFO and mlockall */

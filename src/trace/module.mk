@@ -61,13 +61,13 @@ build/asan/trace/%.o: src/trace/%.cpp | $(DEPS)
 	@mkdir -p $(@D)
 	$(CXX) $(TRACE_CXX) $(SAN) -MMD -MP -c $< -o $@
 
-build/lib/lensmat-trace.so: $(TRACE_OBJ) $(TRACE_PXA)
+build/lib/lensmat-trace.so: $(TRACE_OBJ) $(TRACE_PXA) $(LM_COMMON_PIC)
 	@mkdir -p $(@D)
-	$(CC) -shared $(OPT) $(TRACE_HOT) -ffp-contract=off -o $@ $(TRACE_OBJ) $(TRACE_PXA) \
+	$(CC) -shared $(OPT) $(TRACE_HOT) -ffp-contract=off -o $@ $(TRACE_OBJ) $(TRACE_PXA) $(LM_COMMON_PIC) \
 	    $(TRACE_LIBS)
-build/asan/lib/lensmat-trace.so: $(TRACE_SOBJ) $(TRACE_SPXA)
+build/asan/lib/lensmat-trace.so: $(TRACE_SOBJ) $(TRACE_SPXA) $(LM_COMMON_SPIC)
 	@mkdir -p $(@D)
-	$(CC) -shared $(SAN) -o $@ $(TRACE_SOBJ) $(TRACE_SPXA) $(TRACE_LIBS)
+	$(CC) -shared $(SAN) -o $@ $(TRACE_SOBJ) $(TRACE_SPXA) $(LM_COMMON_SPIC) $(TRACE_LIBS)
 
 # Engine tests and benches talk to the module through trace.h only (linked to the .so).
 build/obj/trace_tests/%: tests/trace/%.c build/lib/lensmat-trace.so src/trace/trace.h
@@ -104,9 +104,9 @@ build/x86-64/trace/px/%.o: src/paraxial/%.c $(GEN) | $(DEPS)
 	$(CC) $(BASE) $(TRACE_X86) -fPIC -fvisibility=hidden -MMD -MP -c $< -o $@
 build/x86-64/trace/px/libpx.a: $(patsubst src/paraxial/%.c,build/x86-64/trace/px/%.o,$(TRACE_PX))
 	rm -f $@; ar rcs $@ $^
-build/x86-64/lib/lensmat-trace.so: $(TRACE_XOBJ) build/x86-64/trace/px/libpx.a
+build/x86-64/lib/lensmat-trace.so: $(TRACE_XOBJ) build/x86-64/trace/px/libpx.a $(LM_COMMON_PIC)
 	@mkdir -p $(@D)
-	$(CC) -shared $(TRACE_X86) -o $@ $(TRACE_XOBJ) build/x86-64/trace/px/libpx.a \
+	$(CC) -shared $(TRACE_X86) -o $@ $(TRACE_XOBJ) build/x86-64/trace/px/libpx.a $(LM_COMMON_PIC) \
 	    $(TRACE_LIBS)
 build/x86-64/trace_tests/%: tests/trace/%.c build/x86-64/lib/lensmat-trace.so src/trace/trace.h
 	@mkdir -p $(@D)

@@ -14,6 +14,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "common/lm_out.h"
 #include "paraxial/paraxial.h"
 #include "scene.h"
 #include "scene_out.h"
@@ -326,7 +327,7 @@ oom:
 
 typedef struct out {
     FILE *seg, *hit;
-    char *seg_part, *hit_part;
+    lm_out seg_out, hit_out;    /* where seg and hit go (src/common/lm_out.h) */
     so_table *seg_t, *hit_t;    /* their formats (scene_out.c); an HDF5 table that
                                    shares the segments' file has no FILE of its own */
     int tty;
@@ -386,34 +387,22 @@ static int w_progress(void *ctx, uint64_t done, uint64_t total)
     return 0;
 }
 
-static char *part_name(const char *name)
+/* An output through the shared writer: a unique temporary beside a regular file, in
+ * place for a device or FIFO, "-" for standard output (src/common/lm_out.h). */
+static FILE *open_part(const char *name, lm_out *o, char *err)
 {
-    char *p = malloc(strlen(name) + 6);
-    if (p) sprintf(p, "%s.part", name);
-    return p;
+    if (lm_out_open(o, name, 0, err, SC_ERRMAX)) return NULL;
+    return o->f;
 }
 
-static FILE *open_part(const char *name, char **part, char *err)
+/* Commit o when ok, else keep what was written as NAME.part (never under its name);
+ * 0 or -1, with a message in err unless one is there already. */
+static int finish(lm_out *o, int ok, char *err)
 {
-    FILE *f;
-    if (!(*part = part_name(name))) {
-        snprintf(err, SC_ERRMAX, "out of memory");
-        return NULL;
-    }
-    if (!(f = fopen(*part, "w")))
-        snprintf(err, SC_ERRMAX, "%s: cannot write: %s", *part, strerror(errno));
-    return f;
-}
-
-/* Close f and rename part to name when ok (else leave the .part); 0 or -1, with a
- * message in err unless one is there already. */
-static int finish(FILE *f, const char *part, const char *name, int ok, char *err)
-{
-    int bad = ferror(f) | fclose(f);
-    if (bad && !err[0]) snprintf(err, SC_ERRMAX, "%s: write error", part);
-    if (!ok || bad) return -1;
-    if (rename(part, name) && !err[0]) {
-        snprintf(err, SC_ERRMAX, "%s: cannot rename to %s: %s", part, name, strerror(errno));
+    char why[SC_ERRMAX];
+    if (!ok) { lm_out_abort(o, 1); return -1; }
+    if (lm_out_commit(o, why, sizeof why)) {
+        if (!err[0]) snprintf(err, SC_ERRMAX, "%s", why);
         return -1;
     }
     return 0;
@@ -447,7 +436,7 @@ static void end_table(const sc_scene *sc, out *o, int i, const sc_result *res,
                       const double *wl, const trace_summary *per, int nwl, char *err)
 {
     FILE *f = i ? o->hit : o->seg;
-    const char *part = i ? o->hit_part : o->seg_part;
+    const char *part = i ? sc->out_hits : sc->out_segments;
     char why[SC_ERRMAX / 2];
     int rc;
     if (!(i ? o->hit_t : o->seg_t)) return;   /* its table could not be set up */
@@ -493,19 +482,17 @@ static void add_summary(trace_summary *a, const trace_summary *b)
 static int write_summary(const sc_scene *sc, const trace_summary *s, const double *wl,
                          const trace_summary *per, int nwl, char *err)
 {
-    char *part;
+    lm_out o;
     FILE *f;
     int rc;
     if (h5_shared(sc, 2)) return 0;   /* written with the tables */
-    if (!(f = open_part(sc->out_summary, &part, err))) { free(part); return -1; }
+    if (!(f = open_part(sc->out_summary, &o, err))) return -1;
     if (sc->out_format[2] == SC_OUT_H5) {
         so_summary m = {sc->name, s, sc->named_wl ? nwl : 0, wl, per};
         char why[SC_ERRMAX / 2];
         rc = so_h5_write(f, NULL, NULL, &m, why, sizeof why);
-        if (rc) snprintf(err, SC_ERRMAX, "%s: %s", part, why);
-        rc = finish(f, part, sc->out_summary, !rc, err);
-        free(part);
-        return rc;
+        if (rc) snprintf(err, SC_ERRMAX, "%s: %s", sc->out_summary, why);
+        return finish(&o, !rc, err);
     }
     fprintf(f, "scene %s\nrays %llu\nsegments %llu\ninteractions %llu\ntir %llu\n"
             "hits %llu\ncut_depth %llu\ncut_power %llu\ncut_reflection %llu\n"
@@ -524,9 +511,7 @@ static int write_summary(const sc_scene *sc, const trace_summary *s, const doubl
                 (unsigned long long)per[k].rays, (unsigned long long)per[k].hits,
                 per[k].emitted, per[k].detected, per[k].absorbed, per[k].escaped,
                 per[k].cutoff);
-    rc = finish(f, part, sc->out_summary, 1, err);
-    free(part);
-    return rc;
+    return finish(&o, 1, err);
 }
 
 /* The engine's scene at wavelength l (0: none named): every surface with its media at
@@ -598,13 +583,13 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     sink.ctx = &o;
     sink.progress = w_progress;
     if (sc->out_segments) {
-        if (!(o.seg = open_part(sc->out_segments, &o.seg_part, err)) ||
-            !(o.seg_t = table(o.seg, sc->out_format[0], 0, o.wl, o.seg_part, err)))
+        if (!(o.seg = open_part(sc->out_segments, &o.seg_out, err)) ||
+            !(o.seg_t = table(o.seg, sc->out_format[0], 0, o.wl, sc->out_segments, err)))
             goto out;
         sink.segment = w_segment;
     }
     if (sc->out_hits) {
-        if ((!h5_shared(sc, 1) && !(o.hit = open_part(sc->out_hits, &o.hit_part, err))) ||
+        if ((!h5_shared(sc, 1) && !(o.hit = open_part(sc->out_hits, &o.hit_out, err))) ||
             !(o.hit_t = table(o.hit, sc->out_format[1], 1, o.wl, sc->out_hits, err)))
             goto out;
         sink.hit = w_hit;
@@ -640,16 +625,14 @@ out:
     /* finish() leaves a message in err on any failure */
     if (o.seg) {
         end_table(sc, &o, 0, res, wl, per, nwl, err);
-        finish(o.seg, o.seg_part, sc->out_segments, !err[0], err);
+        finish(&o.seg_out, !err[0], err);
     }
     if (o.hit) {
         end_table(sc, &o, 1, res, wl, per, nwl, err);
-        finish(o.hit, o.hit_part, sc->out_hits, !err[0], err);
+        finish(&o.hit_out, !err[0], err);
     }
     so_free(o.seg_t);
     so_free(o.hit_t);
-    free(o.seg_part);
-    free(o.hit_part);
     if (ts) tr->scene_free(ts);
     if (!err[0] && sc->out_summary) write_summary(sc, &res->sum, wl, per, nwl, err);
     return err[0] ? -1 : 0;
