@@ -8,9 +8,10 @@
  * is printed, recorded and (optionally) written under a name: Sim K (apex and 3 mm
  * zone), radii, Q, pose, singular values, what is not determined, the spots rejected
  * and why, as NAME.txt, NAME.csv and NAME.json, with the four maps when asked
- * (cornea_out.c).  The eye may carry a keratoconus-like cone.  The loop itself is
- * cornea_loop.c; texts in prompts/cornea_scan.txt.  The rig, cornea and trace engines
- * are loaded here; the imaging engine only when frames or maps are used. */
+ * (cornea_out.c).  The eye may carry a keratoconus-like cone.  The measurement itself
+ * is the topography pipeline (src/topo, lensmat-topo.so); texts in
+ * prompts/cornea_scan.txt.  The rig, cornea, trace and topo engines are loaded here;
+ * the imaging engine only when frames or maps are used. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -20,11 +21,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "calcio.h"
-#include "cornea_loop.h"
 #include "cornea_out.h"
 #include "dialogues.h"
 #include "engine.h"
 #include "../imaging/imaging.h"
+#include "../topo/topo.h"
 #include "../trace/trace.h"
 #include "prompts_cornea_scan.h"
 
@@ -55,6 +56,7 @@ static int stop_cb(void *ctx) { (void)ctx; return lm_stop_requested() != 0; }
 typedef struct cs {
     calc cc;
     const rig_api *rg;
+    const topo_api *tp;
     rg_rig rig;
     int have_rig;
     char rigname[WORD], log[WORD], report[WORD], camera[WORD], save[WORD];
@@ -190,7 +192,7 @@ static double check_tol_um(void)
 
 /* ---- the dialogue ----------------------------------------------------------------- */
 
-static int run(cs *s, cl_run *r, rg_machine **m);
+static int run(cs *s, tp_run *r, rg_machine **m);
 
 /* What the report adds beside the engine's numbers: the scan's settings and, for a
  * synthetic eye, its truth and the errors. */
@@ -205,7 +207,7 @@ static void say_line(void *ctx, const char *line) { say(ctx, CS(LINE), line); }
 
 /* The maps (when asked: their lines join the report) and the report under s->report,
  * from the fitted spots of the run whatever their source (frames, model, camera). */
-static int cs_files(cs *s, const cl_run *r, int maps, const cs_truth *tr)
+static int cs_files(cs *s, const tp_run *r, int maps, const cs_truth *tr)
 {
     const cornea_api *cn = r->cn;
     const cn_clinical *k = &r->res.k;
@@ -269,7 +271,7 @@ int lm_cornea_scan(lm_io *io)
     static const char *const patterns[] = {"spiral", "rings", "grid", NULL};
     static const char *const sources[] = {"frames", "model", "camera", NULL};
     cs *s = calloc(1, sizeof *s);
-    cl_run *r = calloc(1, sizeof *r);
+    tp_run *r = calloc(1, sizeof *r);
     rg_machine *m = NULL;
     int rc = LM_FAIL;
     if (!s || !r) { free(s); free(r); fprintf(stderr, "lensmat: out of memory\n"); return LM_FAIL; }
@@ -277,12 +279,16 @@ int lm_cornea_scan(lm_io *io)
     calc *c = &s->cc;
     rig_get_api_fn rget;
     cornea_get_api_fn cget;
+    topo_get_api_fn pget;
     *(void **)&rget = lm_engine_symbol("rig", RIG_API_SYMBOL);
     *(void **)&cget = lm_engine_symbol("cornea", CORNEA_API_SYMBOL);
+    *(void **)&pget = lm_engine_symbol("topo", TOPO_API_SYMBOL);
     const rig_api *rg = rget ? rget(RIG_ABI) : NULL;
     const cornea_api *cn = cget ? cget(CORNEA_ABI) : NULL;
-    if (!rg || !cn) { rc = calc_fail(c, CS(NO_ENGINE)); goto out; }
+    const topo_api *tp = pget ? pget(TOPO_ABI) : NULL;
+    if (!rg || !cn || !tp) { rc = calc_fail(c, CS(NO_ENGINE)); goto out; }
     s->rg = rg;
+    s->tp = tp;
     int model, chip = 0, pattern, source;
     double np, zone, R = 7.8, Q = 0, cyl = 0, axis = 0, dx = 0, dy = 0, tx = 0, ty = 0,
            noise = 0, pitch, seed = 0, w = 0, h = 0, ms = 0;
@@ -305,11 +311,11 @@ int lm_cornea_scan(lm_io *io)
         (rc = ranged(c, CS(ZONE), CS(ZONE_WHAT), CS(ZONE_RANGE), 0.5, 12, 0, &zone)) ||
         (rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source)))
         goto out;
-    if (source == CL_SRC_CAMERA &&
+    if (source == TP_SRC_CAMERA &&
         (rc = lm_ask_word(io, CS(CAMERA), CS(CAMERA), CS(CAMERA_WHAT), NULL, NULL, s->camera,
                           sizeof s->camera)))
         goto out;
-    if (source != CL_SRC_CAMERA &&      /* a real eye is what the camera sees */
+    if (source != TP_SRC_CAMERA &&      /* a real eye is what the camera sees */
         ((rc = ranged(c, CS(R), CS(R_WHAT), CS(R_RANGE), 5, 12, 0, &R)) ||
         (rc = ranged(c, CS(Q), CS(Q_WHAT), CS(Q_RANGE), -1, 1, 0, &Q)) ||
         (rc = ranged(c, CS(CYL), CS(CYL_WHAT), CS(CYL_RANGE), 0, 8, 0, &cyl)) ||
@@ -319,19 +325,19 @@ int lm_cornea_scan(lm_io *io)
         (rc = ranged(c, CS(TX), CS(TX_WHAT), CS(TILT_RANGE), -10, 10, 0, &tx)) ||
         (rc = ranged(c, CS(TY), CS(TY_WHAT), CS(TILT_RANGE), -10, 10, 0, &ty))))
         goto out;
-    if (source == CL_SRC_MODEL &&
+    if (source == TP_SRC_MODEL &&
         (rc = ranged(c, CS(NOISE), CS(NOISE_WHAT), CS(NOISE_RANGE), 0, 10, 0, &noise)))
         goto out;
     if ((rc = ranged(c, CS(PITCH), CS(PITCH_WHAT), CS(PITCH_RANGE), 0.1, 100, 0, &pitch)))
         goto out;
-    if (source == CL_SRC_FRAMES &&
+    if (source == TP_SRC_FRAMES &&
         ((rc = ranged(c, CS(WIDTH), CS(WIDTH_WHAT), CS(PX_RANGE), 16, 4096, 1, &w)) ||
          (rc = ranged(c, CS(HEIGHT), CS(HEIGHT_WHAT), CS(PX_RANGE), 16, 4096, 1, &h)) ||
          (rc = lm_ask_word(io, CS(SAVE), CS(SAVE), CS(SAVE_WHAT), check_save, s, s->save,
                            sizeof s->save))))
         goto out;
     cn_bump cone = {0, 0, 0, 0};       /* a cone on the synthetic eye (not a camera's) */
-    if (source != CL_SRC_CAMERA &&
+    if (source != TP_SRC_CAMERA &&
         ((rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)) ||
          (rc = ranged(c, CS(CONE), CS(CONE_WHAT), CS(CONE_RANGE), 0, 50, 0, &cone.h))))
         goto out;
@@ -367,21 +373,21 @@ int lm_cornea_scan(lm_io *io)
     r->cn = cn;
     r->g = &g;
     r->truth = eye;
-    r->have_truth = source != CL_SRC_CAMERA;
+    r->have_truth = source != TP_SRC_CAMERA;
     cn_params t;                       /* the true eye as the engine's parameters */
     cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
     if (cone.h > 0) {
         r->bump = &cone;
         r->truth_p = t;
     }
-    r->camera = source == CL_SRC_CAMERA ? s->camera : NULL;
-    r->save = source == CL_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
+    r->camera = source == TP_SRC_CAMERA ? s->camera : NULL;
+    r->save = source == TP_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
     r->pattern = pattern;
     r->npoints = (int)np;
     r->zone = zone * DEG;
     r->source = source;
     r->sigma = noise * pitch * 1e-3;
-    r->cam = (cl_camera){(int)w, (int)h, pitch * 1e-3, 3, 1000, 100, 50};
+    r->cam = (tp_camera){(int)w, (int)h, pitch * 1e-3, 3, 1000, 100, 50};
     r->seed = (uint64_t)seed;
     r->threads = threads_wanted();
     r->expose_ms = ms;
@@ -401,12 +407,12 @@ int lm_cornea_scan(lm_io *io)
         r->tr = tget ? tget(TRACE_ABI) : NULL;
         if (!r->tr) say(s, "%s", CS(NO_TRACER));
     }
-    if (source != CL_SRC_MODEL) {
+    if (source != TP_SRC_MODEL) {
         imaging_get_api_fn iget =
             (imaging_get_api_fn)lm_engine_symbol("imaging", IMAGING_API_SYMBOL);
         r->im = iget ? iget(IMAGING_ABI) : NULL;
         if (!r->im || !r->im->frame) { rc = calc_fail(c, CS(NO_IMAGING)); goto out; }
-        if (source == CL_SRC_CAMERA)
+        if (source == TP_SRC_CAMERA)
             say(s, CS(CAMERA_ON), s->camera, pitch);
         else
             say(s, CS(FRAMES_ON), r->cam.width, r->cam.height, pitch, r->cam.spot_w,
@@ -468,16 +474,16 @@ out:
 }
 
 /* The measurement and its report. */
-static int run(cs *s, cl_run *r, rg_machine **m)
+static int run(cs *s, tp_run *r, rg_machine **m)
 {
     static const char *const pname[] = {"spiral", "rings", "grid"};
     calc *c = &s->cc;
     const cornea_api *cn = r->cn;
     char err[256];
     static char buf[8192];
-    int rc = cl_measure(r, err, sizeof err);
+    int rc = s->tp->measure(r, err, sizeof err);
     int counts[6];
-    cl_counts(r, counts);
+    s->tp->counts(r, counts);
     if (rc == CN_ESTOP || lm_stop_requested()) return LM_FAIL;
     if (rc == CN_EINVAL || rc == CN_ENOMEM) {   /* the machine, the camera or saving */
         if (*m) { r->rg->close(*m); *m = NULL; }
@@ -490,7 +496,7 @@ static int run(cs *s, cl_run *r, rg_machine **m)
     int sn = 0;
     for (int k = 0; k < r->npoints; k++)
         if (r->pt[k].planned && isfinite(r->pt[k].spot.u)) { ssum += r->pt[k].spot.sigma; sn++; }
-    say(s, CS(SCANNED), r->nplanned, sn, (r->source == CL_SRC_MODEL || !sn ? r->sigma
+    say(s, CS(SCANNED), r->nplanned, sn, (r->source == TP_SRC_MODEL || !sn ? r->sigma
                                            : ssum / sn) * 1e3);
     if (rc) {
         calc_say(c, CS(FAILED), err);
@@ -508,7 +514,7 @@ static int run(cs *s, cl_run *r, rg_machine **m)
         counts[CN_S_NONE], counts[CN_S_SEVERAL], counts[CN_S_OUTLIER], counts[CN_S_MISS],
         counts[5]);
     for (int k = 0; k < r->npoints; k++) {
-        const cl_point *q = &r->pt[k];
+        const tp_point *q = &r->pt[k];
         if (q->planned && q->spot.status == CN_S_OK) continue;
         say(s, CS(REJECTED), k + 1, q->t.a / DEG, q->t.b / DEG, q->why);
     }

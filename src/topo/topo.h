@@ -1,36 +1,42 @@
-/* cornea_loop.h -- the measurement loop of --cornea-scan (cornea_loop.c): a scan
- * pattern planned by the rig engine, run on the machine (simulated chip) or only
- * planned, each exposure's spot traced through the true eye by the trace engine, made
- * into a full synthetic detector frame by the imaging engine and located by its
- * centroid fit (or, the quick model, the traced hit plus Gaussian noise), then the
- * cornea engine's fit and the check of its analytic model against the tracer.  The
- * engines never see each other: this file hands each one's results to the next. */
-#ifndef LM_CORNEA_LOOP_H
-#define LM_CORNEA_LOOP_H
+/* topo.h -- public face of the topography pipeline (issue 19): one corneal
+ * measurement end to end.  A scan pattern planned by the rig engine, run on the
+ * machine (simulated chip) or only planned, each exposure's spot traced through the
+ * true eye by the trace engine, made into a full synthetic detector frame by the
+ * imaging engine and located by its centroid fit (or, the quick model, the traced hit
+ * plus Gaussian noise), then the cornea engine's fit and the check of its analytic
+ * model against the tracer.  The engines never see each other: the pipeline hands
+ * each one's results to the next, through the API tables the caller puts in tp_run.
+ * It serves --cornea-scan (src/dialogue/cornea_scan.c asks and prints), the study
+ * script (through --cornea-scan) and the tests.  Lives in build/lib/lensmat-topo.so:
+ *     topo_get_api_fn get = (topo_get_api_fn)lm_engine_symbol("topo", TOPO_API_SYMBOL);
+ *     const topo_api *tp = get ? get(TOPO_ABI) : NULL;
+ * It never prints and never exits; mm and radians. */
+#ifndef TOPO_H
+#define TOPO_H
 #include <stddef.h>
 #include <stdint.h>
-#include "../rig/rig.h"
-#include "../cornea/cornea.h"
+#include "rig/rig.h"
+#include "cornea/cornea.h"
 
 struct trace_api;
 struct imaging_api;
 
-enum { CL_SPIRAL, CL_RINGS, CL_GRID };          /* scan patterns */
-enum { CL_SRC_FRAMES, CL_SRC_MODEL, CL_SRC_CAMERA };   /* where the spots come from:
+enum { TP_SPIRAL, TP_RINGS, TP_GRID };          /* scan patterns */
+enum { TP_SRC_FRAMES, TP_SRC_MODEL, TP_SRC_CAMERA };   /* where the spots come from:
                                    synthetic frames, the traced hit plus noise, or
                                    frames read from a camera, video or files */
 
 /* The detector frames (the imaging benchmark's spot and noise by default). */
-typedef struct cl_camera {
+typedef struct tp_camera {
     int width, height;          /* pixels */
     double pitch;               /* mm */
     double spot_w;              /* the spot's 1/e^2 radius, pixels (3) */
     double peak;                /* its peak above the background, counts (1000) */
     double bias;                /* background level, counts (100) */
     double read_noise;          /* counts rms (50) */
-} cl_camera;
+} tp_camera;
 
-typedef struct cl_point {
+typedef struct tp_point {
     rg_target t;
     int planned;                /* 1: solved and quantised (else why[] says) */
     rg_pose pose;               /* commanded; after a machine scan: where the motors
@@ -42,14 +48,14 @@ typedef struct cl_point {
     int seq;                    /* frame number (1, 2, ...: the planned points in scan
                                    order; 0: none) */
     char why[96];               /* why the point gave no spot */
-} cl_point;
+} tp_point;
 
-typedef struct cl_times {       /* seconds of wall clock, per part */
+typedef struct tp_times {       /* seconds of wall clock, per part */
     double plan, machine, trace, frames, fit, check, total;
     double cpu;                 /* the process's CPU seconds over the whole loop */
-} cl_times;
+} tp_times;
 
-typedef struct cl_run {
+typedef struct tp_run {
     /* engines (the imaging engine only for frames; the tracer may be NULL: then the
        rig's forward model gives the hit and the final check is not made) */
     const rig_api *rg;
@@ -61,11 +67,11 @@ typedef struct cl_run {
     /* scan */
     int pattern, npoints;
     double zone;                /* largest theta (rad) */
-    int source;                 /* CL_SRC_* */
+    int source;                 /* TP_SRC_* */
     double sigma;               /* model: centroid noise (mm) */
-    cl_camera cam;
-    const char *camera;         /* CL_SRC_CAMERA: the source (imaging.h source_open) */
-    const char *save;           /* CL_SRC_FRAMES: write frame N to this %d pattern
+    tp_camera cam;
+    const char *camera;         /* TP_SRC_CAMERA: the source (imaging.h source_open) */
+    const char *save;           /* TP_SRC_FRAMES: write frame N to this %d pattern
                                    (NULL: not saved) */
     int have_truth;             /* 0: a real eye (camera): nothing to trace */
     const cn_bump *bump;        /* a keratoconus-like cone on the true eye (NULL:
@@ -85,21 +91,33 @@ typedef struct cl_run {
     int model;
     double check_tol;           /* mm: largest tracer/model difference accepted */
     /* results */
-    cl_point *pt;               /* npoints */
+    tp_point *pt;               /* npoints */
     int nplanned, nexposed;
     cn_result res;
     int fitted;                 /* 1: res holds a fit */
     double check_max;           /* mm, largest |traced - model| over the fitted spots */
     int check_n;                /* spots traced in the check */
-    cl_times tm;
-} cl_run;
+    tp_times tm;
+} tp_run;
 
-/* Scan pattern: n targets (theta, phi) within zone; returns the count written. */
-int cl_pattern(int pattern, int n, double zone, rg_target *t);
-/* The whole loop.  0; CN_ESTOP when stopped; CN_EFIT (fit failed, err) or CN_EINVAL
- * (bad setup, a machine error: err).  The final check failing is not an error here:
- * the caller compares check_max with check_tol. */
-int cl_measure(cl_run *r, char *err, size_t cap);
-/* Counts of the points by status (OK, NONE, SEVERAL, OUTLIER, MISS) and unplanned. */
-void cl_counts(const cl_run *r, int counts[6]);
+
+typedef struct topo_api {
+    int abi;
+    const char *(*version)(void);
+    /* Scan pattern (TP_SPIRAL ...): n targets (theta, phi) within zone; returns the
+     * count written. */
+    int (*pattern)(int pattern, int n, double zone, rg_target *t);
+    /* The whole measurement.  0; CN_ESTOP when stopped; CN_EFIT (fit failed, err) or
+     * CN_EINVAL (bad setup, a machine error: err).  The final check failing is not
+     * an error here: the caller compares check_max with check_tol. */
+    int (*measure)(tp_run *r, char *err, size_t cap);
+    /* Counts of the points by status (OK, NONE, SEVERAL, OUTLIER, MISS) and
+     * unplanned. */
+    void (*counts)(const tp_run *r, int counts[6]);
+} topo_api;
+
+#define TOPO_ABI 1
+#define TOPO_API_SYMBOL "topo_get_api"
+typedef const topo_api *(*topo_get_api_fn)(int abi);
+const topo_api *topo_get_api(int abi);
 #endif
