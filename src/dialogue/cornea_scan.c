@@ -61,6 +61,8 @@ typedef struct cs {
     int have_rig;
     char rigname[WORD], log[WORD], report[WORD], camera[WORD], save[WORD];
     char *text;                 /* the report as said, for NAME.txt */
+    cn_kc kt;                   /* the true surface's indices (tk 1) */
+    int tk;
     size_t len, cap;
 } cs;
 
@@ -190,9 +192,19 @@ static double check_tol_um(void)
     return e && *e ? strtod(e, NULL) : CHECK_TOL_UM;
 }
 
+/* The fit's iteration cap per solve: LENSMAT_CORNEA_MAX_ITER overrides the engine's
+ * 1000 (tests make a fit stop at its cap). */
+static int max_iter_env(void)
+{
+    const char *e = getenv("LENSMAT_CORNEA_MAX_ITER");
+    long n = e && *e ? strtol(e, NULL, 10) : 0;
+    return n > 0 && n < 1000000 ? (int)n : 0;
+}
+
 /* ---- the dialogue ----------------------------------------------------------------- */
 
 static int run(cs *s, tp_run *r, rg_machine **m);
+static void say_surface(cs *s, tp_run *r);
 
 /* What the report adds beside the engine's numbers: the scan's settings and, for a
  * synthetic eye, its truth and the errors. */
@@ -247,19 +259,44 @@ static int cs_files(cs *s, const tp_run *r, int maps, const cs_truth *tr)
     };
     /* a camera's eye is unknown: the scan's settings only */
     int nrows = r->have_truth ? (int)(sizeof rows / sizeof *rows) : 7;
-    if (maps && cs_write_maps(cn, r->g, s->report, &r->res, sp, n, stop_cb, say_line, s, msg,
-                              sizeof msg)) {
+    /* the surface from the data: its indices, and the true surface's */
+    const cn_kc *k2 = &r->kc;
+    const cn_kc kt = s->kt;
+    int tk = s->tk;
+    const cs_row zrows[] = {
+        {"topo_order", r->have_z ? r->zf->order : NAN, NAN, ""},
+        {"topo_chi2_dof", r->have_z ? r->zf->chi2_dof : NAN, NAN, ""},
+        {"topo_zone_r", r->have_z ? r->zf->rho : NAN, NAN, "mm"},
+        {"kmax", k2->kmax, k2->sd_kmax, "D"}, {"kmax_x", k2->kmax_x, k2->sd_kmax_loc, "mm"},
+        {"kmax_y", k2->kmax_y, k2->sd_kmax_loc, "mm"}, {"central_K", k2->ck, k2->sd_ck, "D"},
+        {"I_S", k2->is, k2->sd_is, "D"}, {"I_S_r", k2->is_r, NAN, "mm"},
+        {"simk1", k2->simk1, k2->sd_simk, "D"}, {"simk2", k2->simk2, k2->sd_simk, "D"},
+        {"AST", k2->ast, k2->sd_ast, "D"}, {"SRAX", k2->srax, k2->sd_srax, "deg"},
+        {"KISA", k2->kisa, k2->sd_kisa, "%"}, {"kc_screen", k2->screen, NAN, ""},
+        {"true_kmax", tk ? kt.kmax : NAN, NAN, "D"}, {"true_kmax_x", tk ? kt.kmax_x : NAN, NAN, "mm"},
+        {"true_kmax_y", tk ? kt.kmax_y : NAN, NAN, "mm"}, {"true_central_K", tk ? kt.ck : NAN, NAN, "D"},
+        {"true_I_S", tk ? kt.is : NAN, NAN, "D"}, {"true_SRAX", tk ? kt.srax : NAN, NAN, "deg"},
+        {"true_KISA", tk ? kt.kisa : NAN, NAN, "%"},
+    };
+    int nz = !r->have_z ? 0 : tk ? (int)(sizeof zrows / sizeof *zrows) : 15;
+    cs_row *all = malloc(sizeof *all * (size_t)(nrows + nz));
+    if (!all) { free(sp); return calc_fail(&s->cc, CS(NO_MEMORY)); }
+    memcpy(all, rows, sizeof *all * (size_t)nrows);
+    memcpy(all + nrows, zrows, sizeof *all * (size_t)nz);
+    if (maps && cs_write_maps(cn, r->g, s->report, &r->res, sp, n, r->have_z ? r->zf : NULL,
+                              &r->kc, stop_cb, say_line, s, msg, sizeof msg)) {
         rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
         fprintf(stderr, "lensmat: ");
         fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
-    } else if (cs_write_report(cn, s->report, s->text, s->len, &r->res, sp, n, rows, nrows,
-                               msg, sizeof msg)) {
+    } else if (cs_write_report(cn, s->report, s->text, s->len, &r->res, sp, n, all,
+                               nrows + nz, msg, sizeof msg)) {
         rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
         fprintf(stderr, "lensmat: ");
         fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
     } else {
         lm_say(s->cc.io, LM_OUT, CS(REPORT_WRITTEN), s->report, s->report, s->report);
     }
+    free(all);
     free(sp);
     return rc;
 }
@@ -394,8 +431,10 @@ int lm_cornea_scan(lm_io *io)
     r->stop = stop_cb;
     r->model = model;
     r->check_tol = check_tol_um() * 1e-3;
+    r->max_iter = max_iter_env();
     r->rig = &s->rig;
-    if (!(r->pt = calloc((size_t)r->npoints, sizeof *r->pt))) {
+    if (!(r->zf = calloc(1, sizeof *r->zf)) ||
+        !(r->pt = calloc((size_t)r->npoints, sizeof *r->pt))) {
         rc = calc_fail(c, CS(NO_MEMORY));
         goto out;
     }
@@ -448,7 +487,18 @@ int lm_cornea_scan(lm_io *io)
                       ? remainder(r->res.k.K1_axis - fmod(axis + 360, 180), 180.0) : 0.0;
     if (rc == LM_GO && r->have_truth) {
         say(s, CS(TRUTH), eye.R, eye.R2, km, cyl);
-        say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km, axis_err);
+        s->tk = r->have_z &&
+                !cn->kc_model(CN_BICONIC, &t, cone.h > 0 ? &cone : NULL, r->zf->rho, &s->kt);
+        if (s->tk)
+            say(s, CS(TOPO_TRUTH), s->kt.kmax, s->kt.kmax_x, s->kt.kmax_y, s->kt.ck, s->kt.is,
+                s->kt.srax, s->kt.kisa);
+        if (!r->res.rejected_model && r->res.converged)   /* else no numbers to compare */
+            say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km, axis_err);
+    }
+    if (rc == LM_GO && r->fitted && !r->res.converged) {
+        fprintf(stderr, "lensmat: ");
+        fprintf(stderr, CS(NOT_CONVERGED), r->res.iterations);
+        rc = LM_FAIL;
     }
     if (rc == LM_GO) {
         if (r->check_max > r->check_tol) {
@@ -467,10 +517,43 @@ out:
     if (m) rg->close(m);
     if (hook_api) { lm_on_stop_remove(laser_off_hook, NULL); hook_api = NULL; }
     free(r->pt);
+    free(r->zf);
     free(r);
     free(s->text);
     free(s);
     return rc;
+}
+
+/* The surface from the data and the keratoconus indices; sd scaled by the root of
+ * the slope fit's chi2/dof when that is above 1.5. */
+static void say_surface(cs *s, tp_run *r)
+{
+    if (!r->have_z) { say(s, CS(TOPO_NONE), r->zwhy[0] ? r->zwhy : "no fit"); return; }
+    const cn_zfit *z = r->zf;
+    cn_kc *k = &r->kc;
+    say(s, CS(TOPO_SURFACE), z->order, z->nused, z->chi2_dof, z->rho, r->zref_R);
+    if (z->chi2_dof > 4) {      /* it does not follow its own data: no index of it */
+        say(s, CS(TOPO_UNFIT), z->chi2_dof);
+        r->have_z = 0;
+        return;
+    }
+    if (z->chi2_dof > 1.5) {
+        double f = sqrt(z->chi2_dof);
+        say(s, CS(TOPO_POOR), z->chi2_dof, f);
+        k->sd_kmax *= f; k->sd_kmax_loc *= f; k->sd_ck *= f; k->sd_is *= f;
+        k->sd_simk *= f; k->sd_ast *= f; k->sd_srax *= f; k->sd_kisa *= f;
+    }
+    say(s, CS(TOPO_KMAX), k->kmax, k->sd_kmax, k->kmax_x, k->kmax_y, k->sd_kmax_loc);
+    say(s, CS(TOPO_CK), k->ck, k->sd_ck, k->ck_rings, k->simk1, k->simk2, k->simk_axis,
+        fmin(1.5, 0.9 * k->zone_r), k->ast, k->sd_ast);
+    say(s, CS(TOPO_IS), k->is, k->sd_is, k->is_r, k->is_r < 3 ? CS(TOPO_IS_SHORT) : "",
+        k->srax, k->sd_srax, k->kisa, k->sd_kisa);
+    if (k->screen == CN_KC_KERATOCONUS)
+        say(s, CS(TOPO_SCREEN_KC), k->why, k->kmax_x, k->kmax_y);
+    else if (k->screen == CN_KC_SUSPECT)
+        say(s, CS(TOPO_SCREEN_SUSPECT), k->why, k->kmax_x, k->kmax_y);
+    else
+        say(s, "%s", CS(TOPO_SCREEN_NORMAL));
 }
 
 /* The measurement and its report. */
@@ -498,6 +581,10 @@ static int run(cs *s, tp_run *r, rg_machine **m)
         if (r->pt[k].planned && isfinite(r->pt[k].spot.u)) { ssum += r->pt[k].spot.sigma; sn++; }
     say(s, CS(SCANNED), r->nplanned, sn, (r->source == TP_SRC_MODEL || !sn ? r->sigma
                                            : ssum / sn) * 1e3);
+    if (r->source == TP_SRC_CAMERA && r->shot.n >= 3) {
+        if (isfinite(r->gain)) say(s, CS(CAMERA_GAIN), r->shot.n, r->gain, r->shot_factor);
+        else say(s, CS(CAMERA_GAIN_NONE), r->shot.n);
+    }
     if (rc) {
         calc_say(c, CS(FAILED), err);
         return LM_FAIL;
@@ -518,6 +605,7 @@ static int run(cs *s, tp_run *r, rg_machine **m)
         if (q->planned && q->spot.status == CN_S_OK) continue;
         say(s, CS(REJECTED), k + 1, q->t.a / DEG, q->t.b / DEG, q->why);
     }
+    say_surface(s, r);
     if (r->tr)
         say(s, CS(CHECK), r->check_n, r->check_max * 1e3, r->check_tol * 1e3,
             r->check_max <= r->check_tol ? CS(CHECK_OK) : CS(CHECK_BAD));

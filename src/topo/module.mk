@@ -26,3 +26,20 @@ all: build/lib/lensmat-topo.so
 MODULE_TEST_BINS  += build/lib/lensmat-topo.so build/asan/lib/lensmat-topo.so
 MODULE_BENCH_BINS += build/lib/lensmat-topo.so
 -include $(TP_OBJ:.o=.d) $(TP_SOBJ:.o=.d)
+
+# tests/topo/t_*.c: the engines through their tables (cornea, rig; trace for the rig)
+TP_TESTS := $(wildcard tests/topo/t_*.c)
+TP_TBIN  := $(patsubst tests/topo/%.c,build/obj/topo_tests/%,$(TP_TESTS)) \
+            $(patsubst tests/topo/%.c,build/asan/topo_tests/%,$(TP_TESTS))
+build/obj/topo_tests/%: tests/topo/%.c build/lib/lensmat-cornea.so build/lib/lensmat-rig.so \
+                        build/lib/lensmat-trace.so src/cornea/cornea.h src/rig/rig.h tests/cornea/ct.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -Itests -o $@ $< build/lib/lensmat-cornea.so \
+	    build/lib/lensmat-rig.so build/lib/lensmat-trace.so -Wl,-rpath,$(abspath build/lib) -lm
+build/asan/topo_tests/%: tests/topo/%.c build/asan/lib/lensmat-cornea.so build/asan/lib/lensmat-rig.so \
+                         build/asan/lib/lensmat-trace.so src/cornea/cornea.h src/rig/rig.h tests/cornea/ct.h
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -Itests -o $@ $< build/asan/lib/lensmat-cornea.so \
+	    build/asan/lib/lensmat-rig.so build/asan/lib/lensmat-trace.so -Wl,-rpath,$(abspath build/asan/lib) -lm
+MODULE_TEST_BINS  += $(TP_TBIN)
+MODULE_BENCH_BINS += build/obj/topo_tests/t_topo

@@ -36,6 +36,9 @@ typedef struct tp_camera {
     double read_noise;          /* counts rms (50) */
 } tp_camera;
 
+typedef struct tp_shot { double s11, s12, s22, s1y, s2y; int n; } tp_shot;   /* photon
+                                   transfer: the normal equations' sums */
+
 typedef struct tp_point {
     rg_target t;
     int planned;                /* 1: solved and quantised (else why[] says) */
@@ -44,6 +47,8 @@ typedef struct tp_point {
     cn_spot spot;               /* the measurement (status CN_S_*) */
     double hit_u, hit_v;        /* the traced hit (mm, detector plane; NAN: none) */
     double x, y, snr;           /* frame: centroid (pixels) and SNR */
+    double amp, w, bg, noise;   /* frame: the spot's fitted peak, 1/e^2 radius and
+                                   background (counts, pixels), the frame's noise */
     int nspots;                 /* frame: spots detected */
     int seq;                    /* frame number (1, 2, ...: the planned points in scan
                                    order; 0: none) */
@@ -89,6 +94,7 @@ typedef struct tp_run {
     void *stop_ctx;
     /* fit */
     int model;
+    int max_iter;               /* per solve (0: the engine's 1000) */
     double check_tol;           /* mm: largest tracer/model difference accepted */
     /* results */
     tp_point *pt;               /* npoints */
@@ -97,6 +103,19 @@ typedef struct tp_run {
     int fitted;                 /* 1: res holds a fit */
     double check_max;           /* mm, largest |traced - model| over the fitted spots */
     int check_n;                /* spots traced in the check */
+    /* camera frames: their gain measured from the spots (photon transfer, tp_shot.c)
+       and the centroid sigmas widened for the shot noise it implies */
+    tp_shot shot;
+    /* the surface from the data (when zf is set: the caller's, large): a reference
+       sphere, the Zernike slope fit, the keratoconus indices */
+    cn_zfit *zf;
+    int have_z;                 /* 1: zf and kc hold a surface (else zwhy says why) */
+    char zwhy[256];
+    double zref_R;              /* the reference sphere's radius (mm) */
+    cn_kc kc;
+    double gain;                /* e-/count (NaN: not measured; INFINITY: no shot
+                                   noise seen) */
+    double shot_factor;         /* mean factor applied to the centroid sigmas (1) */
     tp_times tm;
 } tp_run;
 

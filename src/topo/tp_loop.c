@@ -98,7 +98,7 @@ static int traced_hit(const tp_run *r, const rg_geometry *gt, const cn_plane *pl
  * Gaussian fit; read_noise 0: measured from the frame.  off_sensor: the traced hit
  * lies outside the sensor (the reason given when no spot is found). */
 static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double read_noise,
-                   int off_sensor, tp_point *q)
+                   double gain, int off_sensor, tp_point *q)
 {
     const im_frame_api *F = r->im->frame;
     const double pitch = r->cam.pitch;
@@ -109,6 +109,7 @@ static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double
     memset(&o, 0, sizeof o);
     o.method = IM_CM_GAUSS;
     o.read_noise = read_noise;
+    o.gain = gain;                      /* shot noise in each pixel's variance */
     q->spot.u = q->spot.v = NAN;
     int rc = F->centroid(cz, f, &o, sp, 4, &res, e, sizeof e);
     q->nspots = rc ? 0 : res.ndetected;
@@ -123,6 +124,10 @@ static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double
     q->x = sp[0].x;
     q->y = sp[0].y;
     q->snr = sp[0].snr;
+    q->amp = sp[0].amp;
+    q->w = sp[0].w;
+    q->bg = sp[0].bg;
+    q->noise = res.noise;
     if (res.outcome == IM_FOUND_SEVERAL) {
         q->spot.status = CN_S_SEVERAL;
         snprintf(q->why, sizeof q->why, "several spots in the frame (%d)", res.ndetected);
@@ -167,6 +172,7 @@ static int frame_spot(const tp_run *r, im_centroider *cz, const cn_plane *pl, in
     s.gain = 1;
     s.bias = c->bias;
     s.read_noise = c->read_noise;
+    s.shot_noise = 1;                   /* photons arrive one by one: Poisson */
     s.wavelength = LAMBDA_M;
     /* the electrons that give `peak` counts at the centre of a Gaussian of 1/e^2
        radius w pixels: peak * pi w^2 / 2 */
@@ -198,7 +204,7 @@ static int frame_spot(const tp_run *r, im_centroider *cz, const cn_plane *pl, in
         }
     }
     if (hit)
-        locate(r, cz, f, c->read_noise / s.gain,
+        locate(r, cz, f, c->read_noise / s.gain, s.gain,
                fabs(q->hit_u) > 0.5 * c->width * c->pitch ||
                fabs(q->hit_v) > 0.5 * c->height * c->pitch, q);
     F->frame_free(f);
@@ -356,7 +362,7 @@ static int run_workers(job *j)
 
 /* The next frame of the camera (or video, or file sequence) for point q: its spot
  * located, the noise measured from the frame.  0, or -1 with why in err. */
-static int camera_read(const tp_run *r, im_source *src, im_centroider *cz, tp_point *q,
+static int camera_read(tp_run *r, im_source *src, im_centroider *cz, tp_point *q,
                        int got, char *err, size_t cap)
 {
     const im_frame_api *F = r->im->frame;
@@ -369,9 +375,81 @@ static int camera_read(const tp_run *r, im_source *src, im_centroider *cz, tp_po
         else snprintf(err, cap, "%s", e);
         return -1;
     }
-    locate(r, cz, f, 0, 0, q);
+    locate(r, cz, f, 0, 0, 0, q);
+    if (q->spot.status == CN_S_OK)          /* the gain is measured from the spots */
+        tp_shot_add(&r->shot, f, q->x, q->y, q->amp, q->w, q->bg, q->noise);
     F->frame_free(f);
     return 0;
+}
+
+/* Camera frames: the gain from the spots' photon transfer, and every located spot's
+ * sigma widened for the shot noise it implies (the centroider knew only the
+ * background's noise). */
+static void shot_widen(tp_run *r)
+{
+    r->gain = tp_shot_gain(&r->shot);
+    double sum = 0;
+    int m = 0;
+    for (int k = 0; k < r->npoints; k++) {
+        tp_point *q = &r->pt[k];
+        if (!q->planned || q->spot.status != CN_S_OK) continue;
+        double f = tp_shot_factor(q->amp, q->w, q->noise, r->gain);
+        q->spot.sigma *= f;
+        sum += f;
+        m++;
+    }
+    if (m) r->shot_factor = sum / m;
+}
+
+static int stopped(const tp_run *r);
+
+/* The surface from the data (issue 19): a reference sphere fitted to the measured
+ * spots (their statuses before the model's fit: a spot the model calls an outlier
+ * may be the cone), the Zernike slope fit in its frame, the keratoconus indices.  A
+ * failure here is said in r->zwhy and leaves r->have_z 0; only a stop is an error. */
+static int surface(tp_run *r, int m, const int *of, char *err, size_t cap)
+{
+    cn_spot *sp = malloc(sizeof *sp * (size_t)(m ? m : 1));
+    cn_result *ref = calloc(1, sizeof *ref);
+    char e[256];
+    int rc = 0;
+    r->have_z = 0;
+    r->zwhy[0] = 0;
+    if (!sp || !ref) { free(sp); free(ref); snprintf(err, cap, "out of memory"); return CN_ENOMEM; }
+    for (int i = 0; i < m; i++) sp[i] = r->pt[of[i]].spot;
+    /* the reference: the model's own fit when it holds (converged, not rejected: a
+       toric, tilted eye is better met by its biconic than by a sphere, which read R
+       8.52 for 7.8 there), else a sphere fitted for the purpose */
+    int ref_model = CN_SPHERE, frc = 0;
+    if (r->res.converged && !r->res.rejected_model && !r->res.poor) {
+        *ref = r->res;
+        ref_model = r->model;
+    } else {
+        cn_fit_opts fo = {.model = CN_SPHERE, .stop = r->stop, .stop_ctx = r->stop_ctx,
+                          .threads = r->threads, .max_iter = r->max_iter};
+        frc = r->cn->fit(r->g, sp, m, NULL, &fo, ref, e, sizeof e);
+    }
+    if (frc == CN_ESTOP) { snprintf(err, cap, "stopped"); rc = CN_ESTOP; goto out; }
+    if (frc || !ref->converged) {
+        snprintf(r->zwhy, sizeof r->zwhy, "no reference sphere: %.200s", frc ? e : "not converged");
+        goto out;
+    }
+    r->zref_R = ref->par.p[CN_R];
+    for (int i = 0; i < m; i++) sp[i] = r->pt[of[i]].spot;   /* statuses as measured */
+    if (r->cn->zfit(r->g, sp, m, &ref->par, ref_model, 0, r->zf, e, sizeof e)) {
+        snprintf(r->zwhy, sizeof r->zwhy, "%.250s", e);
+        goto out;
+    }
+    if (stopped(r)) { snprintf(err, cap, "stopped"); rc = CN_ESTOP; goto out; }
+    if (r->cn->kc(r->zf, &r->kc)) {
+        snprintf(r->zwhy, sizeof r->zwhy, "the indices could not be computed on the data's zone");
+        goto out;
+    }
+    r->have_z = 1;
+out:
+    free(sp);
+    free(ref);
+    return rc;
 }
 
 static int stopped(const tp_run *r) { return r->stop && r->stop(r->stop_ctx); }
@@ -384,6 +462,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
     rg_target *tg;
     memset(&r->tm, 0, sizeof r->tm);
     r->fitted = 0;
+    memset(&r->shot, 0, sizeof r->shot);
     r->check_max = NAN;
     r->check_n = 0;
     if (r->source == TP_SRC_FRAMES && (!r->im || !r->im->frame)) {
@@ -468,6 +547,9 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         if (camera_read(r, src, ccz, &r->pt[k], got++, err, cap)) { CAMERA_DONE(); return CN_EINVAL; }
     }
     CAMERA_DONE();
+    r->gain = NAN;
+    r->shot_factor = 1;
+    if (r->source == TP_SRC_CAMERA) shot_widen(r);
     for (int k = 0, seq = 0; k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
     r->tm.machine = now() - t;
     /* detect: the traced spot of each exposure, its frame and centroid */
@@ -500,8 +582,9 @@ int tp_measure(tp_run *r, char *err, size_t cap)
     for (int k = 0; k < n; k++)
         if (r->pt[k].planned) { sp[m] = r->pt[k].spot; of[m++] = k; }
     cn_fit_opts fo = {.model = r->model, .stop = r->stop, .stop_ctx = r->stop_ctx,
-                      .threads = r->threads};
+                      .threads = r->threads, .max_iter = r->max_iter};
     int rc = r->cn->fit(r->g, sp, m, NULL, &fo, &r->res, err, cap);
+    if (!rc && r->zf) rc = surface(r, m, of, err, cap);
     for (int i = 0; i < m; i++) {
         tp_point *q = &r->pt[of[i]];
         if (q->spot.status == CN_S_OK && sp[i].status == CN_S_OUTLIER)
