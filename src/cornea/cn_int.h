@@ -60,7 +60,6 @@ int cn_zterms(int order);
 int cn_zfit_run(const rg_geometry *g, const cn_spot *spots, int n, const cn_params *ref,
                 int ref_model, int max_order, cn_zfit *z, char *err, size_t errcap);
 int cn_zsag(const cn_zfit *z, double x, double y, double *f, double *fx, double *fy);
-int cn_zcurv(const cn_zfit *z, double x, double y, double *axial, double *tang);
 int cn_zcovered(const cn_zfit *z, double x, double y);
 void cn_zvertex(cn_zfit *z);
 void cn_zlocal_vertex(cn_zfit *z);

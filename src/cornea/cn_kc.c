@@ -18,7 +18,7 @@
 typedef struct kc_surf {
     const cn_zfit *z;           /* the reconstruction, or */
     cn_surf s;                  /* an analytic surface */
-    double g0x, g0y;            /* its slope at the origin (taken out, as cn_zcurv) */
+    double g0x, g0y;            /* its slope at the origin (taken out, as cn_zlocal) */
     double ox, oy;              /* the frame's origin about the rig's nominal apex */
 } kc_surf;
 

@@ -3,11 +3,11 @@
  * cornea (deflectometry: the normal halves the turn from the incoming to the
  * reflected direction), and the normals' slopes are fitted by the gradients of
  * Zernike polynomials over the data's disc (GSL weighted least squares, truncated
- * SVD), of the radial order with the lowest BIC.  The point where each beam meets
- * the cornea comes first from a reference sphere (the caller's fit), then from the
- * reconstructed surface itself; the height (piston), which slopes do not give, is
- * the reference's on average over the spots.  From the surface: its sag, slopes and
- * curvatures anywhere in the data (axial, tangential), masked maps, and the
+ * SVD), of the radial order with the lowest BIC, as the departure from a base
+ * sphere.  The point where each beam meets the cornea comes first from the caller's
+ * reference fit, then from the reconstructed surface itself; the height (piston),
+ * which slopes do not give, is the one whose reflections land where the spots are.
+ * The spots' slopes are kept for the local curvature fits, the masked maps and the
  * keratoconus indices (cn_kc.c). */
 #include <math.h>
 #include <stdio.h>
@@ -78,26 +78,7 @@ int cn_zsag(const cn_zfit *z, double x, double y, double *f, double *fx, double 
     return isfinite(*f) ? 0 : -1;
 }
 
-/* Axial and tangential curvature about the normal at the frame's origin: the slope
- * there (g0) taken out first, so a surface tilted at the origin (a cone's flank
- * crossing it) does not send the axial curvature to infinity at the centre. */
-int cn_zcurv(const cn_zfit *z, double x, double y, double *axial, double *tang)
-{
-    double r = hypot(x, y), ex = 1, ey = 0, f, ax, ay, bx, by, cx, cy;
-    const double h = 1e-3;                 /* mm: the slopes' difference step */
-    if (r > 0) { ex = x / r; ey = y / r; }
-    cn_zsag(z, x, y, &f, &ax, &ay);
-    cn_zsag(z, x + h * ex, y + h * ey, &f, &bx, &by);
-    cn_zsag(z, x - h * ex, y - h * ey, &f, &cx, &cy);
-    ax -= z->g0x;
-    ay -= z->g0y;
-    double zr = ax * ex + ay * ey, zrr = ((bx - cx) * ex + (by - cy) * ey) / (2 * h);
-    double q = 1 + ax * ax + ay * ay;
-    *tang = zrr / pow(1 + zr * zr, 1.5);
-    *axial = r > 1e-6 ? zr / (r * sqrt(q)) : *tang;
-    return isfinite(*axial) && isfinite(*tang) ? 0 : -1;
-}
-
+/* The Zernike surface's slope at the frame's origin (its vertex tilt). */
 void cn_zvertex(cn_zfit *z)
 {
     double f;
