@@ -187,7 +187,7 @@ cl_vm() {
     [ -x "$vm" ] || { echo "gpio-vm: $vm not found"; return 1; }
     mkdir -p "$CL/vmlibs"
     for l in $(ldd "$BIN" | grep -o '/[^ ]*libreadline[^ ]*'); do cp -L "$l" "$CL/vmlibs/"; done
-    (cd "$TOP" && GPIO_VM_FILES="tests/cornea/vm_scan.rig lensmat build/lib/lensmat-rig.so build/lib/lensmat-trace.so build/lib/lensmat-cornea.so $CL/vmlibs" \
+    (cd "$TOP" && GPIO_VM_FILES="tests/cornea/vm_scan.rig lensmat build/lib/lensmat-rig.so build/lib/lensmat-trace.so build/lib/lensmat-cornea.so build/lib/lensmat-topo.so $CL/vmlibs" \
         "$vm" tests/cornea/vm_scan.sh) > "$CL/vm.out" 2>&1
     rc=$?
     tr -d '\r' < "$CL/vm.out" | grep -E '^(PASS|FAIL)'

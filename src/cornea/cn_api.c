@@ -1,7 +1,12 @@
 /* cn_api.c -- the cornea engine's table: the one exported symbol, cornea_get_api. */
 #include "cn_int.h"
 
-static const char *version(void) { return "lensmat-cornea 2"; }
+static const char *version(void) { return "lensmat-cornea 3"; }
+
+static int zcurv(const cn_zfit *z, double x, double y, double *axial, double *tang)
+{
+    return cn_zlocal(z, x, y, axial, tang, NULL);
+}
 
 static const cornea_api api = {
     .abi = CORNEA_ABI,
@@ -21,6 +26,13 @@ static const cornea_api api = {
     .spot_xy = cn_spot_xy,
     .report_csv = cn_report_csv,
     .report_json = cn_report_json,
+    .zfit = cn_zfit_run,
+    .zsag = cn_zsag,
+    .zcurv = zcurv,
+    .zcovered = cn_zcovered,
+    .zmap = cn_zmap,
+    .kc = cn_kc_of,
+    .kc_model = cn_kc_model,
 };
 
 __attribute__((visibility("default"))) const cornea_api *cornea_get_api(int abi)

@@ -92,6 +92,9 @@ size_t cn_report_csv(const cn_result *r, const cn_spot *spots, int n, char *buf,
     for (int s = 1; s <= CN_S_MISS; s++) OUT("rejected_%s,%d,,\n", status_names[s], c[s]);
     OUT("iterations,%d,,\n", r->iterations);
     OUT("poor_fit,%d,,\n", r->poor);
+    OUT("converged,%d,,\n", r->converged);
+    OUT("model_rejected,%d,,\n", r->rejected_model);
+    OUT("sd_scale,%s,,\n", num(r->inflation, 0, a));
     for (int k = 0; k < CN_NPARAM; k++)
         OUT("param_%s,%s,%s,%s\n", cn_param_name(k), num(r->par.p[k], 0, a),
             r->free[k] ? num(sqrt(r->cov[k * (CN_NPARAM + 1)]), 0, b) : "fixed", units[k]);
@@ -142,8 +145,9 @@ size_t cn_report_json(const cn_result *r, const cn_spot *spots, int n, char *buf
                 status_names[spots[i].status], num(spots[i].nres, 1, a));
             first = 0;
         }
-    OUT("]},\n \"fit\": {\"iterations\": %d, \"poor\": %d, \"singular_values\": [",
-        r->iterations, r->poor);
+    OUT("]},\n \"fit\": {\"iterations\": %d, \"poor\": %d, \"converged\": %d, "
+        "\"model_rejected\": %d, \"sd_scale\": %s, \"singular_values\": [",
+        r->iterations, r->poor, r->converged, r->rejected_model, num(r->inflation, 1, a));
     for (int i = 0; i < r->nfree; i++) OUT("%s%s", i ? ", " : "", num(r->sv[i], 1, a));
     OUT("], \"undetermined\": [");
     first = 1;

@@ -55,6 +55,20 @@ size_t cn_report_csv(const cn_result *r, const cn_spot *spots, int n, char *buf,
 size_t cn_report_json(const cn_result *r, const cn_spot *spots, int n, char *buf,
                       size_t cap);
 
+/* cn_zern.c / cn_kc.c: the surface from the slopes, its maps and indices */
+int cn_zterms(int order);
+int cn_zfit_run(const rg_geometry *g, const cn_spot *spots, int n, const cn_params *ref,
+                int ref_model, int max_order, cn_zfit *z, char *err, size_t errcap);
+int cn_zsag(const cn_zfit *z, double x, double y, double *f, double *fx, double *fy);
+int cn_zcovered(const cn_zfit *z, double x, double y);
+void cn_zvertex(cn_zfit *z);
+void cn_zlocal_vertex(cn_zfit *z);
+int cn_zlocal(const cn_zfit *z, double x, double y, double *axial, double *tang,
+              double *sd_axial);
+int cn_zmap(int kind, const cn_zfit *z, double hmax, int n, double *grid, double *aux);
+int cn_kc_of(const cn_zfit *z, cn_kc *k);
+int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_r, cn_kc *k);
+
 /* cn_analyse.c: Jacobian, SVD, covariance, determinacy, clinical numbers */
 void cn_free_mask(int model, int fix_tilt, int free[CN_NPARAM]);
 double cn_limit(int k);   /* sd above which parameter k is "not determined" */

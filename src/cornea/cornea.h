@@ -24,7 +24,7 @@
 #include <stddef.h>
 #include "rig/rig.h"
 
-#define CORNEA_ABI 2
+#define CORNEA_ABI 3
 #define CORNEA_API_SYMBOL "cornea_get_api"
 
 enum { CN_OK = 0, CN_EINVAL = -1, CN_ENOMEM = -2, CN_EFIT = -3, CN_ESTOP = -4,
@@ -70,7 +70,7 @@ typedef struct cn_fit_opts {
                                       (0: at most 12; -1: none) */
     double rcond;                  /* singular value / largest below it: not
                                       determined (0: 1e-9) */
-    int max_iter;                  /* trust-region iterations (0: 100) */
+    int max_iter;                  /* trust-region iterations per solve (0: 1000) */
     int (*stop)(void *ctx); void *stop_ctx;   /* polled each iteration */
     int free_q;                    /* asphere: fit Q too (its s^4 term is A4's) */
     int threads;                   /* residuals and Jacobian on this many threads
@@ -125,7 +125,7 @@ typedef struct cn_result {
     double cond;                   /* sv[0] / sv[nfree-1] */
     unsigned undetermined;         /* bit CN_*: parameter not determined (a singular
                                       direction below rcond, or sd over its limit) */
-    char why[512];                 /* one line per undetermined parameter / direction */
+    char why[1024];                /* one line per undetermined parameter / direction */
     int poor;                      /* 1: chi^2 more than 4 sd above its dof (the
                                       weakest direction's parameters then marked) */
     double chi2_z;                 /* (chi^2 - dof) / sqrt(2 dof) */
@@ -135,6 +135,17 @@ typedef struct cn_result {
     double resid_corr;             /* residual map test: mean correlation of each
                                       spot's residual with its nearest neighbour's
                                       (noise ~0; a shape the model lacks ~1) */
+    /* --- ABI 3 --- */
+    int converged;                 /* 1: the final solve met a stopping test; 0: it
+                                      ran into max_iter (the numbers are where it
+                                      stopped, not a minimum: callers fail the run) */
+    int max_solve_iter;            /* most iterations of one solve (iterations counts
+                                      every solve: rejection rounds, restarts) */
+    int rejected_model;            /* 1: poor and systematic residuals: the model
+                                      lacks the surface's shape; every sd INFINITY,
+                                      the report gives none of its numbers */
+    double inflation;              /* poor, residuals uncorrelated: the sd are the
+                                      covariance's times this, sqrt(chi2/dof) (else 1) */
 } cn_result;
 
 typedef struct cn_predict {        /* accuracy of a rig and scan before building it */
@@ -176,6 +187,64 @@ enum cn_map_kind {
     CN_MAP_AXIAL,        /* axial (sagittal) curvature, D (n 1.3375) */
     CN_MAP_TANGENTIAL    /* tangential (meridional) curvature, D */
 };
+
+/* The surface from the data (cn_zern.c): Zernike polynomials (unnormalised,
+ * R_n^|m|(rho) cos m theta for m >= 0, sin |m| theta for m < 0, j = 0 piston,
+ * ordered n = 0.., m = -n, -n+2 .. n) over the disc of radius rho (the spots' largest
+ * distance from the reference's axis) in the eye frame of a reference sphere fit,
+ * fitted to the slopes the spots give (deflectometry), the radial order the lowest
+ * BIC's, for the departure from a base sphere (z below; mm, into the eye, as cn_sag). */
+#define CN_ZORDER 20
+#define CN_ZTERMS 231                  /* (CN_ZORDER + 1)(CN_ZORDER + 2) / 2 */
+#define CN_ZPTS 10000
+typedef struct cn_zfit {
+    cn_params ref;                 /* the reference fit's parameters: the eye frame */
+    int order, nterms;             /* chosen radial order; terms incl. piston */
+    double rho;                    /* the data's disc (mm) */
+    double c[CN_ZTERMS];           /* coefficients (mm) */
+    double cov[CN_ZTERMS * CN_ZTERMS];   /* their covariance (row, col j; piston 0) */
+    double bic[CN_ZORDER + 1];     /* BIC of each order tried (0: not tried) */
+    double chi2_dof;               /* of the chosen order's slope fit */
+    double det_chi2;               /* the spots' chi^2 on the detector for the surface */
+    int nused, npts;
+    double gap;                    /* a map point within gap (mm) of a spot is data */
+    double xy[2 * CN_ZPTS];        /* where the spots met the surface (eye frame) */
+    double sl[2 * CN_ZPTS];        /* the slopes each spot gives there (fx, fy) */
+    double wt[CN_ZPTS];            /* their weight, 1 / sigma_slope^2 */
+    double kr;                     /* the curvatures' local fit: kernel radius (mm) */
+    double l0x, l0y;               /* the local fit's slope at the origin (vertex) */
+    double R0;                     /* the base sphere (the reference's radius, mm): z =
+                                      R0 - sqrt(R0^2 - r^2) + sum c_j Z_j */
+    double g0x, g0y;               /* the slope at the frame's origin: curvatures are
+                                      taken about the normal there (the vertex) */
+} cn_zfit;
+
+/* Keratoconus indices from the reconstructed surface (cn_kc.c), each with its sd
+ * from the coefficients' covariance (Monte Carlo, 16 draws).  Axial (sagittal) power
+ * 337.5 kappa_axial D (n 1.3375); +y superior, so inferior is -y.  Definitions and
+ * thresholds: doc/topography.md (Rabinowitz-McDonnell, Rabinowitz-Rasheed). */
+enum { CN_KC_NORMAL, CN_KC_SUSPECT, CN_KC_KERATOCONUS };
+typedef struct cn_kc {
+    double zone_r;                 /* the data's radius (mm) */
+    double kmax, sd_kmax, kmax_x, kmax_y, sd_kmax_loc;   /* steepest axial power and
+                                      where (within 0.9 zone_r; x, y about the rig's
+                                      nominal apex: the instrument's axis) */
+    double ck, sd_ck;              /* central K: mean axial power on the rings of 2, 3
+                                      and 4 mm diameter the data cover */
+    int ck_rings;                  /* of those 3 rings, how many were covered */
+    double is, sd_is, is_r;        /* I-S: inferior - superior mean of 5 points each,
+                                      30 deg apart, at radius is_r (3 mm when the data
+                                      reach it, else 0.9 zone_r) */
+    double simk1, simk2, sd_simk, simk_axis;   /* the 3 mm ring: K1, K2 (D), steep
+                                      axis deg */
+    double ast, sd_ast;            /* K2 - K1 */
+    double srax, sd_srax;          /* skew of the steepest radial axes (deg) */
+    double kisa, sd_kisa;          /* K x I-S x AST x SRAX x 100 / 300 (%) */
+    int screen;                    /* CN_KC_*: the worst of the thresholds */
+    char why[512];
+} cn_kc;
+
+enum cn_zmap_kind { CN_ZMAP_ELEVATION, CN_ZMAP_AXIAL, CN_ZMAP_TANGENTIAL };
 
 typedef struct cornea_api {
     int abi;
@@ -240,6 +309,28 @@ typedef struct cornea_api {
                          size_t cap);
     size_t (*report_json)(const cn_result *r, const cn_spot *spots, int n, char *buf,
                           size_t cap);
+    /* --- ABI 3 --- */
+    /* The surface from the spots' slopes (statuses OK and OUTLIER used: an outlier
+     * of a global model is data here) in the frame of `ref`, a fit of ref_model
+     * (where each beam first meets the cornea; its mean R is the base sphere);
+     * max_order 0: CN_ZORDER.  z: caller's (large: allocate it). */
+    int (*zfit)(const rg_geometry *g, const cn_spot *spots, int n, const cn_params *ref,
+                int ref_model, int max_order, cn_zfit *z, char *err, size_t errcap);
+    /* Its sag and slopes; axial and tangential curvature (1/mm) at (x, y) mm. */
+    int (*zsag)(const cn_zfit *z, double x, double y, double *f, double *fx, double *fy);
+    int (*zcurv)(const cn_zfit *z, double x, double y, double *axial, double *tang);
+    /* 1 when (x, y) lies within the data (a spot within z->gap), else 0. */
+    int (*zcovered)(const cn_zfit *z, double x, double y);
+    /* A map (enum cn_zmap_kind) on n x n over [-hmax, hmax]^2 as cornea_api.map
+     * (row 0 at +y), NaN where there are no data; elevation against the surface's
+     * best-fit sphere (um, radius in *aux), curvatures in D (n 1.3375). */
+    int (*zmap)(int kind, const cn_zfit *z, double hmax, int n, double *grid, double *aux);
+    /* The keratoconus indices and screen. */
+    int (*kc)(const cn_zfit *z, cn_kc *k);
+    /* The same indices of an analytic surface (model, p, bump; the truth in tests and
+     * benchmarks), without sd, in the eye frame of p. */
+    int (*kc_model)(int model, const cn_params *p, const cn_bump *bump, double zone_r,
+                    cn_kc *k);
 } cornea_api;
 
 typedef const cornea_api *(*cornea_get_api_fn)(int abi);

@@ -20,7 +20,8 @@
 #endif
 
 const char *const cs_out_suffix[] = {".txt", ".csv", ".json", "-elevation.png", "-axial.png",
-                                     "-tangential.png", "-residual.png", NULL};
+                                     "-tangential.png", "-residual.png", "-axial-abs.png",
+                                     NULL};
 
 int cs_check_name(void *io, const char *word, char *msg, size_t cap)
 {
@@ -94,7 +95,8 @@ out:
 static const double dsteps[] = {0.25, 0.5, 1.0, 1.5, 2.0, 2.5, 5.0, 10.0};
 
 int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
-                  const cn_result *r, const cn_spot *sp, int n,
+                  const cn_result *r, const cn_spot *sp, int n, const cn_zfit *zf,
+                  const cn_kc *kc,
                   int (*stop)(void *), void (*say)(void *ctx, const char *line),
                   void *ctx, char *msg, size_t cap)
 {
@@ -106,7 +108,7 @@ int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
         return -1;
     }
     enum { N = 201 };
-    double hmax = r->hmax > 0 ? r->hmax : 1.5;
+    double hmax = zf ? zf->rho : r->hmax > 0 ? r->hmax : 1.5;
     double *grid = malloc(sizeof *grid * N * N);
     double *xy = malloc(sizeof *xy * 2 * (size_t)(n > 0 ? n : 1));
     double *pv = malloc(sizeof *pv * (size_t)(n > 0 ? n : 1));
@@ -117,11 +119,19 @@ int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
     if (!grid || !xy || !pv || !px || !py || !mk) { snprintf(msg, cap, "out of memory"); rc = -1; goto out; }
     static const char *const title[] = {"Elevation against the best-fit sphere",
                                         "Axial curvature", "Tangential curvature",
-                                        "Residuals of the fit (|r| / sigma)"};
+                                        "Residuals of the fit (|r| / sigma)",
+                                        "Axial curvature, absolute scale"};
     static const char *const file[] = {"-elevation.png", "-axial.png", "-tangential.png",
-                                       "-residual.png"};
-    for (int kind = 0; kind < 4 && !rc; kind++) {
-        char path[1100], note[200], line[1400];
+                                       "-residual.png", "-axial-abs.png"};
+    /* the pictures' marks: the instrument's view, superior up (the eye, OD or OS, is
+       not asked: both readings of x are named); Sim K and Kmax of the data */
+    char marks[200] = "";
+    if (zf && kc)
+        snprintf(marks, sizeof marks, "; Sim K %.2f / %.2f D @ %.0f, Kmax %.2f D at "
+                 "(%.2f, %.2f) mm", kc->simk1, kc->simk2, kc->simk_axis, kc->kmax,
+                 kc->kmax_x, kc->kmax_y);
+    for (int kind = 0; kind < (zf ? 5 : 4) && !rc; kind++) {
+        char path[1100], note[480], line[1400];
         double aux = NAN;
         im_map m = {0};
         m.nx = m.ny = N;
@@ -130,15 +140,47 @@ int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
         m.xmax = m.ymax = hmax;
         m.disc = hmax;
         m.title = title[kind];
-        if (kind < 3) {
+        if (zf) {
+            m.xlabel = "x (mm), examiner's view: OD nasal to the right, OS nasal to the left";
+            m.ylabel = "y (mm), superior up";
+        }
+        if (zf && kind != 3) {
+            int zk = kind == 4 ? CN_ZMAP_AXIAL : kind;
+            if (cn->zmap(zk, zf, hmax, N, grid, &aux)) {
+                snprintf(msg, cap, "%.200s: the surface has no value there", title[kind]);
+                rc = -1;
+                break;
+            }
+        } else if (kind < 3) {
             if (cn->map(kind, r->model, &r->par, NULL, hmax, N, grid, &aux)) {
-                snprintf(msg, cap, "%s: the surface has no value there", title[kind]);
+                snprintf(msg, cap, "%.200s: the surface has no value there", title[kind]);
                 rc = -1;
                 break;
             }
         } else
             for (int k = 0; k < N * N; k++) grid[k] = NAN;
-        if (kind == CN_MAP_ELEVATION) {
+        if (zf && kind == CN_MAP_ELEVATION) {
+            m.unit = "um";
+            m.symmetric = 1;
+            snprintf(note, sizeof note, "from the slopes (Zernike order %d); best-fit sphere "
+                     "R %.4f mm; + toward the observer%s", zf->order, aux, marks);
+        } else if (zf && (kind == 1 || kind == 2)) {
+            m.unit = "D";
+            m.steps = dsteps;
+            m.nsteps = (int)(sizeof dsteps / sizeof *dsteps);
+            snprintf(note, sizeof note, "n 1.3375; from the slopes, where there are data "
+                     "(to %.2f mm), normalised scale%s", hmax, marks);
+        } else if (kind == 4) {
+            /* the absolute scale: 28 to 65.5 D in 1.5 D steps (Smolek, Klyce and
+               Hovis's universal standard scale; doc/topography.md), the same colours
+               for every eye */
+            m.unit = "D";
+            m.step = 1.5;
+            m.lo = 28;
+            m.hi = 65.5;
+            snprintf(note, sizeof note, "n 1.3375; absolute scale 28-65.5 D in 1.5 D steps%s",
+                     marks);
+        } else if (kind == CN_MAP_ELEVATION) {
             m.unit = "um";
             m.symmetric = 1;
             snprintf(note, sizeof note, "best-fit sphere R %.4f mm; + toward the observer; "

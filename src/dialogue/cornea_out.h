@@ -14,7 +14,8 @@
 typedef struct cs_row { const char *name; double v, sd; const char *unit; } cs_row;
 
 /* The files a report NAME makes: NAME.txt NAME.csv NAME.json NAME-elevation.png
- * NAME-axial.png NAME-tangential.png NAME-residual.png (NULL-terminated suffixes). */
+ * NAME-axial.png NAME-tangential.png NAME-residual.png NAME-axial-abs.png
+ * (NULL-terminated suffixes). */
 extern const char *const cs_out_suffix[];
 /* lm_ask_word's check for the report's name: "-" (none), or a name none of whose
  * files (or their .part) is an input of this session, in a writable folder. */
@@ -27,10 +28,13 @@ int cs_check_name(void *io, const char *word, char *msg, size_t cap);
 int cs_write_report(const cornea_api *cn, const char *name, const char *text, size_t len,
                     const cn_result *r, const cn_spot *sp, int n, const cs_row *rows,
                     int nrows, char *msg, size_t cap);
-/* The four maps of the fit.  say(ctx, line) is told each map's scale and file.
- * 0, or -1 with why in msg (a stop: no file under its final name). */
+/* The maps.  zf (NULL: the fitted model's surface): the surface from the data, drawn
+ * only where there are data, with its indices kc on the pictures, and the axial map
+ * a second time on the absolute scale.  say(ctx, line) is told each map's scale and
+ * file.  0, or -1 with why in msg (a stop: no file under its final name). */
 int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
-                  const cn_result *r, const cn_spot *sp, int n,
+                  const cn_result *r, const cn_spot *sp, int n, const cn_zfit *zf,
+                  const cn_kc *kc,
                   int (*stop)(void *), void (*say)(void *ctx, const char *line),
                   void *ctx, char *msg, size_t cap);
 /* The manifest of one scan's frames: PATTERN with its %d made "-frames" and its

@@ -8,9 +8,10 @@
  * is printed, recorded and (optionally) written under a name: Sim K (apex and 3 mm
  * zone), radii, Q, pose, singular values, what is not determined, the spots rejected
  * and why, as NAME.txt, NAME.csv and NAME.json, with the four maps when asked
- * (cornea_out.c).  The eye may carry a keratoconus-like cone.  The loop itself is
- * cornea_loop.c; texts in prompts/cornea_scan.txt.  The rig, cornea and trace engines
- * are loaded here; the imaging engine only when frames or maps are used. */
+ * (cornea_out.c).  The eye may carry a keratoconus-like cone.  The measurement itself
+ * is the topography pipeline (src/topo, lensmat-topo.so); texts in
+ * prompts/cornea_scan.txt.  The rig, cornea, trace and topo engines are loaded here;
+ * the imaging engine only when frames or maps are used. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -20,11 +21,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 #include "calcio.h"
-#include "cornea_loop.h"
 #include "cornea_out.h"
 #include "dialogues.h"
 #include "engine.h"
 #include "../imaging/imaging.h"
+#include "../topo/topo.h"
 #include "../trace/trace.h"
 #include "prompts_cornea_scan.h"
 
@@ -55,10 +56,13 @@ static int stop_cb(void *ctx) { (void)ctx; return lm_stop_requested() != 0; }
 typedef struct cs {
     calc cc;
     const rig_api *rg;
+    const topo_api *tp;
     rg_rig rig;
     int have_rig;
     char rigname[WORD], log[WORD], report[WORD], camera[WORD], save[WORD];
     char *text;                 /* the report as said, for NAME.txt */
+    cn_kc kt;                   /* the true surface's indices (tk 1) */
+    int tk;
     size_t len, cap;
 } cs;
 
@@ -190,10 +194,20 @@ static double check_tol_um(void)
     return e && *e ? strtod(e, NULL) : CHECK_TOL_UM;
 }
 
+/* The fit's iteration cap per solve: LENSMAT_CORNEA_MAX_ITER overrides the engine's
+ * 1000 (tests make a fit stop at its cap). */
+static int max_iter_env(void)
+{
+    const char *e = getenv("LENSMAT_CORNEA_MAX_ITER");
+    long n = e && *e ? strtol(e, NULL, 10) : 0;
+    return n > 0 && n < 1000000 ? (int)n : 0;
+}
+
 /* ---- the dialogue ----------------------------------------------------------------- */
 
-static int run(cs *s, cl_run *r, rg_machine **m);
-static int scan_end(cs *s, const cl_run *r, int rc);
+static int run(cs *s, tp_run *r, rg_machine **m);
+static int scan_end(cs *s, const tp_run *r, int rc);
+static void say_surface(cs *s, tp_run *r);
 
 /* What the report adds beside the engine's numbers: the scan's settings and, for a
  * synthetic eye, its truth and the errors. */
@@ -208,7 +222,7 @@ static void say_line(void *ctx, const char *line) { say(ctx, CS(LINE), line); }
 
 /* The maps (when asked: their lines join the report) and the report under s->report,
  * from the fitted spots of the run whatever their source (frames, model, camera). */
-static int cs_files(cs *s, const cl_run *r, int maps, const cs_truth *tr)
+static int cs_files(cs *s, const tp_run *r, int maps, const cs_truth *tr)
 {
     const cornea_api *cn = r->cn;
     const cn_clinical *k = &r->res.k;
@@ -248,13 +262,37 @@ static int cs_files(cs *s, const cl_run *r, int maps, const cs_truth *tr)
     };
     /* a camera's eye is unknown: the scan's settings only */
     int nrows = r->have_truth ? (int)(sizeof rows / sizeof *rows) : 7;
-    if (maps && cs_write_maps(cn, r->g, s->report, &r->res, sp, n, stop_cb, say_line, s, msg,
-                              sizeof msg)) {
+    /* the surface from the data: its indices, and the true surface's */
+    const cn_kc *k2 = &r->kc;
+    const cn_kc kt = s->kt;
+    int tk = s->tk;
+    const cs_row zrows[] = {
+        {"topo_order", r->have_z ? r->zf->order : NAN, NAN, ""},
+        {"topo_chi2_dof", r->have_z ? r->zf->chi2_dof : NAN, NAN, ""},
+        {"topo_zone_r", r->have_z ? r->zf->rho : NAN, NAN, "mm"},
+        {"kmax", k2->kmax, k2->sd_kmax, "D"}, {"kmax_x", k2->kmax_x, k2->sd_kmax_loc, "mm"},
+        {"kmax_y", k2->kmax_y, k2->sd_kmax_loc, "mm"}, {"central_K", k2->ck, k2->sd_ck, "D"},
+        {"I_S", k2->is, k2->sd_is, "D"}, {"I_S_r", k2->is_r, NAN, "mm"},
+        {"simk1", k2->simk1, k2->sd_simk, "D"}, {"simk2", k2->simk2, k2->sd_simk, "D"},
+        {"AST", k2->ast, k2->sd_ast, "D"}, {"SRAX", k2->srax, k2->sd_srax, "deg"},
+        {"KISA", k2->kisa, k2->sd_kisa, "%"}, {"kc_screen", k2->screen, NAN, ""},
+        {"true_kmax", tk ? kt.kmax : NAN, NAN, "D"}, {"true_kmax_x", tk ? kt.kmax_x : NAN, NAN, "mm"},
+        {"true_kmax_y", tk ? kt.kmax_y : NAN, NAN, "mm"}, {"true_central_K", tk ? kt.ck : NAN, NAN, "D"},
+        {"true_I_S", tk ? kt.is : NAN, NAN, "D"}, {"true_SRAX", tk ? kt.srax : NAN, NAN, "deg"},
+        {"true_KISA", tk ? kt.kisa : NAN, NAN, "%"},
+    };
+    int nz = !r->have_z ? 0 : tk ? (int)(sizeof zrows / sizeof *zrows) : 15;
+    cs_row *all = malloc(sizeof *all * (size_t)(nrows + nz));
+    if (!all) { free(sp); return calc_fail(&s->cc, CS(NO_MEMORY)); }
+    memcpy(all, rows, sizeof *all * (size_t)nrows);
+    memcpy(all + nrows, zrows, sizeof *all * (size_t)nz);
+    if (maps && cs_write_maps(cn, r->g, s->report, &r->res, sp, n, r->have_z ? r->zf : NULL,
+                              &r->kc, stop_cb, say_line, s, msg, sizeof msg)) {
         rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
         fprintf(stderr, "lensmat: ");
         fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
-    } else if (cs_write_report(cn, s->report, s->text, s->len, &r->res, sp, n, rows, nrows,
-                               msg, sizeof msg)) {
+    } else if (cs_write_report(cn, s->report, s->text, s->len, &r->res, sp, n, all,
+                               nrows + nz, msg, sizeof msg)) {
         rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
         fprintf(stderr, "lensmat: ");
         fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
@@ -263,6 +301,7 @@ static int cs_files(cs *s, const cl_run *r, int maps, const cs_truth *tr)
         lm_escape(s->report, shown, sizeof shown);
         lm_say(s->cc.io, LM_OUT, CS(REPORT_WRITTEN), shown, shown, shown);
     }
+    free(all);
     free(sp);
     return rc;
 }
@@ -274,7 +313,7 @@ int lm_cornea_scan(lm_io *io)
     static const char *const patterns[] = {"spiral", "rings", "grid", NULL};
     static const char *const sources[] = {"frames", "model", "camera", NULL};
     cs *s = calloc(1, sizeof *s);
-    cl_run *r = calloc(1, sizeof *r);
+    tp_run *r = calloc(1, sizeof *r);
     rg_machine *m = NULL;
     int rc = LM_FAIL;
     if (!s || !r) { free(s); free(r); fprintf(stderr, "lensmat: out of memory\n"); return LM_FAIL; }
@@ -282,12 +321,16 @@ int lm_cornea_scan(lm_io *io)
     calc *c = &s->cc;
     rig_get_api_fn rget;
     cornea_get_api_fn cget;
+    topo_get_api_fn pget;
     *(void **)&rget = lm_engine_symbol("rig", RIG_API_SYMBOL);
     *(void **)&cget = lm_engine_symbol("cornea", CORNEA_API_SYMBOL);
+    *(void **)&pget = lm_engine_symbol("topo", TOPO_API_SYMBOL);
     const rig_api *rg = rget ? rget(RIG_ABI) : NULL;
     const cornea_api *cn = cget ? cget(CORNEA_ABI) : NULL;
-    if (!rg || !cn) { rc = calc_fail(c, CS(NO_ENGINE)); goto out; }
+    const topo_api *tp = pget ? pget(TOPO_ABI) : NULL;
+    if (!rg || !cn || !tp) { rc = calc_fail(c, CS(NO_ENGINE)); goto out; }
     s->rg = rg;
+    s->tp = tp;
     int model, chip = 0, pattern, source;
     double np, zone, R = 7.8, Q = 0, cyl = 0, axis = 0, dx = 0, dy = 0, tx = 0, ty = 0,
            noise = 0, pitch, seed = 0, w = 0, h = 0, ms = 0;
@@ -310,11 +353,11 @@ int lm_cornea_scan(lm_io *io)
         (rc = ranged(c, CS(ZONE), CS(ZONE_WHAT), CS(ZONE_RANGE), 0.5, 12, 0, &zone)) ||
         (rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source)))
         goto out;
-    if (source == CL_SRC_CAMERA &&
+    if (source == TP_SRC_CAMERA &&
         (rc = lm_ask_file(io, CS(CAMERA), CS(CAMERA), CS(CAMERA_WHAT), NULL, NULL, s->camera,
                           sizeof s->camera)))
         goto out;
-    if (source != CL_SRC_CAMERA &&      /* a real eye is what the camera sees */
+    if (source != TP_SRC_CAMERA &&      /* a real eye is what the camera sees */
         ((rc = ranged(c, CS(R), CS(R_WHAT), CS(R_RANGE), 5, 12, 0, &R)) ||
         (rc = ranged(c, CS(Q), CS(Q_WHAT), CS(Q_RANGE), -1, 1, 0, &Q)) ||
         (rc = ranged(c, CS(CYL), CS(CYL_WHAT), CS(CYL_RANGE), 0, 8, 0, &cyl)) ||
@@ -324,19 +367,19 @@ int lm_cornea_scan(lm_io *io)
         (rc = ranged(c, CS(TX), CS(TX_WHAT), CS(TILT_RANGE), -10, 10, 0, &tx)) ||
         (rc = ranged(c, CS(TY), CS(TY_WHAT), CS(TILT_RANGE), -10, 10, 0, &ty))))
         goto out;
-    if (source == CL_SRC_MODEL &&
+    if (source == TP_SRC_MODEL &&
         (rc = ranged(c, CS(NOISE), CS(NOISE_WHAT), CS(NOISE_RANGE), 0, 10, 0, &noise)))
         goto out;
     if ((rc = ranged(c, CS(PITCH), CS(PITCH_WHAT), CS(PITCH_RANGE), 0.1, 100, 0, &pitch)))
         goto out;
-    if (source == CL_SRC_FRAMES &&
+    if (source == TP_SRC_FRAMES &&
         ((rc = ranged(c, CS(WIDTH), CS(WIDTH_WHAT), CS(PX_RANGE), 16, 4096, 1, &w)) ||
          (rc = ranged(c, CS(HEIGHT), CS(HEIGHT_WHAT), CS(PX_RANGE), 16, 4096, 1, &h)) ||
          (rc = lm_ask_file(io, CS(SAVE), CS(SAVE), CS(SAVE_WHAT), check_save, s, s->save,
                            sizeof s->save))))
         goto out;
     cn_bump cone = {0, 0, 0, 0};       /* a cone on the synthetic eye (not a camera's) */
-    if (source != CL_SRC_CAMERA &&
+    if (source != TP_SRC_CAMERA &&
         ((rc = ranged(c, CS(SEED), CS(SEED_WHAT), CS(SEED_RANGE), 0, 1e15, 1, &seed)) ||
          (rc = ranged(c, CS(CONE), CS(CONE_WHAT), CS(CONE_RANGE), 0, 50, 0, &cone.h))))
         goto out;
@@ -372,29 +415,31 @@ int lm_cornea_scan(lm_io *io)
     r->cn = cn;
     r->g = &g;
     r->truth = eye;
-    r->have_truth = source != CL_SRC_CAMERA;
+    r->have_truth = source != TP_SRC_CAMERA;
     cn_params t;                       /* the true eye as the engine's parameters */
     cn->params_from_cornea(&eye, g.cornea.trans, tx * DEG, ty * DEG, &t);
     if (cone.h > 0) {
         r->bump = &cone;
         r->truth_p = t;
     }
-    r->camera = source == CL_SRC_CAMERA ? s->camera : NULL;
-    r->save = source == CL_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
+    r->camera = source == TP_SRC_CAMERA ? s->camera : NULL;
+    r->save = source == TP_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
     r->pattern = pattern;
     r->npoints = (int)np;
     r->zone = zone * DEG;
     r->source = source;
     r->sigma = noise * pitch * 1e-3;
-    r->cam = (cl_camera){(int)w, (int)h, pitch * 1e-3, 3, 1000, 100, 50};
+    r->cam = (tp_camera){(int)w, (int)h, pitch * 1e-3, 3, 1000, 100, 50};
     r->seed = (uint64_t)seed;
     r->threads = threads_wanted();
     r->expose_ms = ms;
     r->stop = stop_cb;
     r->model = model;
     r->check_tol = check_tol_um() * 1e-3;
+    r->max_iter = max_iter_env();
     r->rig = &s->rig;
-    if (!(r->pt = calloc((size_t)r->npoints, sizeof *r->pt))) {
+    if (!(r->zf = calloc(1, sizeof *r->zf)) ||
+        !(r->pt = calloc((size_t)r->npoints, sizeof *r->pt))) {
         rc = calc_fail(c, CS(NO_MEMORY));
         goto out;
     }
@@ -406,12 +451,12 @@ int lm_cornea_scan(lm_io *io)
         r->tr = tget ? tget(TRACE_ABI) : NULL;
         if (!r->tr) say(s, "%s", CS(NO_TRACER));
     }
-    if (source != CL_SRC_MODEL) {
+    if (source != TP_SRC_MODEL) {
         imaging_get_api_fn iget =
             (imaging_get_api_fn)lm_engine_symbol("imaging", IMAGING_API_SYMBOL);
         r->im = iget ? iget(IMAGING_ABI) : NULL;
         if (!r->im || !r->im->frame) { rc = calc_fail(c, CS(NO_IMAGING)); goto out; }
-        if (source == CL_SRC_CAMERA)
+        if (source == TP_SRC_CAMERA)
             say(s, CS(CAMERA_ON), s->camera, pitch);
         else
             say(s, CS(FRAMES_ON), r->cam.width, r->cam.height, pitch, r->cam.spot_w,
@@ -447,7 +492,18 @@ int lm_cornea_scan(lm_io *io)
                       ? remainder(r->res.k.K1_axis - fmod(axis + 360, 180), 180.0) : 0.0;
     if (rc == LM_GO && r->have_truth) {
         say(s, CS(TRUTH), eye.R, eye.R2, km, cyl);
-        say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km, axis_err);
+        s->tk = r->have_z &&
+                !cn->kc_model(CN_BICONIC, &t, cone.h > 0 ? &cone : NULL, r->zf->rho, &s->kt);
+        if (s->tk)
+            say(s, CS(TOPO_TRUTH), s->kt.kmax, s->kt.kmax_x, s->kt.kmax_y, s->kt.ck, s->kt.is,
+                s->kt.srax, s->kt.kisa);
+        if (!r->res.rejected_model && r->res.converged)   /* else no numbers to compare */
+            say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km, axis_err);
+    }
+    if (rc == LM_GO && r->fitted && !r->res.converged) {
+        fprintf(stderr, "lensmat: ");
+        fprintf(stderr, CS(NOT_CONVERGED), r->res.iterations);
+        rc = LM_FAIL;
     }
     if (rc == LM_GO) {
         if (r->check_max > r->check_tol) {
@@ -472,6 +528,7 @@ out:
     if (m) rg->close(m);
     if (hook_api) { lm_on_stop_remove(laser_off_hook, NULL); hook_api = NULL; }
     free(r->pt);
+    free(r->zf);
     free(r);
     free(s->text);
     free(s);
@@ -481,7 +538,7 @@ out:
 /* After the loop: an interruption says where it stopped (stdout, the record and
  * stderr); saved frames get their manifest, so that frames an earlier scan left under
  * the same pattern are never taken for this one's.  rc, or LM_FAIL. */
-static int scan_end(cs *s, const cl_run *r, int rc)
+static int scan_end(cs *s, const tp_run *r, int rc)
 {
     int sig = lm_stop_requested(), nm = 0, ns = 0;
     int *seq = r->save ? malloc(sizeof *seq * (size_t)(r->npoints ? r->npoints : 1)) : NULL;
@@ -510,17 +567,49 @@ static int scan_end(cs *s, const cl_run *r, int rc)
     return rc;
 }
 
+/* The surface from the data and the keratoconus indices; sd scaled by the root of
+ * the slope fit's chi2/dof when that is above 1.5. */
+static void say_surface(cs *s, tp_run *r)
+{
+    if (!r->have_z) { say(s, CS(TOPO_NONE), r->zwhy[0] ? r->zwhy : "no fit"); return; }
+    const cn_zfit *z = r->zf;
+    cn_kc *k = &r->kc;
+    say(s, CS(TOPO_SURFACE), z->order, z->nused, z->chi2_dof, z->rho, r->zref_R);
+    if (z->chi2_dof > 4) {      /* it does not follow its own data: no index of it */
+        say(s, CS(TOPO_UNFIT), z->chi2_dof);
+        r->have_z = 0;
+        return;
+    }
+    if (z->chi2_dof > 1.5) {
+        double f = sqrt(z->chi2_dof);
+        say(s, CS(TOPO_POOR), z->chi2_dof, f);
+        k->sd_kmax *= f; k->sd_kmax_loc *= f; k->sd_ck *= f; k->sd_is *= f;
+        k->sd_simk *= f; k->sd_ast *= f; k->sd_srax *= f; k->sd_kisa *= f;
+    }
+    say(s, CS(TOPO_KMAX), k->kmax, k->sd_kmax, k->kmax_x, k->kmax_y, k->sd_kmax_loc);
+    say(s, CS(TOPO_CK), k->ck, k->sd_ck, k->ck_rings, k->simk1, k->simk2, k->simk_axis,
+        fmin(1.5, 0.9 * k->zone_r), k->ast, k->sd_ast);
+    say(s, CS(TOPO_IS), k->is, k->sd_is, k->is_r, k->is_r < 3 ? CS(TOPO_IS_SHORT) : "",
+        k->srax, k->sd_srax, k->kisa, k->sd_kisa);
+    if (k->screen == CN_KC_KERATOCONUS)
+        say(s, CS(TOPO_SCREEN_KC), k->why, k->kmax_x, k->kmax_y);
+    else if (k->screen == CN_KC_SUSPECT)
+        say(s, CS(TOPO_SCREEN_SUSPECT), k->why, k->kmax_x, k->kmax_y);
+    else
+        say(s, "%s", CS(TOPO_SCREEN_NORMAL));
+}
+
 /* The measurement and its report. */
-static int run(cs *s, cl_run *r, rg_machine **m)
+static int run(cs *s, tp_run *r, rg_machine **m)
 {
     static const char *const pname[] = {"spiral", "rings", "grid"};
     calc *c = &s->cc;
     const cornea_api *cn = r->cn;
     char err[256];
     static char buf[8192];
-    int rc = cl_measure(r, err, sizeof err);
+    int rc = s->tp->measure(r, err, sizeof err);
     int counts[6];
-    cl_counts(r, counts);
+    s->tp->counts(r, counts);
     if (rc == CN_ESTOP || lm_stop_requested()) return LM_FAIL;
     if (rc == CN_EINVAL || rc == CN_ENOMEM) {   /* the machine, the camera or saving */
         if (*m) { r->rg->close(*m); *m = NULL; }
@@ -533,8 +622,12 @@ static int run(cs *s, cl_run *r, rg_machine **m)
     int sn = 0;
     for (int k = 0; k < r->npoints; k++)
         if (r->pt[k].planned && isfinite(r->pt[k].spot.u)) { ssum += r->pt[k].spot.sigma; sn++; }
-    say(s, CS(SCANNED), r->nplanned, sn, (r->source == CL_SRC_MODEL || !sn ? r->sigma
+    say(s, CS(SCANNED), r->nplanned, sn, (r->source == TP_SRC_MODEL || !sn ? r->sigma
                                            : ssum / sn) * 1e3);
+    if (r->source == TP_SRC_CAMERA && r->shot.n >= 3) {
+        if (isfinite(r->gain)) say(s, CS(CAMERA_GAIN), r->shot.n, r->gain, r->shot_factor);
+        else say(s, CS(CAMERA_GAIN_NONE), r->shot.n);
+    }
     if (rc) {
         calc_say(c, CS(FAILED), err);
         return LM_FAIL;
@@ -551,10 +644,11 @@ static int run(cs *s, cl_run *r, rg_machine **m)
         counts[CN_S_NONE], counts[CN_S_SEVERAL], counts[CN_S_OUTLIER], counts[CN_S_MISS],
         counts[5]);
     for (int k = 0; k < r->npoints; k++) {
-        const cl_point *q = &r->pt[k];
+        const tp_point *q = &r->pt[k];
         if (q->planned && q->spot.status == CN_S_OK) continue;
         say(s, CS(REJECTED), k + 1, q->t.a / DEG, q->t.b / DEG, q->why);
     }
+    say_surface(s, r);
     if (r->tr)
         say(s, CS(CHECK), r->check_n, r->check_max * 1e3, r->check_tol * 1e3,
             r->check_max <= r->check_tol ? CS(CHECK_OK) : CS(CHECK_BAD));

@@ -1,6 +1,6 @@
 #!/bin/sh
 # vm_scan.sh -- lensmat --cornea-scan on the gpio-sim chip, inside the gpio-vm guest
-# (tests/t_91_cornea_loop.sh copies lensmat, the rig, trace and cornea modules and
+# (tests/t_91_cornea_loop.sh copies lensmat, the rig, trace, cornea and topo modules and
 # tests/cornea/vm_scan.rig into /data): a 10-point scan moved and exposed on the real
 # kernel chip, fitted, the laser line low afterwards, and its grep'd record replaying
 # to the same record.  Prints PASS/FAIL lines; exit 0 or 1.

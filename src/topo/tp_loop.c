@@ -1,4 +1,4 @@
-/* cornea_loop.c -- the measurement loop of --cornea-scan: plan (rig engine: solve and
+/* tp_loop.c -- the topography pipeline's measurement loop: plan (rig engine: solve and
  * quantise every target of the pattern), run (the machine: move, expose; optional),
  * detect (the trace engine's hit through the true eye, a full synthetic frame from the
  * imaging engine and its centroid fit, or the quick model: the hit plus Gaussian
@@ -13,13 +13,12 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
-#include "cornea_loop.h"
-#include "../common/lm_rand.h"
-#include "../imaging/imaging.h"
-#include "../trace/trace.h"
+#include "tp_int.h"
+#include "common/lm_rand.h"
+#include "imaging/imaging.h"
+#include "trace/trace.h"
 
 #define PI 3.14159265358979323846
-#define GOLDEN 2.399963229728653        /* the golden angle, rad */
 #define PLANCK_HC 1.98644586e-25        /* h c, J m */
 #define LAMBDA_M 633e-9
 
@@ -37,83 +36,6 @@ static double cpu_now(void)
     struct timespec t;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return t.tv_sec + 1e-9 * t.tv_nsec;
-}
-
-/* ---- the scan pattern ------------------------------------------------------------ */
-
-static int by_radius(const void *a, const void *b)
-{
-    const rg_target *x = a, *y = b;
-    if (x->a != y->a) return x->a < y->a ? -1 : 1;
-    return x->b < y->b ? -1 : x->b > y->b;
-}
-
-int cl_pattern(int pattern, int n, double zone, rg_target *t)
-{
-    if (n <= 0 || !(zone > 0)) return 0;
-    if (pattern == CL_RINGS) {
-        /* concentric rings, points per ring growing with the ring's radius (ring i of
-           nr gets a share i / (1 + 2 + ... + nr)), each ring started half a step
-           further round than the last */
-        int nr = (int)floor(sqrt(n / PI) + 0.5), k = 0;
-        if (nr < 1) nr = 1;
-        double total = nr * (nr + 1) / 2.0;
-        for (int i = 1; i <= nr; i++) {
-            int m = (int)floor(n * (i * (i + 1) / 2.0) / total + 0.5) -
-                    (int)floor(n * ((i - 1) * i / 2.0) / total + 0.5);
-            for (int j = 0; j < m && k < n; j++, k++) {
-                t[k].kind = RG_T_ANGLES;
-                t[k].a = zone * i / nr;
-                t[k].b = fmod(2 * PI * (j + 0.5 * (i & 1)) / m, 2 * PI);
-            }
-        }
-        return k;
-    }
-    if (pattern == CL_GRID) {
-        /* a square grid in (theta cos phi, theta sin phi), spacing shrunk until the
-           disc holds n points; the n nearest the centre, centre first */
-        double d = zone * sqrt(PI / n) * 1.05;
-        for (int tries = 0; tries < 200; tries++, d *= 0.99) {
-            int half = (int)ceil(zone / d), k = 0;
-            for (int i = -half; i <= half; i++)
-                for (int j = -half; j <= half; j++) {
-                    double x = i * d, y = j * d, r = hypot(x, y);
-                    if (r > zone * (1 + 1e-12)) continue;
-                    if (k < n) {
-                        t[k].kind = RG_T_ANGLES;
-                        t[k].a = r;
-                        t[k].b = r > 0 ? fmod(atan2(y, x) + 2 * PI, 2 * PI) : 0;
-                    }
-                    k++;
-                }
-            if (k >= n) {
-                /* more than n: keep the n nearest (recount in order, sorted) */
-                rg_target *all = malloc(sizeof *all * (size_t)k);
-                if (!all) return 0;
-                int q = 0;
-                for (int i = -half; i <= half; i++)
-                    for (int j = -half; j <= half; j++) {
-                        double x = i * d, y = j * d, r = hypot(x, y);
-                        if (r > zone * (1 + 1e-12)) continue;
-                        all[q].kind = RG_T_ANGLES;
-                        all[q].a = r;
-                        all[q].b = r > 0 ? fmod(atan2(y, x) + 2 * PI, 2 * PI) : 0;
-                        q++;
-                    }
-                qsort(all, (size_t)q, sizeof *all, by_radius);
-                memcpy(t, all, sizeof *t * (size_t)n);
-                free(all);
-                return n;
-            }
-        }
-        return 0;
-    }
-    for (int k = 0; k < n; k++) {      /* sunflower (Vogel) spiral */
-        t[k].kind = RG_T_ANGLES;
-        t[k].a = zone * sqrt((k + 0.5) / n);
-        t[k].b = fmod(k * GOLDEN, 2 * PI);
-    }
-    return n;
 }
 
 /* ---- per-point work ---------------------------------------------------------------- */
@@ -141,7 +63,7 @@ static int on_plane(const cn_plane *pl, const double p[3], const double d[3], do
 /* The traced path of pose p through geometry gt: the hit on the plane.  The tracer
  * when there is one (its cornea point and detector hit give the reflected ray),
  * else the rig's forward model.  0, or -1 with why. */
-static int traced_hit(const cl_run *r, const rg_geometry *gt, const cn_plane *pl,
+static int traced_hit(const tp_run *r, const rg_geometry *gt, const cn_plane *pl,
                       const rg_pose *p, double *u, double *v, double hit[3], char *why,
                       size_t cap)
 {
@@ -178,8 +100,8 @@ static int traced_hit(const cl_run *r, const rg_geometry *gt, const cn_plane *pl
 /* The spot of one frame (synthetic or read), located by the imaging engine's
  * Gaussian fit; read_noise 0: measured from the frame.  off_sensor: the traced hit
  * lies outside the sensor (the reason given when no spot is found). */
-static void locate(const cl_run *r, im_centroider *cz, const im_frame *f, double read_noise,
-                   int off_sensor, cl_point *q)
+static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double read_noise,
+                   double gain, int off_sensor, tp_point *q)
 {
     const im_frame_api *F = r->im->frame;
     const double pitch = r->cam.pitch;
@@ -190,6 +112,7 @@ static void locate(const cl_run *r, im_centroider *cz, const im_frame *f, double
     memset(&o, 0, sizeof o);
     o.method = IM_CM_GAUSS;
     o.read_noise = read_noise;
+    o.gain = gain;                      /* shot noise in each pixel's variance */
     q->spot.u = q->spot.v = NAN;
     int rc = F->centroid(cz, f, &o, sp, 4, &res, e, sizeof e);
     q->nspots = rc ? 0 : res.ndetected;
@@ -204,6 +127,10 @@ static void locate(const cl_run *r, im_centroider *cz, const im_frame *f, double
     q->x = sp[0].x;
     q->y = sp[0].y;
     q->snr = sp[0].snr;
+    q->amp = sp[0].amp;
+    q->w = sp[0].w;
+    q->bg = sp[0].bg;
+    q->noise = res.noise;
     if (res.outcome == IM_FOUND_SEVERAL) {
         q->spot.status = CN_S_SEVERAL;
         snprintf(q->why, sizeof q->why, "several spots in the frame (%d)", res.ndetected);
@@ -225,11 +152,11 @@ static void locate(const cl_run *r, im_centroider *cz, const im_frame *f, double
 /* One synthetic frame: the traced hit (NULL: none, the frame shows no spot) splatted
  * as the camera's Gaussian spot into a full sensor frame at the detector point, saved
  * when asked, then located.  Returns 0, or -1 when a frame could not be saved (why). */
-static int frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, int k,
-                      const double *hit, cl_point *q)
+static int frame_spot(const tp_run *r, im_centroider *cz, const cn_plane *pl, int k,
+                      const double *hit, tp_point *q)
 {
     const im_frame_api *F = r->im->frame;
-    const cl_camera *c = &r->cam;
+    const tp_camera *c = &r->cam;
     im_sensor s;
     im_spot_src src;
     im_hit h;
@@ -248,6 +175,7 @@ static int frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, in
     s.gain = 1;
     s.bias = c->bias;
     s.read_noise = c->read_noise;
+    s.shot_noise = 1;                   /* photons arrive one by one: Poisson */
     s.wavelength = LAMBDA_M;
     /* the electrons that give `peak` counts at the centre of a Gaussian of 1/e^2
        radius w pixels: peak * pi w^2 / 2 */
@@ -280,7 +208,7 @@ static int frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, in
         q->saved = 1;
     }
     if (hit)
-        locate(r, cz, f, c->read_noise / s.gain,
+        locate(r, cz, f, c->read_noise / s.gain, s.gain,
                fabs(q->hit_u) > 0.5 * c->width * c->pitch ||
                fabs(q->hit_v) > 0.5 * c->height * c->pitch, q);
     F->frame_free(f);
@@ -290,7 +218,7 @@ static int frame_spot(const cl_run *r, im_centroider *cz, const cn_plane *pl, in
 /* ---- workers ----------------------------------------------------------------------- */
 
 typedef struct job {
-    cl_run *r;
+    tp_run *r;
     int phase;                  /* 0: measure, 1: check */
     pthread_mutex_t mu;
     int next;
@@ -333,7 +261,7 @@ static int take(job *j, int finished)
 /* With a cone: the hit of point q's beam through the true eye with the cone, by the
  * cornea engine's analytic model (equal to the tracer's on the eye without it to
  * 1e-12 mm); 0, or -1 (status NONE, why said) when the beam misses. */
-static int cone_hit(const cl_run *r, const cn_plane *pl, cl_point *q, double hit[3])
+static int cone_hit(const tp_run *r, const cn_plane *pl, tp_point *q, double hit[3])
 {
     cn_spot b = q->spot;
     if (r->cn->reimage(r->g, CN_BICONIC, &r->truth_p, r->bump, 0, 0, &b, 1) != 1) {
@@ -350,8 +278,8 @@ static int cone_hit(const cl_run *r, const cn_plane *pl, cl_point *q, double hit
 
 static void measure_one(job *j, im_centroider *cz, int k)
 {
-    cl_run *r = j->r;
-    cl_point *q = &r->pt[k];
+    tp_run *r = j->r;
+    tp_point *q = &r->pt[k];
     double hit[3];
     char e[RG_ERRMAX];
     if (!q->planned) return;
@@ -361,23 +289,23 @@ static void measure_one(job *j, im_centroider *cz, int k)
         snprintf(q->why, sizeof q->why, "no beam: %.80s", e);
         return;
     }
-    if (r->source == CL_SRC_CAMERA) return;       /* located as each frame was read */
+    if (r->source == TP_SRC_CAMERA) return;       /* located as each frame was read */
     q->spot.sigma = r->sigma > 0 ? r->sigma : 1e-4;
     if (traced_hit(r, &j->gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
                    sizeof q->why)) {
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         /* the camera still takes the frame: it shows no spot */
-        if (r->source == CL_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
+        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
             fail_job(j);
         return;
     }
     if (r->bump && cone_hit(r, &j->pl, q, hit)) {
-        if (r->source == CL_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
+        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
             fail_job(j);
         return;
     }
-    if (r->source == CL_SRC_FRAMES) {
+    if (r->source == TP_SRC_FRAMES) {
         if (frame_spot(r, cz, &j->pl, k, hit, q)) fail_job(j);
         return;
     }
@@ -392,8 +320,8 @@ static void measure_one(job *j, im_centroider *cz, int k)
  * or a negative number when the point is not checked. */
 static double check_one(job *j, int k)
 {
-    cl_run *r = j->r;
-    cl_point *q = &r->pt[k];
+    tp_run *r = j->r;
+    tp_point *q = &r->pt[k];
     double u, v, mu, mv, hit[3];
     char why[96];
     if (!q->planned || q->spot.status != CN_S_OK) return -1;
@@ -408,9 +336,9 @@ static double check_one(job *j, int k)
 static void *worker(void *arg)
 {
     job *j = arg;
-    cl_run *r = j->r;
+    tp_run *r = j->r;
     im_centroider *cz = NULL;
-    if (j->phase == 0 && r->source == CL_SRC_FRAMES && r->im) {
+    if (j->phase == 0 && r->source == TP_SRC_FRAMES && r->im) {
         cz = r->im->frame->centroider_new();
         if (!cz) {
             pthread_mutex_lock(&j->mu);
@@ -456,7 +384,7 @@ static int run_workers(job *j)
 
 /* The next frame of the camera (or video, or file sequence) for point q: its spot
  * located, the noise measured from the frame.  0, or -1 with why in err. */
-static int camera_read(const cl_run *r, im_source *src, im_centroider *cz, cl_point *q,
+static int camera_read(tp_run *r, im_source *src, im_centroider *cz, tp_point *q,
                        int got, char *err, size_t cap)
 {
     const im_frame_api *F = r->im->frame;
@@ -469,14 +397,86 @@ static int camera_read(const cl_run *r, im_source *src, im_centroider *cz, cl_po
         else snprintf(err, cap, "%s", e);
         return -1;
     }
-    locate(r, cz, f, 0, 0, q);
+    locate(r, cz, f, 0, 0, 0, q);
+    if (q->spot.status == CN_S_OK)          /* the gain is measured from the spots */
+        tp_shot_add(&r->shot, f, q->x, q->y, q->amp, q->w, q->bg, q->noise);
     F->frame_free(f);
     return 0;
 }
 
-static int stopped(const cl_run *r) { return r->stop && r->stop(r->stop_ctx); }
+/* Camera frames: the gain from the spots' photon transfer, and every located spot's
+ * sigma widened for the shot noise it implies (the centroider knew only the
+ * background's noise). */
+static void shot_widen(tp_run *r)
+{
+    r->gain = tp_shot_gain(&r->shot);
+    double sum = 0;
+    int m = 0;
+    for (int k = 0; k < r->npoints; k++) {
+        tp_point *q = &r->pt[k];
+        if (!q->planned || q->spot.status != CN_S_OK) continue;
+        double f = tp_shot_factor(q->amp, q->w, q->noise, r->gain);
+        q->spot.sigma *= f;
+        sum += f;
+        m++;
+    }
+    if (m) r->shot_factor = sum / m;
+}
 
-int cl_measure(cl_run *r, char *err, size_t cap)
+static int stopped(const tp_run *r);
+
+/* The surface from the data (issue 19): a reference sphere fitted to the measured
+ * spots (their statuses before the model's fit: a spot the model calls an outlier
+ * may be the cone), the Zernike slope fit in its frame, the keratoconus indices.  A
+ * failure here is said in r->zwhy and leaves r->have_z 0; only a stop is an error. */
+static int surface(tp_run *r, int m, const int *of, char *err, size_t cap)
+{
+    cn_spot *sp = malloc(sizeof *sp * (size_t)(m ? m : 1));
+    cn_result *ref = calloc(1, sizeof *ref);
+    char e[256];
+    int rc = 0;
+    r->have_z = 0;
+    r->zwhy[0] = 0;
+    if (!sp || !ref) { free(sp); free(ref); snprintf(err, cap, "out of memory"); return CN_ENOMEM; }
+    for (int i = 0; i < m; i++) sp[i] = r->pt[of[i]].spot;
+    /* the reference: the model's own fit when it holds (converged, not rejected: a
+       toric, tilted eye is better met by its biconic than by a sphere, which read R
+       8.52 for 7.8 there), else a sphere fitted for the purpose */
+    int ref_model = CN_SPHERE, frc = 0;
+    if (r->res.converged && !r->res.rejected_model && !r->res.poor) {
+        *ref = r->res;
+        ref_model = r->model;
+    } else {
+        cn_fit_opts fo = {.model = CN_SPHERE, .stop = r->stop, .stop_ctx = r->stop_ctx,
+                          .threads = r->threads, .max_iter = r->max_iter};
+        frc = r->cn->fit(r->g, sp, m, NULL, &fo, ref, e, sizeof e);
+    }
+    if (frc == CN_ESTOP) { snprintf(err, cap, "stopped"); rc = CN_ESTOP; goto out; }
+    if (frc || !ref->converged) {
+        snprintf(r->zwhy, sizeof r->zwhy, "no reference sphere: %.200s", frc ? e : "not converged");
+        goto out;
+    }
+    r->zref_R = ref->par.p[CN_R];
+    for (int i = 0; i < m; i++) sp[i] = r->pt[of[i]].spot;   /* statuses as measured */
+    if (r->cn->zfit(r->g, sp, m, &ref->par, ref_model, 0, r->zf, e, sizeof e)) {
+        snprintf(r->zwhy, sizeof r->zwhy, "%.250s", e);
+        goto out;
+    }
+    if (stopped(r)) { snprintf(err, cap, "stopped"); rc = CN_ESTOP; goto out; }
+    if (r->cn->kc(r->zf, &r->kc)) {
+        snprintf(r->zwhy, sizeof r->zwhy, "the indices could not be computed on the data's zone");
+        goto out;
+    }
+    r->have_z = 1;
+out:
+    free(sp);
+    free(ref);
+    return rc;
+}
+
+static int stopped(const tp_run *r) { return r->stop && r->stop(r->stop_ctx); }
+
+int tp_measure(tp_run *r, char *err, size_t cap)
 {
     const rig_api *rg = r->rg;
     double t0 = now(), c0 = cpu_now(), t;
@@ -484,11 +484,12 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     rg_target *tg;
     memset(&r->tm, 0, sizeof r->tm);
     r->fitted = 0;
+    memset(&r->shot, 0, sizeof r->shot);
     r->check_max = NAN;
     r->check_n = 0;
     r->phase = "planning";
     progress_tty = isatty(2);
-    if (r->source == CL_SRC_FRAMES && (!r->im || !r->im->frame)) {
+    if (r->source == TP_SRC_FRAMES && (!r->im || !r->im->frame)) {
         snprintf(err, cap, "frames need the imaging engine");
         return CN_EINVAL;
     }
@@ -496,13 +497,13 @@ int cl_measure(cl_run *r, char *err, size_t cap)
         snprintf(err, cap, "out of memory");
         return CN_ENOMEM;
     }
-    int n = cl_pattern(r->pattern, r->npoints, r->zone, tg);
+    int n = tp_pattern(r->pattern, r->npoints, r->zone, tg);
     memset(r->pt, 0, sizeof *r->pt * (size_t)r->npoints);
     r->npoints = n;
     /* plan: solve and quantise each target on the nominal cornea */
     r->nplanned = 0;
     for (int k = 0; k < n; k++) {
-        cl_point *q = &r->pt[k];
+        tp_point *q = &r->pt[k];
         rg_solution s;
         rg_quantised qu;
         q->t = tg[k];
@@ -524,7 +525,7 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     im_source *src = NULL;
     im_centroider *ccz = NULL;
     int got = 0;
-    if (r->source == CL_SRC_CAMERA) {
+    if (r->source == TP_SRC_CAMERA) {
         if (!r->im || !r->camera) { snprintf(err, cap, "no camera"); return CN_EINVAL; }
         if (r->im->frame->source_open(r->camera, 1, 2000, &src, err, cap))
             return CN_EINVAL;
@@ -552,7 +553,7 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     r->phase = "the scan on the machine";
     if (r->m) {
         for (int k = 0; k < n; k++) {
-            cl_point *q = &r->pt[k];
+            tp_point *q = &r->pt[k];
             long steps[RG_NJOINTS];
             if (!q->planned) continue;
             if (rg->pose_steps(r->rig, &q->pose, steps, e, sizeof e)) {
@@ -582,10 +583,13 @@ int cl_measure(cl_run *r, char *err, size_t cap)
         if (camera_read(r, src, ccz, &r->pt[k], got++, err, cap)) { CAMERA_DONE(); return CN_EINVAL; }
     }
     CAMERA_DONE();
+    r->gain = NAN;
+    r->shot_factor = 1;
+    if (r->source == TP_SRC_CAMERA) shot_widen(r);
     for (int k = 0, seq = 0; k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
     r->tm.machine = now() - t;
     /* detect: the traced spot of each exposure, its frame and centroid */
-    r->phase = r->source == CL_SRC_FRAMES ? "the frames and their centroids"
+    r->phase = r->source == TP_SRC_FRAMES ? "the frames and their centroids"
              : "the traced spots";
     job j;
     memset(&j, 0, sizeof j);
@@ -617,10 +621,11 @@ int cl_measure(cl_run *r, char *err, size_t cap)
     for (int k = 0; k < n; k++)
         if (r->pt[k].planned) { sp[m] = r->pt[k].spot; of[m++] = k; }
     cn_fit_opts fo = {.model = r->model, .stop = r->stop, .stop_ctx = r->stop_ctx,
-                      .threads = r->threads};
+                      .threads = r->threads, .max_iter = r->max_iter};
     int rc = r->cn->fit(r->g, sp, m, NULL, &fo, &r->res, err, cap);
+    if (!rc && r->zf) rc = surface(r, m, of, err, cap);
     for (int i = 0; i < m; i++) {
-        cl_point *q = &r->pt[of[i]];
+        tp_point *q = &r->pt[of[i]];
         if (q->spot.status == CN_S_OK && sp[i].status == CN_S_OUTLIER)
             snprintf(q->why, sizeof q->why, "outlier: |r|/sigma %.3g, over the robust limit",
                      sp[i].nres);
@@ -680,11 +685,11 @@ fail:
     return CN_EFIT;
 }
 
-void cl_counts(const cl_run *r, int counts[6])
+void tp_counts(const tp_run *r, int counts[6])
 {
     memset(counts, 0, sizeof *counts * 6);
     for (int k = 0; k < r->npoints; k++) {
-        const cl_point *q = &r->pt[k];
+        const tp_point *q = &r->pt[k];
         if (!q->planned) counts[5]++;
         else if (q->spot.status >= 0 && q->spot.status < 5) counts[q->spot.status]++;
     }

@@ -1,0 +1,379 @@
+/* cn_kc.c -- what a topographer reads off the reconstructed surface (cn_zern.c):
+ * masked maps (elevation against the best-fit sphere, axial and tangential power)
+ * and the keratoconus indices as clinical software reports them -- Kmax and where,
+ * central K, I-S, Sim K and AST on the 3 mm ring, SRAX, KISA% -- with the screen
+ * against the published thresholds (sources in doc/topography.md) and each index's
+ * sd from the Zernike coefficients' covariance (Monte Carlo draws).  The same
+ * indices of an analytic surface (the truth of a simulation) for tests and benches. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "cn_int.h"
+
+#define KN 337.5                /* (1.3375 - 1) * 1000: D per 1/mm */
+#define DEG (M_PI / 180)
+
+/* A surface the indices read: axial power (D) at (x, y), 0 or -1. */
+typedef struct kc_surf {
+    const cn_zfit *z;           /* the reconstruction, or */
+    cn_surf s;                  /* an analytic surface */
+    double g0x, g0y;            /* its slope at the origin (taken out, as cn_zlocal) */
+    double ox, oy;              /* the frame's origin about the rig's nominal apex */
+} kc_surf;
+
+/* Axial curvature of the analytic surface about its normal at the origin. */
+static int model_axial(const kc_surf *k, double x, double y, double *axial)
+{
+    double r = hypot(x, y), ex = 1, ey = 0, z, ax, ay, bx, by, cx, cy;
+    const double h = 1e-4;
+    if (r > 0) { ex = x / r; ey = y / r; }
+    if (cn_sag(&k->s, x, y, &z, &ax, &ay) || cn_sag(&k->s, x + h * ex, y + h * ey, &z, &bx, &by) ||
+        cn_sag(&k->s, x - h * ex, y - h * ey, &z, &cx, &cy))
+        return -1;
+    ax -= k->g0x;
+    ay -= k->g0y;
+    double zr = ax * ex + ay * ey, zrr = ((bx - cx) * ex + (by - cy) * ey) / (2 * h);
+    *axial = r > 1e-6 ? zr / (r * sqrt(1 + ax * ax + ay * ay)) : zrr / pow(1 + zr * zr, 1.5);
+    return 0;
+}
+
+/* Solve the 5 x 5 system m (destroyed) for its inverse; 0 or -1. */
+static int inv5(double m[5][5], double out[5][5])
+{
+    double a[5][10];
+    for (int i = 0; i < 5; i++)
+        for (int j = 0; j < 10; j++) a[i][j] = j < 5 ? m[i][j] : (j - 5 == i);
+    for (int c = 0; c < 5; c++) {
+        int p = c;
+        for (int r = c + 1; r < 5; r++) if (fabs(a[r][c]) > fabs(a[p][c])) p = r;
+        if (!(fabs(a[p][c]) > 1e-300)) return -1;
+        for (int j = 0; j < 10; j++) { double t = a[c][j]; a[c][j] = a[p][j]; a[p][j] = t; }
+        double d = a[c][c];
+        for (int j = 0; j < 10; j++) a[c][j] /= d;
+        for (int r = 0; r < 5; r++) {
+            if (r == c) continue;
+            double f = a[r][c];
+            for (int j = 0; j < 10; j++) a[r][j] -= f * a[c][j];
+        }
+    }
+    for (int i = 0; i < 5; i++) for (int j = 0; j < 5; j++) out[i][j] = a[i][j + 5];
+    return 0;
+}
+
+/* The measured slopes about (x, y), fitted locally (the curvatures come from the
+ * data where they are, not from a global surface: a cone 0.8 mm wide near the
+ * zone's edge is beyond what 20 orders of Zernike polynomials follow to the noise):
+ * fx = a0 + a1 dx + a2 dy, fy = b0 + a2 dx + a3 dy (one Hessian), each spot weighted
+ * by its slope's 1 / sigma^2 and a Gaussian kernel of sd kr / 2 (cut at 1.5 kr).
+ * p = (a0, b0, a1, a2, a3); V its covariance (the sandwich of the kernel weights).
+ * 0, or -1 with fewer than 8 spots in reach. */
+static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V[5][5])
+{
+    double M[5][5] = {{0}}, S[5][5] = {{0}}, b[5] = {0}, Mi[5][5];
+    double s2 = 0.25 * z->kr * z->kr, cut = 2.25 * z->kr * z->kr;
+    int nn = 0;
+    for (int i = 0; i < z->npts; i++) {
+        double dx = z->xy[2 * i] - x, dy = z->xy[2 * i + 1] - y, d2 = dx * dx + dy * dy;
+        if (d2 > cut || !(z->wt[i] > 0)) continue;
+        double k = exp(-d2 / (2 * s2)), w = k * z->wt[i], w2 = k * k * z->wt[i];
+        double ru[5] = {1, 0, dx, dy, 0}, rv[5] = {0, 1, 0, dx, dy};
+        for (int a = 0; a < 5; a++) {
+            b[a] += w * (ru[a] * z->sl[2 * i] + rv[a] * z->sl[2 * i + 1]);
+            for (int c = 0; c < 5; c++) {
+                M[a][c] += w * (ru[a] * ru[c] + rv[a] * rv[c]);
+                S[a][c] += w2 * (ru[a] * ru[c] + rv[a] * rv[c]);
+            }
+        }
+        nn++;
+    }
+    if (nn < 8 || inv5(M, Mi)) return -1;
+    for (int a = 0; a < 5; a++) {
+        p[a] = 0;
+        for (int c = 0; c < 5; c++) p[a] += Mi[a][c] * b[c];
+    }
+    double T[5][5];
+    for (int a = 0; a < 5; a++)
+        for (int c = 0; c < 5; c++) {
+            T[a][c] = 0;
+            for (int q = 0; q < 5; q++) T[a][c] += Mi[a][q] * S[q][c];
+        }
+    for (int a = 0; a < 5; a++)
+        for (int c = 0; c < 5; c++) {
+            V[a][c] = 0;
+            for (int q = 0; q < 5; q++) V[a][c] += T[a][q] * Mi[q][c];
+        }
+    return 0;
+}
+
+void cn_zlocal_vertex(cn_zfit *z)
+{
+    double p[5], V[5][5];
+    z->l0x = z->l0y = 0;
+    if (!local_fit(z, 0, 0, p, V)) { z->l0x = p[0]; z->l0y = p[1]; }
+}
+
+/* Axial and tangential curvature (1/mm) at (x, y) from the local fit, about the
+ * normal at the vertex, and the axial one's sd.  Within one kernel radius of the
+ * vertex the axial curvature is its limit there, the tangential (f_r / r loses all
+ * precision as r -> 0). */
+int cn_zlocal(const cn_zfit *z, double x, double y, double *axial, double *tang,
+              double *sd_axial)
+{
+    double p[5], V[5][5], r = hypot(x, y), ex = 1, ey = 0;
+    if (local_fit(z, x, y, p, V)) return -1;
+    if (r > 0) { ex = x / r; ey = y / r; }
+    double sx = p[0] - z->l0x, sy = p[1] - z->l0y;
+    double fr = sx * ex + sy * ey, q = 1 + sx * sx + sy * sy;
+    double g[3] = {ex * ex, 2 * ex * ey, ey * ey};
+    double frr = g[0] * p[2] + g[1] * p[3] + g[2] * p[4], vt = 0;
+    for (int a = 0; a < 3; a++)
+        for (int c = 0; c < 3; c++) vt += g[a] * V[a + 2][c + 2] * g[c];
+    double t15 = pow(1 + fr * fr, 1.5);
+    *tang = frr / t15;
+    if (r > z->kr) {
+        double vr = ex * ex * V[0][0] + 2 * ex * ey * V[0][1] + ey * ey * V[1][1];
+        *axial = fr / (r * sqrt(q));
+        if (sd_axial) *sd_axial = sqrt(vr) / (r * sqrt(q));
+    } else {
+        *axial = *tang;
+        if (sd_axial) *sd_axial = sqrt(vt) / t15;
+    }
+    return isfinite(*axial) && isfinite(*tang) ? 0 : -1;
+}
+
+static int power(const kc_surf *k, double x, double y, double *ax)
+{
+    double a, t;
+    int rc = k->z ? cn_zlocal(k->z, x, y, &a, &t, NULL) : model_axial(k, x, y, &a);
+    *ax = KN * a;
+    return rc;
+}
+
+static int power_sd(const kc_surf *k, double x, double y, double *ax, double *sd)
+{
+    double a, t, sa = NAN;
+    int rc = k->z ? cn_zlocal(k->z, x, y, &a, &t, &sa) : model_axial(k, x, y, &a);
+    *ax = KN * a;
+    *sd = KN * sa;
+    return rc;
+}
+
+/* Mean axial power on a ring of radius r (72 points); its second harmonic too. */
+static int ring(const kc_surf *k, double r, double *mean, double *amp, double *steep)
+{
+    enum { N = 72 };
+    double sum = 0, a = 0, b = 0, p;
+    int n = 0;
+    for (int j = 0; j < N; j++) {
+        double phi = 2 * M_PI * j / N;
+        if (power(k, r * cos(phi), r * sin(phi), &p)) continue;   /* a gap in the data */
+        sum += p;
+        a += p * cos(2 * phi);
+        b += p * sin(2 * phi);
+        n++;
+    }
+    if (n < N / 2) return -1;
+    *mean = sum / n;
+    if (amp) *amp = hypot(a, b) * 2.0 / n;
+    if (steep) {
+        double st = 0.5 * atan2(b, a) / DEG;
+        *steep = st < 0 ? st + 180 : st;
+    }
+    return 0;
+}
+
+/* The indices of one surface (no sd). */
+static int indices(const kc_surf *k, double zone, cn_kc *o)
+{
+    double p;
+    o->zone_r = zone;
+    /* Kmax: a 0.05 mm grid within 0.95 of the zone, then 0.005 mm about its best */
+    double lim = 0.9 * zone, best = -INFINITY, bx = 0, by = 0;
+    for (double y = -lim; y <= lim; y += 0.05)
+        for (double x = -lim; x <= lim; x += 0.05) {
+            if (hypot(x, y) > lim || (k->z && !cn_zcovered(k->z, x, y))) continue;
+            if (!power(k, x, y, &p) && p > best) { best = p; bx = x; by = y; }
+        }
+    if (!isfinite(best)) return -1;
+    double cx = bx, cy = by;
+    for (double y = cy - 0.05; y <= cy + 0.05; y += 0.005)
+        for (double x = cx - 0.05; x <= cx + 0.05; x += 0.005)
+            if (hypot(x, y) <= lim && !power(k, x, y, &p) && p > best) { best = p; bx = x; by = y; }
+    o->kmax = best;
+    o->kmax_x = bx + k->ox;
+    o->kmax_y = by + k->oy;
+    /* central K: the rings of 2, 3, 4 mm diameter inside the data */
+    double s = 0, m;
+    o->ck_rings = 0;
+    for (int d = 2; d <= 4; d++)
+        if (d / 2.0 <= lim && !ring(k, d / 2.0, &m, NULL, NULL)) { s += m; o->ck_rings++; }
+    o->ck = o->ck_rings ? s / o->ck_rings : NAN;
+    /* I-S: five points 30 deg apart about straight down and straight up */
+    o->is_r = fmin(3.0, lim);
+    double inf = 0, sup = 0;
+    int ni = 0, ns = 0;
+    for (int j = -2; j <= 2; j++) {
+        double a = (90 + 30 * j) * DEG;
+        if (!power(k, o->is_r * cos(a), o->is_r * sin(a), &p)) { sup += p; ns++; }
+        if (!power(k, o->is_r * cos(a + M_PI), o->is_r * sin(a + M_PI), &p)) { inf += p; ni++; }
+    }
+    if (ni < 3 || ns < 3) return -1;
+    o->is = inf / ni - sup / ns;
+    /* Sim K on the 3 mm ring (or the zone's, if smaller) */
+    double amp, st, hr = fmin(1.5, lim);
+    if (ring(k, hr, &m, &amp, &st)) return -1;
+    o->simk1 = m - amp;
+    o->simk2 = m + amp;
+    o->simk_axis = st;
+    o->ast = 2 * amp;
+    /* SRAX: the steepest semi-meridian above and below the horizontal (mean axial
+       power from 0.5 mm to the zone's edge, 1 deg steps); the angle between them
+       less 180 */
+    double bu = -INFINITY, bl = -INFINITY, au = 0, al = 0;
+    for (int dg = 0; dg < 360; dg++) {
+        double a = dg * DEG, sum = 0;
+        int nn = 0;
+        for (double r = 0.5; r <= lim; r += 0.1)
+            if (!power(k, r * cos(a), r * sin(a), &p)) { sum += p; nn++; }
+        if (!nn) continue;
+        sum /= nn;
+        if (dg < 180) { if (sum > bu) { bu = sum; au = dg; } }
+        else if (sum > bl) { bl = sum; al = dg; }
+    }
+    o->srax = fabs(180 - fabs(al - au));
+    /* KISA% (Rabinowitz & Rasheed 1999) */
+    o->kisa = o->ck * o->is * o->ast * o->srax * 100 / 300;
+    return 0;
+}
+
+static void screen(cn_kc *o)
+{
+    /* thresholds: central K 47.2-48.7 probable, > 48.7 keratoconus; I-S 1.4-1.8
+       probable, > 1.8 keratoconus; SRAX > 21 deg abnormal; KISA% 60-100 suspect,
+       > 100 keratoconus (doc/topography.md names the sources) */
+    size_t l = 0;
+    o->screen = CN_KC_NORMAL;
+    o->why[0] = 0;
+#define FLAG(lvl, ...) do { if ((lvl) > o->screen) o->screen = (lvl); \
+        if (l < sizeof o->why) l += snprintf(o->why + l, sizeof o->why - l, __VA_ARGS__); } while (0)
+    if (o->ck > 48.7) FLAG(CN_KC_KERATOCONUS, "central K %.2f D > 48.7; ", o->ck);
+    else if (o->ck > 47.2) FLAG(CN_KC_SUSPECT, "central K %.2f D in 47.2-48.7; ", o->ck);
+    if (o->is > 1.8) FLAG(CN_KC_KERATOCONUS, "I-S %.2f D > 1.8; ", o->is);
+    else if (o->is > 1.4) FLAG(CN_KC_SUSPECT, "I-S %.2f D in 1.4-1.8; ", o->is);
+    /* SRAX alone is not screened: without astigmatism the steepest axes are noise
+       (a sphere's came out 133 deg); it enters through KISA, times AST */
+    if (o->kisa > 100) FLAG(CN_KC_KERATOCONUS, "KISA %.0f %% > 100; ", o->kisa);
+    else if (o->kisa > 60) FLAG(CN_KC_SUSPECT, "KISA %.0f %% in 60-100; ", o->kisa);
+#undef FLAG
+    if (l >= 2 && l < sizeof o->why) o->why[l - 2] = 0;
+}
+
+int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_r, cn_kc *k)
+{
+    kc_surf s = {0};
+    memset(k, 0, sizeof *k);
+    cn_surface(model, p, &s.s);
+    if (bump) s.s.bump = *bump;
+    double z0;
+    cn_sag(&s.s, 0, 0, &z0, &s.g0x, &s.g0y);
+    s.ox = p->p[CN_DX];
+    s.oy = p->p[CN_DY];
+    if (indices(&s, zone_r, k)) return CN_EINVAL;
+    screen(k);
+    return CN_OK;
+}
+
+int cn_kc_of(const cn_zfit *z, cn_kc *k)
+{
+    kc_surf s = {.z = z, .ox = z->ref.p[CN_DX], .oy = z->ref.p[CN_DY]};
+    memset(k, 0, sizeof *k);
+    if (indices(&s, z->rho, k)) return CN_EINVAL;
+    screen(k);
+    /* sd from the local fits' covariances: Kmax's at its point; the mean of N
+       powers (rings, I-S's five points) as independent points (the kernels of the
+       ring's points hardly overlap); the location from the peak's sharpness,
+       sd_loc ~ sqrt(2 sd_K / |P''|) (the distance at which the peak falls by 2 sd) */
+    double p, sd, pe, sdd;
+    power_sd(&s, k->kmax_x - s.ox, k->kmax_y - s.oy, &p, &k->sd_kmax);
+    /* along the flattest direction through the peak (a toric's ridge: the
+       location is then poorly defined, and says so) */
+    double x0 = k->kmax_x - s.ox, y0 = k->kmax_y - s.oy, hh = 0.1, curv = INFINITY;
+    for (int d = 0; d < 8; d++) {
+        double dx = hh * cos(d * M_PI / 8), dy = hh * sin(d * M_PI / 8), pa, pb;
+        if (!power(&s, x0 + dx, y0 + dy, &pa) && !power(&s, x0 - dx, y0 - dy, &pb))
+            curv = fmin(curv, -(pa + pb - 2 * p) / (hh * hh));
+    }
+    k->sd_kmax_loc = curv > 0 && isfinite(curv) ? sqrt(2 * k->sd_kmax / curv) : INFINITY;
+    double v = 0;
+    int nv = 0;
+    for (int j = -2; j <= 2; j++) {
+        double a = (90 + 30 * j) * DEG;
+        if (!power_sd(&s, k->is_r * cos(a), k->is_r * sin(a), &pe, &sdd)) { v += sdd * sdd; nv++; }
+        if (!power_sd(&s, -k->is_r * cos(a), -k->is_r * sin(a), &pe, &sdd)) { v += sdd * sdd; nv++; }
+    }
+    k->sd_is = nv ? sqrt(v) / 5 : INFINITY;
+    v = 0;
+    nv = 0;
+    double hr = fmin(1.5, 0.9 * z->rho);
+    for (int j = 0; j < 72; j++) {
+        double a = 2 * M_PI * j / 72;
+        if (!power_sd(&s, hr * cos(a), hr * sin(a), &pe, &sdd)) { v += sdd * sdd; nv++; }
+    }
+    /* 72 points of about kr apart or closer share spots: count ring length / kr */
+    double indep = fmin(72, fmax(1, 2 * M_PI * hr / z->kr));
+    k->sd_simk = nv ? sqrt(v / nv) / sqrt(indep) : INFINITY;
+    k->sd_ck = k->sd_simk;
+    k->sd_ast = 2 * k->sd_simk;
+    k->sd_srax = INFINITY;          /* not propagated: SRAX enters the screen via KISA */
+    (void)sd;
+    double rel = 0;
+    if (k->ck) rel += pow(k->sd_ck / k->ck, 2);
+    if (k->is) rel += pow(k->sd_is / k->is, 2);
+    if (k->ast) rel += pow(k->sd_ast / k->ast, 2);
+    k->sd_kisa = fabs(k->kisa) * sqrt(rel);
+    return CN_OK;
+}
+
+int cn_zmap(int kind, const cn_zfit *z, double hmax, int n, double *grid, double *aux)
+{
+    if (n < 2 || !(hmax > 0) || kind < CN_ZMAP_ELEVATION || kind > CN_ZMAP_TANGENTIAL)
+        return CN_EINVAL;
+    double cell = 2 * hmax / n, a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            double x = -hmax + (i + 0.5) * cell, y = hmax - (j + 0.5) * cell;
+            double *g = &grid[(size_t)j * n + i];
+            *g = NAN;
+            if (!cn_zcovered(z, x, y)) continue;
+            if (kind == CN_ZMAP_ELEVATION) {
+                double f;
+                if (cn_zsag(z, x, y, &f, NULL, NULL)) continue;
+                double rho = x * x + y * y + f * f;
+                a11 += 4 * f * f; a12 += -2 * f; a22 += 1;
+                b1 += 2 * f * rho; b2 += -rho;
+                *g = f;
+            } else {
+                double ax, tg;
+                if (cn_zlocal(z, x, y, &ax, &tg, NULL)) continue;
+                *g = KN * (kind == CN_ZMAP_AXIAL ? ax : tg);
+            }
+        }
+    if (kind != CN_ZMAP_ELEVATION) { if (aux) *aux = NAN; return CN_OK; }
+    /* the best-fit sphere, centre on the axis (as cn_map) */
+    double det = a11 * a22 - a12 * a12;
+    if (!(fabs(det) > 0)) return CN_EINVAL;
+    double zc = (b1 * a22 - a12 * b2) / det, kk = (a11 * b2 - a12 * b1) / det;
+    double rb = sqrt(zc * zc - kk);
+    if (!isfinite(rb)) return CN_EINVAL;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            double *g = &grid[(size_t)j * n + i];
+            if (isnan(*g)) continue;
+            double x = -hmax + (i + 0.5) * cell, y = hmax - (j + 0.5) * cell;
+            double q = rb * rb - x * x - y * y;
+            *g = q > 0 ? (zc - sqrt(q) - *g) * 1000 : NAN;
+        }
+    if (aux) *aux = rb;
+    return CN_OK;
+}

@@ -1,0 +1,17 @@
+/* tp_int.h -- the topography pipeline's internal declarations (one file per job:
+ * tp_pattern.c, tp_loop.c; the table in tp_api.c). */
+#ifndef TP_INT_H
+#define TP_INT_H
+#include "topo.h"
+
+int tp_pattern(int pattern, int n, double zone, rg_target *t);
+int tp_measure(tp_run *r, char *err, size_t cap);
+void tp_counts(const tp_run *r, int counts[6]);
+
+/* tp_shot.c: photon transfer over the located spots of a scan (sums a, b over n) */
+struct im_frame;
+void tp_shot_add(tp_shot *sh, const struct im_frame *f, double x, double y, double amp,
+                 double w, double bg, double noise);
+double tp_shot_gain(const tp_shot *sh);         /* e-/count; INFINITY: none; NaN: too few */
+double tp_shot_factor(double amp, double w, double noise, double gain);
+#endif

@@ -1,0 +1,77 @@
+# t_93_topo.sh -- the topography pipeline (src/topo, issue 19): its module exports one
+# symbol and lensmat does not link it (it is loaded by --cornea-scan on first use).
+check "lensmat-topo.so exports topo_get_api alone" sh -c \
+    "test \"\$(nm -D --defined-only '$TOP/build/lib/lensmat-topo.so' | grep ' T ' | awk '{print \$3}')\" = topo_get_api"
+check "lensmat links no engine module (topo, cornea, GSL)" sh -c \
+    "! ldd '$TOP/lensmat' | grep -q -e lensmat- -e gsl"
+# Honest numbers (issue 19 item 3).  Frames with photon (shot) noise: the centroid's
+# sigma includes it (the synthetic camera's gain, 1 e-/count, given to the centroider),
+# so the fit's chi2/dof is about 1, and the fit converges in tens of iterations
+TP=$WORK/topo
+mkdir -p "$TP"
+tp_frames() {
+    printf 'biconic\n-\nspiral\n300\n12\nframes\n%s\n%s\n%s\n0\n0\n0\n0\n0\n14\n640\n480\n%s\n1\n0\n-\n' \
+        "$2" "$3" "$4" "$5" > "$TP/$1.in"
+    (cd "$TP" && "$BIN" --cornea-scan -i "$1.in" "$1.rec" > "$1.out" 2> "$1.err")
+}
+tp_chi2() {
+    for e in "s1 7.8 0 0" "s2 7.8 0 0.25" "s3 6.5 -0.2 0" "s4 9.5 -0.3 1.5"; do
+        set -- $e
+        tp_frames "$1" "$2" "$3" "$4" - || { cat "$TP/$1.err"; return 1; }
+        awk -v e="$1" '/^model biconic:/ { it = $9; c = $NF; print e, it, "iterations, chi2/dof", c;
+             exit !(it <= 50 && c > 0.8 && c < 1.25) }' "$TP/$1.rec" || return 1
+    done
+}
+check "frames with shot noise: chi2/dof 0.8-1.25 and <= 50 iterations on 4 eyes (0, 0.25, 1.5 D)" tp_chi2
+# A camera of unknown gain: measured from the spots (photon transfer) and the centroid
+# sigmas widened for it; the frames are the synthetic camera's (gain 1 e-/count)
+tp_camera() {
+    rm -f "$TP"/fr*.png
+    tp_frames cf 7.8 -0.26 0.75 'fr%03d.png' || { cat "$TP/cf.err"; return 1; }
+    printf 'biconic\n-\nspiral\n300\n12\ncamera\nfr%%03d.png\n14\n-\n' > "$TP/cc.in"
+    (cd "$TP" && "$BIN" --cornea-scan -i cc.in cc.rec > cc.out 2> cc.err) || { cat "$TP/cc.err"; return 1; }
+    grep '^Camera gain' "$TP/cc.rec" &&
+    awk '/^Camera gain from the spots/ { g = $11; ok = g > 0.6 && g < 1.4 }
+         /^model biconic:/ { c = $NF; okc = c > 0.8 && c < 1.25 }
+         END { exit !(ok && okc) }' "$TP/cc.rec"
+}
+check "camera frames: the gain measured from the spots (1 e-/count within 40 %), chi2/dof 0.8-1.25" tp_camera
+# A fit stopped at its iteration cap says so and the run fails (exit 2), no numbers
+tp_cap() {
+    if (cd "$TP" && LENSMAT_CORNEA_MAX_ITER=3 "$BIN" --cornea-scan -i s1.in cap.rec > cap.out 2> cap.err); then
+        echo "exit 0 at the iteration cap"; return 1; fi
+    grep -q 'did not converge' "$TP/cap.err" && grep -q '^NOT CONVERGED' "$TP/cap.rec" &&
+        grep -q '^the fit did not converge: R, Q, K' "$TP/cap.rec" && ! grep -q '^apex radius' "$TP/cap.rec"
+}
+check "a fit at its iteration cap: NOT CONVERGED, no numbers, exit non-zero" tp_cap
+# The surface from the slopes and the keratoconus indices, against spots from an
+# independent forward model written for the test (tests/topo/t_topo.c); the
+# sanitizer build without the 1500-spot cone (slow under ASan)
+unit "$TOP/build/obj/topo_tests/t_topo"
+if [ -x "$TOP/build/asan/topo_tests/t_topo" ]; then
+    "$TOP/build/asan/topo_tests/t_topo" quick > "$WORK/unit.out" 2>&1; rc=$?
+    p=$(grep -c '^PASS' "$WORK/unit.out"); f=$(grep -c '^FAIL' "$WORK/unit.out")
+    PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
+    grep '^FAIL' "$WORK/unit.out" | sed 's|^|asan/t_topo: |'
+    [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || fail "asan t_topo exited $rc"
+else fail "$TOP/build/asan/topo_tests/t_topo (not built)"; fi
+# --cornea-scan: an ordinary toric eye's surface from its slopes (the biconic as the
+# reference), its indices against the true surface's; a coned eye: the model rejected,
+# and a reconstruction that does not follow its data gives no index
+tp_surface() {
+    tp_frames ts 7.8 -0.26 0.75 - || { cat "$TP/ts.err"; return 1; }
+    grep '^Surface from the slopes' "$TP/ts.rec" &&
+    awk '/^Central K/ { ck = $3 } /^True surface.s indices/ { t = $15 }
+         END { d = ck - t; exit !(ck > 40 && d < 0.1 && d > -0.1) }' "$TP/ts.rec" &&
+    grep -q '^Keratoconus screen: within the published thresholds' "$TP/ts.rec"
+}
+check "--cornea-scan: a toric eye's central K from its slopes within 0.1 D of the true surface's, screen normal" tp_surface
+tp_cone() {
+    printf 'biconic\n-\nspiral\n500\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0.1732\n0.1\n2\n0\n0.04\n5\n1\n10\n0.8\n0.4\n-0.7\n-\n' > "$TP/k.in"
+    (cd "$TP" && "$BIN" --cornea-scan -i k.in k.rec > k.out 2> k.err) || { cat "$TP/k.err"; return 1; }
+    grep -q '^MODEL REJECTED\|MODEL REJECTED' "$TP/k.rec" && ! grep -q '^apex radius' "$TP/k.rec" &&
+    if grep -q '^The surface from the slopes does not follow' "$TP/k.rec"; then
+        ! grep -q '^Kmax' "$TP/k.rec"
+    else grep -q '^Keratoconus screen: \(SUSPECT\|KERATOCONUS\)' "$TP/k.rec"; fi
+}
+check "--cornea-scan, a cone: model rejected; indices only from a surface that follows its data" tp_cone
