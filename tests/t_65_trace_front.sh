@@ -344,10 +344,16 @@ open(os.path.join(d, "big.scene"), "w").write(
 open(os.path.join(d, "in"), "w").write("scene\nbig.scene\nn\n")
 p = subprocess.Popen([bin_, "--trace", "-i", "in", "r.rec"], cwd=d,
                      stdout=subprocess.DEVNULL, stderr=open(os.path.join(d, "err"), "w"))
-part = os.path.join(d, "h.csv.part")
+def growing():   # the hits file being written: a unique h.csv.part.XXXXXX (lm_out)
+    for f in os.listdir(d):
+        if f.startswith("h.csv.part"):
+            try:
+                if os.path.getsize(os.path.join(d, f)) > 200000: return True
+            except OSError: pass
+    return False
 t_end = time.time() + 60
 while time.time() < t_end and p.poll() is None:
-    if os.path.exists(part) and os.path.getsize(part) > 200000: break
+    if growing(): break
     time.sleep(0.01)
 fails = []
 if p.poll() is not None: fails.append("the trace ended before the signal (exit %d)" % p.returncode)
