@@ -83,3 +83,75 @@ sf_fold() {
     [ -s "$SF/fo.k" ] && cmp "$SF/fo.k" "$SF/un.k"
 }
 check "--pupil, flat fold: spots and wavefronts as the lens unfolded (3 wavelengths)" sf_fold "$BIN"
+
+# Coordinate breaks.  A 45-degree fold as OpticStudio writes one (fold-coordbrk.zmx
+# with the break's twin after the mirror and the thickness after it negative, made
+# here by awk): break (tilt 45 about x), the flat mirror, break (tilt 45), -18 to the
+# image.  The image is the one the fold at normal incidence gives (singlet-fold.zmx).
+awk 'BEGIN { RS = "\r\n"; ORS = "\r\n" }
+     /^SURF 4/ { m = 1 } m && /^  DISZ/ { $0 = "  DISZ 0" }
+     /^SURF 5/ { m = 0
+                 print "SURF 5"; print "  TYPE COORDBRK"; print "  CURV 0.0 0 0 0 0 \"\""
+                 print "  PARM 1 0"; print "  PARM 2 0"; print "  PARM 3 4.5E+1"
+                 print "  PARM 4 0"; print "  PARM 5 0"; print "  PARM 6 0"
+                 print "  DISZ -1.8E+1"; $0 = "SURF 6" }
+     { print }' "$ZV/fold-coordbrk.zmx" > "$SF/fold45.zmx"
+sf_fold45() {
+    sf_pupil "$1" "$SF/fold45.zmx" f45 6 || { cat "$SF/f45.err"; return 1; }
+    [ -s "$SF/fo.k" ] || sf_pupil "$1" "$ZV/singlet-fold.zmx" fo 6 || return 1
+    grep -E 'spot:|RMS radius|centroid x|RMS .* waves|chief ray:' "$SF/fo.rec" > "$SF/fo.k"
+    grep -q '^Coordinate breaks: 2; ' "$SF/f45.rec" && grep -q '^Mirrors: 1; ' "$SF/f45.rec" &&
+    grep -E 'spot:|RMS radius|centroid x|RMS .* waves|chief ray:' "$SF/f45.rec" > "$SF/f45.k" &&
+    cmp "$SF/fo.k" "$SF/f45.k"
+}
+check "--pupil, 45-degree fold by two COORDBRK: spots and wavefronts as the fold at normal incidence" sf_fold45 "$BIN"
+check "--pupil, 45-degree fold: the same under ASan/UBSan" sf_fold45 "$ASAN"
+
+# Read, written, read: .zmx -> prescription (coordbrk lines) -> .zmx (TYPE COORDBRK,
+# PARM 1-6) -> prescription: a fixed point with the file's numbers.
+sf_cb_back() {
+    (cd "$SF" && "$1" --to-thickness -i fold45.zmx cb.rx 2>/dev/null) &&
+    grep -q '^coordbrk  *0  *decenter 0 0 tilt 45 0 0 order 0$' "$SF/cb.rx" &&
+    grep -q '^coordbrk  *-18  *decenter 0 0 tilt 45 0 0 order 0$' "$SF/cb.rx" || { cat "$SF/cb.rx"; return 1; }
+    (cd "$SF" && "$1" --to-zmx -i cb.rx cb.zmx 2>/dev/null) &&
+    [ "$(grep -c 'TYPE COORDBRK' "$SF/cb.zmx")" -eq 2 ] && grep -q 'PARM 3 45' "$SF/cb.zmx" &&
+    grep -q 'DISZ -18' "$SF/cb.zmx" || { cat "$SF/cb.zmx"; return 1; }
+    (cd "$SF" && "$1" --to-thickness -i cb.zmx cb2.rx 2>/dev/null && "$1" --to-zmx -i cb2.rx cb2.zmx 2>/dev/null) &&
+    cmp "$SF/cb.rx" "$SF/cb2.rx" && cmp "$SF/cb.zmx" "$SF/cb2.zmx"
+}
+check "COORDBRK read -> prescription -> .zmx -> read: the same numbers (fixed point)" sf_cb_back "$BIN"
+
+# A lens decentred by 0.5 mm (a break, the lens, the inverse break: order 1, negated):
+# the axis point images on the lens's own axis, 0.5 off the old one (the chief ray
+# runs down the lens's axis), while first order takes the break as zero (0) and says so.
+cat > "$SF/dec.rx" <<'RX'
+thickness
+title plano-convex f 1000 decentred 0.5
+unit mm
+wavelengths d
+epd 10
+field angle 0
+index air
+coordbrk  0    decenter 0 0.5
+500       2    1.5  stop
+plane     0    air
+coordbrk  998  decenter 0 -0.5 order 1
+RX
+sf_dec() {
+    sf_pupil "$1" "$SF/dec.rx" de 2 || { cat "$SF/de.err"; return 1; }
+    grep -q '^Coordinate breaks: 2; first-order data .* with every tilt and decentre zero' "$SF/de.rec" &&
+    grep -q 'chief ray: paraxial image height 0 (0 at the image plane), real 0.5 ' "$SF/de.rec" &&
+    grep -q 'centroid x 0 y 0.5' "$SF/de.rec" || { cat "$SF/de.rec"; return 1; }
+}
+check "--pupil, a lens decentred 0.5: the image 0.5 off the axis; first order says it takes the break as zero" sf_dec "$BIN"
+
+# Refused: a coordinate break as the stop, a bad order, a bad key (FILE:LINE, exit 2).
+sf_cb_bad() {
+    printf 'thickness\nepd 10\nindex air\n50 5 N-BK7\ncoordbrk 0 tilt 1 0 0 order 2\n-50 40 air\n' > "$SF/bad1.rx"
+    (cd "$SF" && "$1" --prescription -i bad1.rx b1.rec > /dev/null 2> b1.err); [ $? -eq 2 ] &&
+    grep -q 'bad1.rx:5: order: 0 (decentre, then tilt) or 1' "$SF/b1.err" || { cat "$SF/b1.err"; return 1; }
+    printf 'thickness\nepd 10\nindex air\n50 5 N-BK7\ncoordbrk 0 twist 1\n-50 40 air\n' > "$SF/bad2.rx"
+    (cd "$SF" && "$1" --prescription -i bad2.rx b2.rec > /dev/null 2> b2.err); [ $? -eq 2 ] &&
+    grep -q "bad2.rx:5: 'twist' is not a coordinate-break key" "$SF/b2.err" || { cat "$SF/b2.err"; return 1; }
+}
+check "bad coordinate breaks refused with FILE:LINE (order 2, an unknown key)" sf_cb_bad "$BIN"

@@ -324,6 +324,11 @@ static int build_rx(pdlg *d, wl_ctx *w, double lambda, double r_stop, double z_i
         for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
         t->semi_diameter = s->semi;
         t->mirror = s->mirror;
+        t->coordbrk = s->coordbrk;
+        t->order = s->cb_order;
+        t->decenter[0] = s->cb_dec[0];
+        t->decenter[1] = s->cb_dec[1];
+        for (int k = 0; k < 3; k++) t->tilt[k] = s->cb_tilt[k];
         if (ln_index(l, i, lambda, &t->n_right, NULL, why, cap) != LN_OK) return -1;
         z += s->t;
     }
@@ -630,16 +635,17 @@ static int compute(pdlg *d)
     wl_ctx *w;
     px_pupil prim;
     double lp = ln_primary(l), z_image, zl = 0, fbig = 0;
-    int nwl = l->nwl ? l->nwl : 1, rc = LM_GO, nm = ln_mirrors(l);
+    int nwl = l->nwl ? l->nwl : 1, rc = LM_GO, nm = ln_mirrors(l), nb = ln_breaks(l);
     d->sig = nm % 2 ? -1 : 1;
-    if (nm) {
+    if (nm || nb) {
         if (ln_unfold(l, &d->unf, &d->map, why, sizeof why) != LN_OK) return refuse(d, why);
         if (d->unf.nsurf > PX_PUPIL_MAXSURF) {
             snprintf(why, sizeof why, "%d surfaces unfolded: at most %d", d->unf.nsurf,
                      PX_PUPIL_MAXSURF);
             return refuse(d, why);
         }
-        calc_say(&d->c, P(UNFOLDED), nm);
+        if (nm) calc_say(&d->c, P(UNFOLDED), nm);
+        if (nb) calc_say(&d->c, P(BREAKS), nb);
     }
     for (int i = 0; i + 1 < plens(d)->nsurf; i++) d->zl_u += plens(d)->surf[i].t;
     if (ln_to_csurf(plens(d), cs, names, &obj, why, sizeof why) != LN_OK) return refuse(d, why);
