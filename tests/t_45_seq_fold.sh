@@ -155,3 +155,14 @@ sf_cb_bad() {
     grep -q "bad2.rx:5: 'twist' is not a coordinate-break key" "$SF/b2.err" || { cat "$SF/b2.err"; return 1; }
 }
 check "bad coordinate breaks refused with FILE:LINE (order 2, an unknown key)" sf_cb_bad "$BIN"
+
+# The design module (optimisation, tolerancing) takes centred refracting lenses only:
+# a folded one is refused at its mirror's line, not traced as if it refracted.
+sf_design_refuses() {
+    printf 'tol t 2 0.1\n' > "$SF/c.tol"
+    printf '%s\n%s\nsens\n' "$SF/cass.rx" "$SF/c.tol" > "$SF/ct.in"
+    (cd "$SF" && "$1" --tolerance -i ct.in ct.rec > /dev/null 2> ct.err); [ $? -eq 2 ] &&
+    grep -q "cass.rx:8: surface 1 is a mirror: optimisation and tolerancing take centred refracting lenses only" "$SF/ct.err" ||
+        { cat "$SF/ct.err"; return 1; }
+}
+check "--tolerance on a Cassegrain: refused at the mirror's line (the design module is centred, refracting)" sf_design_refuses "$BIN"
