@@ -124,13 +124,17 @@ check "mirrors write back: .zmx -> prescription (mirror key, -18) -> .zmx (GLAS 
 zv_pupil_mirror() {
     printf '%s\nhex\n1\nn\n' "$ZV/mirror-concave.zmx" > "$WORK/pm.in"
     (cd "$WORK" && "$BIN" --pupil -i pm.in pm.rec > pm.out 2> pm.err); rc=$?
-    [ $rc -eq 2 ] && grep -q "surface 1 is a mirror: pupils, colour and Seidel sums here take refracting surfaces only" "$WORK/pm.err"
+    # since the sequential trace reflects (tests/t_45_seq_fold.sh): traced, not refused
+    [ $rc -eq 0 ] && grep -q "^Mirrors: 1; first-order data from the lens unfolded" "$WORK/pm.rec" &&
+        grep -q "^  efl 100, " "$WORK/pm.rec"
 }
-check "--pupil on a mirror says why it stops (exit 2)" zv_pupil_mirror
+check "--pupil on a mirror traces it (first order unfolded: efl 100)" zv_pupil_mirror
 
 # 5. coordinate breaks: a 45-degree tilt refused at its PARM line; an empty one skipped
-check "a coordinate break that tilts is refused at its PARM line" zv_refuse "$BIN" \
-    "$ZV/fold-coordbrk.zmx" "fold-coordbrk.zmx:93: surface 3: a coordinate break (TYPE COORDBRK) that decentres by x 0, y 0 and tilts by 45, 0, 0 degrees"
+# since coordinate breaks are read (tests/t_45_seq_fold.sh), this file is refused for
+# its DISZ 18 after the mirror (OpticStudio's thicknesses after a mirror are negative)
+check "a tilted fold with a positive DISZ after its mirror is refused at that line" zv_refuse "$BIN" \
+    "$ZV/fold-coordbrk.zmx" "fold-coordbrk.zmx:106: DISZ 18: a positive thickness where the light travels toward -z"
 zv_cb_zero() {
     a=$(focal_of "$BIN" "$ZV/singlet-coordbrk-zero.zmx")
     grep -q "singlet-coordbrk-zero.zmx:85: surface 3: a coordinate break with no decentre or tilt is skipped (its thickness 18 joins the gap before it)" "$WORK/fo.err" ||

@@ -35,6 +35,13 @@ static int index_at(const ds_problem *p, const ln_lens *l, int i, double lambda,
 int ds_setup(ds_problem *p, const ln_lens *l, ds_wl *w, int nwl, char *why, size_t cap)
 {
     double z_prim_stop = 0;
+    for (int i = 0; i < l->nsurf; i++)     /* ds_setup's rx and pupils are centred, refracting */
+        if (l->surf[i].mirror || l->surf[i].coordbrk) {
+            snprintf(why, cap, "surface %d is a %s: optimisation and tolerancing take "
+                     "centred refracting lenses only (--pupil traces folded and tilted ones)",
+                     i + 1, l->surf[i].mirror ? "mirror" : "coordinate break");
+            return -1;
+        }
     for (int k = 0; k < nwl; k++) {
         ds_wl *x = &w[k];
         double z = 0;

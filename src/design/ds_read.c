@@ -487,6 +487,12 @@ int ds_read(const char *lens_text, size_t lens_len, const char *lens_src,
     if (rc == LN_OK) rc = ln_check(&p->lens, lens_src, err, cap) == LN_OK ? DS_OK : DS_BAD;
     if (rc == DS_OK && p->lens.nsurf > DS_MAXSURF)
         rc = fail(err, cap, lens_src, 0, "%d surfaces: at most %d", p->lens.nsurf, DS_MAXSURF);
+    for (int i = 0; rc == DS_OK && i < p->lens.nsurf; i++)     /* ds_setup: centred, refracting */
+        if (p->lens.surf[i].mirror || p->lens.surf[i].coordbrk)
+            rc = fail(err, cap, lens_src, p->lens.surf[i].line, "surface %d is a %s: "
+                      "optimisation and tolerancing take centred refracting lenses only "
+                      "(--pupil traces folded and tilted ones)", i + 1,
+                      p->lens.surf[i].mirror ? "mirror" : "coordinate break");
     if (rc == DS_OK && clean) rc = read_lines(p, lens_text, lens_len, lens_src, 1, err, cap);
     free(clean);
     if (rc == DS_OK && merit_text)

@@ -37,7 +37,19 @@ typedef struct pdlg {
     int nsamp;
     double spx[MAXSAMPLE], spy[MAXSAMPLE];
     double scale;              /* the lens's size: below 1e-13 of it a result is 0 */
+    /* A folded lens (mirrors): first-order data from it unfolded (ln_unfold), real rays
+     * traced folded.  unf: the unfolded lens (nsurf 0: no mirror), map[k] its surface
+     * k's surface in the file; zl, zl_u: the last surface's z, folded and unfolded;
+     * sig: -1 when light leaves it going -z. */
+    ln_lens unf;
+    int *map;
+    double zl, zl_u, sig;
 } pdlg;
+
+/* The lens the paraxial engine sees. */
+static const ln_lens *plens(const pdlg *d) { return d->unf.nsurf ? &d->unf : &d->lens; }
+/* An image-space position along the unfolded axis as the folded lens's z. */
+static double real_z(const pdlg *d, double u) { return d->zl + d->sig * (u - d->zl_u); }
 
 /* A centroid or a height that is zero but for rounding (1e-17 on the axis) prints as
  * 0: the same on every build and in every replay. */
@@ -283,7 +295,7 @@ typedef struct wl_ctx {
 static int pupil_at(pdlg *d, const px_csurf *cs, const char *obj, double lambda, px_pupil *p,
                     char *why, size_t cap)
 {
-    const ln_lens *l = &d->lens;
+    const ln_lens *l = plens(d);
     px_pupil_in in = {cs, l->nsurf, l->stop, obj, lambda, PX_AP_EPD, l->ap_value,
                       isinf(l->object) ? INFINITY : l->object, isinf(l->object) ? 45 : 1};
     in.aperture = l->ap_kind == LN_AP_FNUM ? PX_AP_FNUM : l->ap_kind == LN_AP_NA ? PX_AP_NA
@@ -311,6 +323,12 @@ static int build_rx(pdlg *d, wl_ctx *w, double lambda, double r_stop, double z_i
         t->nasph = s->nasph < TRACE_MAXASPH ? s->nasph : TRACE_MAXASPH;
         for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
         t->semi_diameter = s->semi;
+        t->mirror = s->mirror;
+        t->coordbrk = s->coordbrk;
+        t->order = s->cb_order;
+        t->decenter[0] = s->cb_dec[0];
+        t->decenter[1] = s->cb_dec[1];
+        for (int k = 0; k < 3; k++) t->tilt[k] = s->cb_tilt[k];
         if (ln_index(l, i, lambda, &t->n_right, NULL, why, cap) != LN_OK) return -1;
         z += s->t;
     }
@@ -410,8 +428,8 @@ static void wavefront_init(const pdlg *d, const wl_ctx *w, const trace_aim_ray *
 {
     const px_pupil *p = &w->p;
     memset(wf, 0, sizeof *wf);
-    if (!isfinite(p->z_xp) || !(chief->img_dir[2] > 0)) return;
-    double t = (p->z_xp - chief->img[2]) / chief->img_dir[2];
+    if (!isfinite(p->z_xp) || chief->img_dir[2] == 0) return;
+    double t = (real_z(d, p->z_xp) - chief->img[2]) / chief->img_dir[2];
     if (!(fabs(t) > 0)) return;
     wf->inf = isinf(d->lens.object);
     memcpy(wf->c, chief->img, sizeof wf->c);
@@ -432,7 +450,7 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
     const px_pupil *p = &w->p;
     trace_aim_ray chief, r;
     aim_tally t = {0, 0};
-    int N = l->nsurf - 1, inf = isinf(l->object), nok = 0, nvig = 0;
+    int N = plens(d)->nsurf - 1, inf = isinf(l->object), nok = 0, nvig = 0;
     double sx = 0, sy = 0, sc = 0;
     double fx = inf ? tan(f->x * DEG) : f->x, fy = inf ? tan(f->y * DEG) : f->y;
     char dist[32], hp[64], hi[64], hr[64];
@@ -452,7 +470,8 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
      * real rays are carried to (the distortion compares the real one with this,
      * radially); x and y are separate paraxial rays, both the unit chief ray scaled */
     {
-        double unit = p->yb[N] + p->ub[N + 1] * (w->rx.z_image - p->z[N]);
+        double zi = d->zl_u + d->sig * (w->rx.z_image - d->zl);   /* unfolded */
+        double unit = p->yb[N] + p->ub[N + 1] * (zi - p->z[N]);
         double px_ = fx * unit, py_ = fy * unit, rp = hypot(px_, py_);
         double rr = hypot(chief.img[0], chief.img[1]);
         if (snap(d, rp) != 0) snprintf(dist, sizeof dist, "%.4g %%", CL(100 * (rr - rp) / rp));
@@ -538,23 +557,29 @@ static void report_pupil(pdlg *d, const wl_ctx *w, double fbig)
 {
     const px_pupil *p = &w->p;
     const ln_lens *l = &d->lens;
-    int inf = isinf(l->object), N = l->nsurf - 1;
+    int inf = isinf(l->object), N = plens(d)->nsurf - 1;
     double k = inf ? tan(fbig * DEG) : fbig;
     char a[32], b[32], c[32], e[32];
     calc_say(&d->c, P(FIRST), CL(p->efl), fmt_num(a, sizeof a, p->fnum),
              fmt_num(b, sizeof b, p->work_fnum), CL(p->na_obj), CL(p->na_img));
     calc_say(&d->c, P(PUPILS), fmt_len(a, sizeof a, p->z_ep),
-             fmt_len(b, sizeof b, 2 * p->r_ep * w->s), fmt_len(c, sizeof c, p->z_xp),
+             fmt_len(b, sizeof b, 2 * p->r_ep * w->s),
+             fmt_len(c, sizeof c, isfinite(p->z_xp) ? real_z(d, p->z_xp) : p->z_xp),
              fmt_len(e, sizeof e, 2 * p->r_xp * w->s), CL(p->r_stop * w->s));
     if (inf || !isfinite(p->mag)) snprintf(b, sizeof b, "-");
     else snprintf(b, sizeof b, "%.6g", CL(p->mag));
-    calc_say(&d->c, P(IMAGE), fmt_len(a, sizeof a, p->z_img), b, CL(p->lagrange * w->s * k));
+    calc_say(&d->c, P(IMAGE), fmt_len(a, sizeof a, isfinite(p->z_img) ? real_z(d, p->z_img)
+                                                   : p->z_img), b, CL(p->lagrange * w->s * k));
     calc_say(&d->c, P(RAYS_HEAD), fbig);
     snprintf(a, sizeof a, "-");
     calc_say(&d->c, P(RAYS_OBJ), a, CL(p->u[0] * w->s), a, CL(p->ub[0] * k));
-    for (int i = 0; i <= N; i++)
-        calc_say(&d->c, P(RAYS_ROW), i + 1, CL(p->y[i] * w->s), CL(p->u[i + 1] * w->s),
+    for (int i = 0; i <= N; i++) {
+        /* a mirror is two unfolded surfaces: its row is the second (the rays leaving it,
+         * slopes along the unfolded axis) */
+        if (d->map && i < N && d->map[i + 1] == d->map[i]) continue;
+        calc_say(&d->c, P(RAYS_ROW), d->map ? d->map[i] + 1 : i + 1, CL(p->y[i] * w->s), CL(p->u[i + 1] * w->s),
                  CL(p->yb[i] * k), CL(p->ub[i + 1] * k));
+    }
 }
 
 static int need_engine(pdlg *d)
@@ -610,14 +635,27 @@ static int compute(pdlg *d)
     wl_ctx *w;
     px_pupil prim;
     double lp = ln_primary(l), z_image, zl = 0, fbig = 0;
-    int nwl = l->nwl ? l->nwl : 1, rc = LM_GO;
-    if (ln_to_csurf(l, cs, names, &obj, why, sizeof why) != LN_OK) return refuse(d, why);
+    int nwl = l->nwl ? l->nwl : 1, rc = LM_GO, nm = ln_mirrors(l), nb = ln_breaks(l);
+    d->sig = nm % 2 ? -1 : 1;
+    if (nm || nb) {
+        if (ln_unfold(l, &d->unf, &d->map, why, sizeof why) != LN_OK) return refuse(d, why);
+        if (d->unf.nsurf > PX_PUPIL_MAXSURF) {
+            snprintf(why, sizeof why, "%d surfaces unfolded: at most %d", d->unf.nsurf,
+                     PX_PUPIL_MAXSURF);
+            return refuse(d, why);
+        }
+        if (nm) calc_say(&d->c, P(UNFOLDED), nm);
+        if (nb) calc_say(&d->c, P(BREAKS), nb);
+    }
+    for (int i = 0; i + 1 < plens(d)->nsurf; i++) d->zl_u += plens(d)->surf[i].t;
+    if (ln_to_csurf(plens(d), cs, names, &obj, why, sizeof why) != LN_OK) return refuse(d, why);
     if (pupil_at(d, cs, obj, lp, &prim, why, sizeof why)) return refuse(d, why);
     d->scale = fmax(fabs(prim.efl), prim.r_stop);
     if (!isinf(l->object) && l->nfield && l->field_kind == LN_FIELD_ANGLE &&
         (rc = angles_to_heights(d, &prim)) != LM_GO)
         return rc;
     for (int i = 0; i + 1 < l->nsurf; i++) zl += l->surf[i].t;
+    d->zl = zl;
     for (int i = 0; i < l->nfield; i++)
         if (fabs(l->field[i].y) > fabs(fbig)) fbig = l->field[i].y;
     if (isinf(l->object)) snprintf(ob, sizeof ob, "%s", P(OBJ_INF));
@@ -631,12 +669,12 @@ static int compute(pdlg *d)
     calc_say(&d->c, P(HEAD), l->title[0] ? l->title : "(untitled)", l->nsurf, l->stop + 1,
              l->ap_kind == LN_AP_FNUM ? "f-number" : l->ap_kind == LN_AP_NA ? "NA" : "EPD",
              l->ap_value, ob, l->nfield, l->nfield == 1 ? "" : "s", nwl, nwl == 1 ? "" : "s");
-    if (l->surf[l->nsurf - 1].t > 0) {
+    if (l->surf[l->nsurf - 1].t * d->sig > 0) {   /* after odd mirrors: negative */
         z_image = zl + l->surf[l->nsurf - 1].t;
         calc_say(&d->c, P(IMAGE_FILE), z_image, d->c.uname);
     } else {
         if (!isfinite(prim.z_img)) return refuse(d, P(NO_IMAGE));
-        z_image = prim.z_img;
+        z_image = real_z(d, prim.z_img);
         calc_say(&d->c, P(IMAGE_PARAXIAL), CL(z_image), d->c.uname, lp * 1000);
     }
     calc_say(&d->c, P(SAMPLING_ECHO), d->sampling ? "hexapolar" : "grid", d->nsamp);
@@ -664,6 +702,7 @@ int lm_pupil(lm_io *io)
     char name[WORD];
     int rc;
     memset(d, 0, sizeof *d);
+    ln_init(&d->unf);
     d->io = io;
     d->c.io = io;
     d->c.unit = PX_MM;
@@ -688,6 +727,8 @@ int lm_pupil(lm_io *io)
     }
     if (rc == LM_GO) rc = calc_done(&d->c);
     if (d->have) ln_free(&d->lens);
+    ln_free(&d->unf);
+    free(d->map);
     ln_notes_free(&d->notes);
     return rc;
 }

@@ -183,6 +183,13 @@ int ln_check(const ln_lens *l, const char *src, char *err, size_t cap)
     }
     for (int i = 0, sigma = 1; i < l->nsurf; i++) {
         const ln_surface *s = &l->surf[i];
+        if (s->coordbrk && (s->mirror || i == l->stop || (s->cb_order != 0 && s->cb_order != 1) ||
+                            !isfinite(s->cb_dec[0]) || !isfinite(s->cb_dec[1]) ||
+                            !isfinite(s->cb_tilt[0]) || !isfinite(s->cb_tilt[1]) ||
+                            !isfinite(s->cb_tilt[2])))
+            return fail(err, cap, src, s->line, "%sa coordinate break (surface %g) needs "
+                        "finite decentres and tilts, order 0 or 1, and is neither a mirror "
+                        "nor the stop", "", i + 1);
         if (s->mirror) {
             const char *before = i ? l->surf[i - 1].glass : l->obj_glass;
             sigma = -sigma;

@@ -58,6 +58,16 @@ typedef struct ln_surface {
      * after an odd number of mirrors are negative (OpticStudio's convention: z is
      * never flipped).  Mirrors in air only (ln_check). */
     int mirror;
+    /* 1: not a surface but a coordinate break (.zmx TYPE COORDBRK, a prescription's
+     * `coordbrk` line): the surfaces after it are given in a frame decentred by
+     * cb_dec (x, y) and tilted by cb_tilt (degrees about x, y, z), cb_order 0:
+     * decentre then tilt x, y, z; 1: tilt z, y, x then decentre (OpticStudio's PARM
+     * 1-6; the trace engine's trace_rx_surface has the conventions).  Its `t` is the
+     * thickness after it, its glass the medium it stands in (set by the readers);
+     * radius, conic, semi-diameter are not used.  First-order optics takes every break
+     * as zero (the on-axis parts: ln_unfold). */
+    int coordbrk, cb_order;
+    double cb_dec[2], cb_tilt[3];
 } ln_surface;
 
 /* Aperture kinds. */
@@ -169,8 +179,12 @@ int ln_paraxial(const ln_lens *l, double lambda_um, struct px_system *s, char *e
 double ln_paraxial_curvature(const ln_surface *s);
 /* How many surfaces reflect. */
 int ln_mirrors(const ln_lens *l);
+/* How many coordinate breaks the lens holds. */
+int ln_breaks(const ln_lens *l);
 /* The lens unfolded (lens_paraxial.c): the same first-order optics with every mirror
- * replaced by refracting surfaces, light always going +z.  A mirror of paraxial
+ * replaced by refracting surfaces, light always going +z.  Coordinate breaks are
+ * dropped (their thickness joins the gap before them): first-order data are those of
+ * the lens with every tilt and decentre zero.  A mirror of paraxial
  * radius R in air (power -2/R as it faces the light) becomes a surface of radius -R/2
  * into a medium of index 2 and a plane back into air at the same place (power
  * (2 - 1)/(-R/2) = -2/R); the surfaces after an odd number of mirrors have their

@@ -43,6 +43,13 @@ int ln_mirrors(const ln_lens *l)
     return k;
 }
 
+int ln_breaks(const ln_lens *l)
+{
+    int k = 0;
+    for (int i = 0; i < l->nsurf; i++) k += l->surf[i].coordbrk != 0;
+    return k;
+}
+
 int ln_unfold(const ln_lens *l, ln_lens *out, int **map, char *err, size_t cap)
 {
     int sigma = 1, *m = NULL, k = 0;
@@ -53,6 +60,12 @@ int ln_unfold(const ln_lens *l, ln_lens *out, int **map, char *err, size_t cap)
     if (map && !(m = malloc(sizeof *m * (size_t)(2 * l->nsurf + 1)))) goto nomem;
     for (int i = 0; i < l->nsurf; i++) {
         ln_surface s = l->surf[i], *d;
+        if (s.coordbrk) {               /* the on-axis part: nothing; t joins the gap */
+            if (k) out->surf[k - 1].t += s.t * sigma;
+            else if (isfinite(out->object)) out->object += s.t;
+            if (l->stop == i) out->stop = -1;
+            continue;
+        }
         if (s.mirror) {
             const char *before = i ? l->surf[i - 1].glass : l->obj_glass;
             double c = ln_paraxial_curvature(&s) * sigma;
@@ -115,6 +128,12 @@ int ln_to_csurf(const ln_lens *l, struct px_csurf *out, char (*names)[LN_NAME_MA
 {
     if (l->nsurf < 1) { snprintf(err, cap, "no surface"); return LN_BAD; }
     for (int i = 0; i < l->nsurf; i++)
+        if (l->surf[i].coordbrk) {
+            snprintf(err, cap, "surface %d is a coordinate break: pupils, colour and "
+                     "Seidel sums take the lens without it (ln_unfold)", i + 1);
+            return LN_BAD;
+        }
+    for (int i = 0; i < l->nsurf; i++)
         if (l->surf[i].mirror) {
             snprintf(err, cap, "surface %d is a mirror: pupils, colour and Seidel sums "
                      "here take refracting surfaces only (the lens's first-order data, "
@@ -137,7 +156,7 @@ int ln_paraxial(const ln_lens *l, double lambda, struct px_system *s, char *err,
     char why[LN_ERR_MAX];
     int r;
     if (l->nsurf < 1) { snprintf(err, cap, "no surface"); return LN_BAD; }
-    if (ln_mirrors(l)) {
+    if (ln_mirrors(l) || ln_breaks(l)) {
         ln_lens u;
         if ((r = ln_unfold(l, &u, NULL, err, cap)) != LN_OK) return r;
         r = ln_paraxial(&u, lambda, s, err, cap);

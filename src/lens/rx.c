@@ -211,6 +211,43 @@ static int surface_keys(rd *r, ln_surface *s, char **tok, int n)
     return LN_OK;
 }
 
+/* coordbrk THICKNESS [decenter X Y] [tilt A B C] [order 0|1]: a coordinate break in
+ * the medium before it (lens.h's ln_surface). */
+static int coordbrk(rd *r, char **tok, int n)
+{
+    ln_lens *l = r->l;
+    ln_surface *s;
+    double t;
+    if (n < 2) return bad(r, "coordbrk THICKNESS [decenter X Y] [tilt A B C] [order 0|1]");
+    if (number(r, "the thickness", tok[1], 0, &t)) return LN_BAD;
+    if (!(s = ln_add_surface(l))) return bad(r, "out of memory");
+    s->line = r->line;
+    s->t = t;
+    s->coordbrk = 1;
+    if (l->nsurf > 1) {
+        strcpy(s->glass, l->surf[l->nsurf - 2].glass);
+        s->nd = l->surf[l->nsurf - 2].nd;
+        s->vd = l->surf[l->nsurf - 2].vd;
+    } else strcpy(s->glass, l->obj_glass);
+    for (int i = 2; i < n; i++) {
+        const char *k = tok[i];
+        int m = !strcmp(k, "decenter") ? 2 : !strcmp(k, "tilt") ? 3 : !strcmp(k, "order") ? 1 : 0;
+        double v[3];
+        if (!m) return bad(r, "'%s' is not a coordinate-break key (decenter X Y, tilt A B C, "
+                           "order 0|1)", k);
+        if (i + m >= n) return bad(r, "'%s' needs %d value%s", k, m, m > 1 ? "s" : "");
+        for (int j = 0; j < m; j++)
+            if (number(r, k, tok[i + 1 + j], 0, &v[j])) return LN_BAD;
+        if (m == 2) { s->cb_dec[0] = v[0]; s->cb_dec[1] = v[1]; }
+        else if (m == 3) memcpy(s->cb_tilt, v, sizeof s->cb_tilt);
+        else if (v[0] != 0 && v[0] != 1) return bad(r, "order: 0 (decentre, then tilt) or 1 "
+                                                    "(tilt, then decentre)");
+        else s->cb_order = (int)v[0];
+        i += m;
+    }
+    return LN_OK;
+}
+
 static int surface(rd *r, char **tok, int n)
 {
     ln_lens *l = r->l;
@@ -218,6 +255,7 @@ static int surface(rd *r, char **tok, int n)
     double rad, t;
     if (r->have_image) return bad(r, "surfaces must come before the image line");
     if (!r->thick && l->nplanes) return bad(r, "surfaces must come before the object lines");
+    if (r->thick && !strcmp(tok[0], "coordbrk")) return coordbrk(r, tok, n);
     if (n < 3 || (!r->thick && n != 3))
         return bad(r, r->thick ? "a surface line needs radius, thickness, glass (then "
                    "optional keys)" : "a surface line needs three numbers: radius, "
@@ -564,6 +602,18 @@ char *ln_write_rx(const ln_lens *l)
     }
     for (int i = 0; i < l->nsurf; i++) {
         const ln_surface *s = &l->surf[i];
+        if (s->coordbrk) {
+            char e[32], f[32];
+            ln_format(s->t, c, sizeof c);
+            ln_format(s->cb_dec[0], a, sizeof a);
+            ln_format(s->cb_dec[1], e, sizeof e);
+            ln_buf_printf(&b, "%-24s %-24s decenter %s %s", "coordbrk", c, a, e);
+            ln_format(s->cb_tilt[0], a, sizeof a);
+            ln_format(s->cb_tilt[1], e, sizeof e);
+            ln_format(s->cb_tilt[2], f, sizeof f);
+            ln_buf_printf(&b, " tilt %s %s %s order %d\n", a, e, f, s->cb_order);
+            continue;
+        }
         ln_format_radius(s, a, sizeof a);
         ln_format(s->t, c, sizeof c);
         ln_buf_printf(&b, "%-24s %-24s %s", a, c, s->glass[0] ? s->glass : "air");

@@ -444,7 +444,6 @@ static int assemble(zr *r)
     }
     for (int i = 1, sigma = 1; i < r->nz - 1; i++) {    /* thickness signs: by DISZ line */
         double t = r->zs[i].s.t;
-        if (r->zs[i].cb && r->zs[i].cb_line) break;     /* refused below, at its PARM */
         if (r->zs[i].s.mirror) sigma = -sigma;
         if (sigma > 0 ? t < 0 : t > 0) {
             char a[32];
@@ -460,13 +459,33 @@ static int assemble(zr *r)
         ln_surface *s;
         if (r->zs[i].cb) {
             zsurf *z = &r->zs[i];
-            if (z->cb_line) {
-                r->line = z->cb_line;
-                return zbad(r, "surface %d: a coordinate break (TYPE COORDBRK) that decentres "
-                            "by x %g, y %g and tilts by %g, %g, %g degrees about x, y, z: "
-                            "the lens model is one rotationally symmetric axis, so tilted and "
-                            "decentred parts are refused rather than read as centred", i,
-                            z->cbp[0], z->cbp[1], z->cbp[2], z->cbp[3], z->cbp[4]);
+            if (z->cb_line) {            /* a frame for the surfaces after it */
+                if (!(s = ln_add_surface(l))) {
+                    snprintf(r->err, r->cap, "%s: out of memory", r->src);
+                    return LN_NOMEM;
+                }
+                memset(s, 0, sizeof *s);
+                s->type = LN_STANDARD;
+                ln_set_curvature(s, 0);
+                s->line = z->s.line;
+                s->t = z->s.t;
+                s->coordbrk = 1;
+                s->cb_dec[0] = z->cbp[0];
+                s->cb_dec[1] = z->cbp[1];
+                for (int j = 0; j < 3; j++) s->cb_tilt[j] = z->cbp[2 + j];
+                s->cb_order = z->cbp[5] != 0;   /* OpticStudio: any non-zero order flag */
+                if (l->nsurf > 1) {             /* it stands in the medium before it */
+                    strcpy(s->glass, l->surf[l->nsurf - 2].glass);
+                    s->nd = l->surf[l->nsurf - 2].nd;
+                    s->vd = l->surf[l->nsurf - 2].vd;
+                } else {
+                    strcpy(s->glass, l->obj_glass);
+                    s->nd = l->obj_nd;
+                    s->vd = l->obj_vd;
+                }
+                if (z->stop) ln_note(r->notes, r->src, z->s.line, "surface %d: the stop on "
+                                     "a coordinate break is skipped", i);
+                continue;
             }
             /* a break that moves nothing (files keep them as placeholders): its
              * thickness joins the gap before it */
@@ -630,6 +649,18 @@ static void write_surface(ln_buf *b, int k, const ln_surface *s, int stop, doubl
 {
     char a[40];
     ln_buf_printf(b, "SURF %d\r\n", k);
+    if (s->coordbrk) {                  /* PARM 1-6: decentre x, y, tilt x, y, z, order */
+        double p[6] = {s->cb_dec[0], s->cb_dec[1], s->cb_tilt[0], s->cb_tilt[1],
+                       s->cb_tilt[2], s->cb_order};
+        ln_buf_printf(b, "  TYPE COORDBRK\r\n  CURV 0 0 0 0 0 \"\"\r\n");
+        for (int i = 0; i < 6; i++) {
+            ln_format(p[i], a, sizeof a);
+            ln_buf_printf(b, "  PARM %d %s\r\n", i + 1, a);
+        }
+        zfmt(disz, a, sizeof a);
+        ln_buf_printf(b, "  DISZ %s\r\n", a);
+        return;
+    }
     if (stop) ln_buf_printf(b, "  STOP\r\n");
     ln_buf_printf(b, "  TYPE %s\r\n", s->type == LN_EVENASPH ? "EVENASPH" : "STANDARD");
     ln_format(s->c, a, sizeof a);

@@ -8,7 +8,20 @@
  * totally reflected -- an evaluation that fails.  GSL's solvers give up on a failed
  * evaluation (GSL_EBADFUNC); here the step is halved until the trial ray traces and
  * the residual falls, which is what brings a wide-angle ray in from a paraxial guess
- * that misses the stop by a large fraction of its size. */
+ * that misses the stop by a large fraction of its size.
+ *
+ * Folded and tilted systems (ABI 2).  A mirror reflects (d - 2 (d.n) n, the normal of
+ * the same conic or asphere a refracting surface uses); z then runs backwards, as
+ * OpticStudio's negative thicknesses after a mirror say, so planes and the image
+ * plane are crossed forwards or backwards alike.  A coordinate break moves the frame
+ * the following surfaces are given in: the ray (point and direction) is taken into
+ * the new frame there and traced on in it, so every crossing, the stop target and
+ * the image point are in the local frame of their surface.  The new frame's axes are
+ * the old ones turned right-handed about x by tilt[0], then about the new y, then
+ * the new z (order 0, after the decentre), or about z, new y, new x and then
+ * decentred along the turned axes (order 1): order 1 with every value negated undoes
+ * an order-0 break exactly (OpticStudio's convention).  Its origin keeps the z the
+ * break stands at, so thicknesses run on across it. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -19,8 +32,49 @@ typedef struct aim_sys {
     const trace_rx *rx;
     tr_shape *g;               /* one shape per surface, unbounded by clear apertures */
     int *plane;                /* 1: a plane (crossed in closed form, t >= 0 kept) */
+    double (*rot)[9];          /* a coordinate break's M (new axes as columns) */
     double scale;              /* the system's size */
 } aim_sys;
+
+#define AIM_DEG (3.14159265358979323846 / 180)
+
+/* a = a * (rotation by deg about axis i), both row-major 3x3 */
+static void turn(double a[9], int i, double deg)
+{
+    double c = cos(deg * AIM_DEG), s = sin(deg * AIM_DEG), r[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1},
+           o[9];
+    int j = (i + 1) % 3, k = (i + 2) % 3;
+    if (deg == 0) return;
+    r[3 * j + j] = c; r[3 * j + k] = -s;
+    r[3 * k + j] = s; r[3 * k + k] = c;
+    for (int p = 0; p < 3; p++)
+        for (int q = 0; q < 3; q++)
+            o[3 * p + q] = a[3 * p] * r[q] + a[3 * p + 1] * r[3 + q] + a[3 * p + 2] * r[6 + q];
+    memcpy(a, o, sizeof o);
+}
+
+static void break_matrix(const trace_rx_surface *s, double m[9])
+{
+    static const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    memcpy(m, id, sizeof id);
+    if (s->order == 0) for (int i = 0; i < 3; i++) turn(m, i, s->tilt[i]);
+    else for (int i = 2; i >= 0; i--) turn(m, i, s->tilt[i]);
+}
+
+/* The ray o, d into the frame after break s (matrix m). */
+static void break_apply(const trace_rx_surface *s, const double m[9], double o[3],
+                        double d[3])
+{
+    double p[3] = {o[0], o[1], o[2] - s->z}, q[3], e[3];
+    if (s->order == 0) { p[0] -= s->decenter[0]; p[1] -= s->decenter[1]; }
+    for (int i = 0; i < 3; i++) {            /* M^T p, M^T d */
+        q[i] = m[i] * p[0] + m[3 + i] * p[1] + m[6 + i] * p[2];
+        e[i] = m[i] * d[0] + m[3 + i] * d[1] + m[6 + i] * d[2];
+    }
+    if (s->order != 0) { q[0] -= s->decenter[0]; q[1] -= s->decenter[1]; }
+    o[0] = q[0]; o[1] = q[1]; o[2] = q[2] + s->z;
+    v_set(d, e);
+}
 
 static int is_plane(const trace_rx_surface *s)
 {
@@ -46,8 +100,30 @@ static int check_rx(const trace_rx *rx, char *err, size_t cap)
         tr_set_err(err, cap, "the stop's semi-diameter must be a number >= 0");
         return -1;
     }
+    int folded = 0;
+    for (int i = 0; i < rx->nsurf; i++) folded |= rx->surf[i].mirror || rx->surf[i].coordbrk;
     for (int i = 0; i < rx->nsurf; i++) {
         const trace_rx_surface *s = &rx->surf[i];
+        if (s->coordbrk) {
+            if (!isfinite(s->z) || !isfinite(s->decenter[0]) || !isfinite(s->decenter[1]) ||
+                !isfinite(s->tilt[0]) || !isfinite(s->tilt[1]) || !isfinite(s->tilt[2]) ||
+                (s->order != 0 && s->order != 1) || s->mirror) {
+                tr_set_err(err, cap, "surface %d: a coordinate break needs a finite "
+                           "position, decentres and tilts, order 0 or 1, and no mirror",
+                           i + 1);
+                return -1;
+            }
+            if (i == rx->stop) {
+                tr_set_err(err, cap, "surface %d: a coordinate break cannot be the stop",
+                           i + 1);
+                return -1;
+            }
+            if (!(s->n_right > 0 && isfinite(s->n_right))) {
+                tr_set_err(err, cap, "surface %d: bad index", i + 1);
+                return -1;
+            }
+            continue;
+        }
         if (!isfinite(s->z) || isnan(s->radius) || !isfinite(s->conic) ||
             !(s->n_right > 0 && isfinite(s->n_right)) || s->nasph < 0 ||
             s->nasph > TRACE_MAXASPH || !(s->semi_diameter >= 0) ||
@@ -56,7 +132,8 @@ static int check_rx(const trace_rx *rx, char *err, size_t cap)
                        "aspheric terms or semi-diameter", i + 1);
             return -1;
         }
-        if (i && s->z < rx->surf[i - 1].z) {
+        /* folded or tilted: z may run backwards (a ray that cannot go on misses) */
+        if (!folded && i && s->z < rx->surf[i - 1].z) {
             tr_set_err(err, cap, "surface %d lies left of surface %d", i + 1, i);
             return -1;
         }
@@ -68,6 +145,7 @@ static void sys_free(aim_sys *a)
 {
     free(a->g);
     free(a->plane);
+    free(a->rot);
 }
 
 static int sys_init(aim_sys *a, const trace_rx *rx, char *err, size_t cap)
@@ -84,7 +162,8 @@ static int sys_init(aim_sys *a, const trace_rx *rx, char *err, size_t cap)
     a->scale = fmax(fmax(a->scale, rx->stop_radius), 1e-3);
     a->g = calloc((size_t)rx->nsurf, sizeof *a->g);
     a->plane = calloc((size_t)rx->nsurf, sizeof *a->plane);
-    if (!a->g || !a->plane) {
+    a->rot = calloc((size_t)rx->nsurf, sizeof *a->rot);
+    if (!a->g || !a->plane || !a->rot) {
         sys_free(a);
         tr_set_err(err, cap, "out of memory");
         return -1;
@@ -93,6 +172,10 @@ static int sys_init(aim_sys *a, const trace_rx *rx, char *err, size_t cap)
         const trace_rx_surface *rs = &rx->surf[i];
         trace_surface s;
         char e[200];
+        if (rs->coordbrk) {
+            break_matrix(rs, a->rot[i]);
+            continue;
+        }
         memset(&s, 0, sizeof s);
         s.shape = TRACE_AXIAL;
         s.at[2] = rs->z;
@@ -135,8 +218,14 @@ static int run_ray(const aim_sys *a, const double o0[3], const double d0[3], int
         const trace_rx_surface *s = &rx->surf[k];
         const tr_shape *g = &a->g[k];
         double t, p[3], q[3], nrm[3], dn[3];
+        if (s->coordbrk) {                   /* the ray into the new frame */
+            break_apply(s, a->rot[k], o, d);
+            if (pts) v_set(pts + 3 * k, o);
+            n = s->n_right;
+            continue;
+        }
         if (a->plane[k]) {
-            if (!(d[2] > 0)) { out->surface = k; return out->status = TRACE_AIM_MISSED; }
+            if (d[2] == 0) { out->surface = k; return out->status = TRACE_AIM_MISSED; }
             t = (s->z - o[2]) / d[2];
             if (t < 0) {
                 if (t < -1e-12 * a->scale) {
@@ -165,7 +254,11 @@ static int run_ray(const aim_sys *a, const double o0[3], const double d0[3], int
         if (pts) v_set(pts + 3 * k, q);
         if (k == rx->stop) v_set(out->stop, q);
         opl += n * t;
-        if (!tr_refract(d, nrm, n, s->n_right, dn)) {
+        if (s->mirror) {                     /* law of reflection */
+            double dd = v_dot(d, nrm);
+            for (int j = 0; j < 3; j++) dn[j] = d[j] - 2 * dd * nrm[j];
+            v_unit(dn);
+        } else if (!tr_refract(d, nrm, n, s->n_right, dn)) {
             out->surface = k;
             return out->status = TRACE_AIM_TIR;
         }
@@ -175,7 +268,7 @@ static int run_ray(const aim_sys *a, const double o0[3], const double d0[3], int
     }
     v_set(out->img_dir, d);
     if (to_image && isfinite(rx->z_image)) {
-        if (!(d[2] > 0)) { out->surface = rx->nsurf; return out->status = TRACE_AIM_MISSED; }
+        if (d[2] == 0) { out->surface = rx->nsurf; return out->status = TRACE_AIM_MISSED; }
         double t = (rx->z_image - o[2]) / d[2];
         for (int j = 0; j < 3; j++) out->img[j] = o[j] + t * d[j];
         opl += n * t;
@@ -214,7 +307,8 @@ static void make_ray(const aim_sys *a, const trace_aim_req *rq, const double v[2
                      double o[3], double d[3], double q[3])
 {
     if (rq->infinite) {
-        double z0 = fmin(rq->z_ref, a->g[0].lo[2]) - 1e-3 * a->scale;
+        double z0 = fmin(rq->z_ref, a->rx->surf[0].coordbrk ? a->rx->surf[0].z : a->g[0].lo[2]) -
+                    1e-3 * a->scale;
         v_set(d, rq->dir);
         v_unit(d);
         q[0] = v[0]; q[1] = v[1]; q[2] = rq->z_ref;

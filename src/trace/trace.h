@@ -37,7 +37,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define TRACE_ABI 1
+#define TRACE_ABI 2     /* 2: trace_rx_surface's mirror and coordinate-break fields */
 #define TRACE_API_SYMBOL "trace_get_api"
 
 enum {
@@ -300,6 +300,15 @@ typedef struct trace_rx_surface {
     int nasph;
     double n_right;
     double semi_diameter;
+    /* ABI 2 (tr_aim.c's head comment has the conventions).  mirror 1: the surface
+     * reflects (n_right: the medium the light goes back into; z may then run
+     * backwards).  coordbrk 1: not a surface but a coordinate break at z (only
+     * decenter, tilt and order count): the surfaces after it are in the new frame,
+     * whose origin is (decenter x, y) off the old axis at z, rotated by tilt[0..2]
+     * degrees about x, y, z (order 0: decentre, then tilt x, y, z; order 1: tilt z,
+     * y, x, then decentre -- OpticStudio's COORDBRK PARM 1-6). */
+    int mirror, coordbrk, order;
+    double decenter[2], tilt[3];
 } trace_rx_surface;
 typedef struct trace_rx {
     double n_object;
