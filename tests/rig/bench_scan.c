@@ -6,7 +6,8 @@
  *       end of the last exposure (target <= 10);
  *   baseline in the same run: the same targets in the spiral's own order.  Also the
  *   predicted times (rig_api.scan_time) and where the time goes.
- * argv: RIG [N [ZONE_MM [EXPOSE_MS]]] (defaults 1000, 1.8, 1). */
+ * argv: RIG [N [ZONE_MM [EXPOSE_MS [TAG]]]] (defaults 1000, 1.8, 1); with TAG the
+ * BENCH names are cornea_scan1000_TAG_sim_s (a variant rig, scripts/bench_rig.sh). */
 #define _GNU_SOURCE
 #include <math.h>
 #include <stdio.h>
@@ -109,8 +110,13 @@ int main(int argc, char **argv)
            s0.path[RG_J_U] / rig.axis[RG_J_U].steps_per, s1.path[RG_J_U] / rig.axis[RG_J_U].steps_per,
            s0.path[RG_J_V] / rig.axis[RG_J_V].steps_per, s1.path[RG_J_V] / rig.axis[RG_J_V].steps_per);
     printf("# limited by: %s; ordered/unordered %.3f\n", s1.limit, sim1 / sim0);
-    printf("BENCH cornea_scan1000_sim_s %.3f s\n", sim1);
-    printf("BENCH cornea_scan1000_unordered_sim_s %.3f s\n", sim0);
+    if (argc > 5) {
+        printf("BENCH cornea_scan1000_%s_sim_s %.3f s\n", argv[5], sim1);
+        printf("BENCH cornea_scan1000_%s_unordered_sim_s %.3f s\n", argv[5], sim0);
+    } else {
+        printf("BENCH cornea_scan1000_sim_s %.3f s\n", sim1);
+        printf("BENCH cornea_scan1000_unordered_sim_s %.3f s\n", sim0);
+    }
     free(steps);
     free(order);
     return 0;
