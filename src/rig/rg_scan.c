@@ -43,7 +43,8 @@ static int check_targets(const rg_rig *rig, const long *steps, long n, char *err
 }
 
 /* Path positions 0..n: node 0 is the start pose, node i+1 target i.  A cost matrix
- * when it fits (n <= 2048: 32 MB), else the legs are recomputed. */
+ * when it fits (n <= 2048: 32 MB) and 2-opt on it; else the nearest neighbour alone,
+ * its legs recomputed (n = 20000: 2e8 legs, about 5 s). */
 typedef struct tour {
     const rg_rig *rig;
     const long *start, *steps;
@@ -75,6 +76,10 @@ int rg_scan_order(const rg_rig *rig, const long start[RG_NJOINTS], const long *s
     }
     if (n == 0) return 0;
     if ((rc = check_targets(rig, steps, n, err, cap))) return rc;
+    if (n > RG_SCAN_ORDER_MAX) {        /* O(n^2): beyond this, the given order */
+        for (long k = 0; k < n; k++) order[k] = k;
+        return 0;
+    }
     p = malloc((size_t)(n + 1) * sizeof *p);
     used = calloc((size_t)n + 1, 1);
     if (!p || !used) {
@@ -104,7 +109,7 @@ int rg_scan_order(const rg_rig *rig, const long start[RG_NJOINTS], const long *s
     }
     /* 2-opt on the open path (node 0 stays first): reverse p[i+1..j] when the two
      * new legs are shorter than the two old ones (j = n: the path's end, one leg) */
-    for (int pass = 0; pass < 200; pass++) {
+    for (int pass = 0; pass < (t.c ? 200 : 0); pass++) {
         better = 0;
         for (long i = 0; i + 2 <= n; i++)
             for (long j = i + 2; j <= n; j++) {

@@ -356,6 +356,7 @@ typedef struct rg_sim_shared {
  * from the rig's profiles, split by what set it.  Every move is the machine's own
  * coordinated trapezoid (rig_api.move_steps), so its time is the tightest joint's:
  * the one whose speed caps the cruise and the one whose acceleration caps the ramps. */
+#define RG_SCAN_ORDER_MAX 20000
 typedef struct rg_scan_stats {
     long n;                     /* targets */
     double t_total;             /* predicted: moves + settle + exposures (s) */
@@ -493,8 +494,10 @@ typedef struct rig_api {
      * quantise) to shorten the machine's time from start: greedy nearest neighbour
      * by the move's own duration (rig_api.plan_move's profile), then 2-opt until no
      * reversal gains; deterministic (ties: the lower index).  order[0..n-1] gets a
-     * permutation of 0..n-1.  RG_OK, RG_ETRAVEL (a target outside travel, before
-     * anything is ordered) or RG_EINVAL / RG_ENOMEM. */
+     * permutation of 0..n-1.  The work is O(n^2): above 2048 targets the nearest
+     * neighbour alone, above RG_SCAN_ORDER_MAX the given order (identity).  RG_OK,
+     * RG_ETRAVEL (a target outside travel, before anything is ordered) or RG_EINVAL /
+     * RG_ENOMEM. */
     int (*scan_order)(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps,
                       long n, long *order, char *err, size_t cap);
     /* The predicted time of visiting the targets in order (NULL: as given) from start,
