@@ -383,14 +383,15 @@ static int do_point(rdlg *d)
 
 /* The scan's order from the engine's planner (rig_api.scan_order), with its predicted
  * time against the spiral's own order; NULL (spiral order) when a target does not
- * solve or the engine has no planner. */
+ * solve, the scan is too long to plan, or the engine has no planner. */
 static long *plan_scan(rdlg *d, long n, double hmax, double ms)
 {
     const rig_api *a = d->api;
     long *steps, *order, start[RG_NJOINTS];
     char err[RG_ERRMAX], buf[1024];
     rg_scan_stats s0, s1;
-    if (!a->scan_order || !a->scan_time || !a->scan_limit_text) return NULL;
+    if (!a->scan_order || !a->scan_time || !a->scan_limit_text || n > RG_SCAN_ORDER_MAX)
+        return NULL;                /* (the planner keeps the given order there) */
     steps = malloc((size_t)n * RG_NJOINTS * sizeof *steps);
     order = malloc((size_t)n * sizeof *order);
     if (!steps || !order) { free(steps); free(order); return NULL; }
