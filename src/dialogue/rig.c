@@ -382,6 +382,45 @@ static int do_point(rdlg *d)
     return visit(d, &t, 0);
 }
 
+/* The scan's order from the engine's planner (rig_api.scan_order), with its predicted
+ * time against the spiral's own order; NULL (spiral order) when a target does not
+ * solve, the scan is too long to plan, or the engine has no planner. */
+static long *plan_scan(rdlg *d, long n, double hmax, double ms)
+{
+    const rig_api *a = d->api;
+    long *steps, *order, start[RG_NJOINTS];
+    char err[RG_ERRMAX], buf[1024];
+    rg_scan_stats s0, s1;
+    if (!a->scan_order || !a->scan_time || !a->scan_limit_text || n > RG_SCAN_ORDER_MAX)
+        return NULL;                /* (the planner keeps the given order there) */
+    steps = malloc((size_t)n * RG_NJOINTS * sizeof *steps);
+    order = malloc((size_t)n * sizeof *order);
+    if (!steps || !order) { free(steps); free(order); return NULL; }
+    for (long k = 0; k < n; k++) {
+        rg_target t = {RG_T_HEIGHT, hmax * sqrt((k + 0.5) / n),
+                       fmod(k * 137.50776405, 360) * DEG};
+        rg_solution s;
+        rg_quantised q;
+        if (a->solve(&d->rig.geom, &t, NULL, &s, err, sizeof err) ||
+            a->quantise(&d->rig.geom, &t, &s, &q, err, sizeof err)) {
+            free(steps); free(order);
+            return NULL;
+        }
+        for (int j = 0; j < RG_NJOINTS; j++) steps[k * RG_NJOINTS + j] = (long)q.steps[j];
+    }
+    a->position(d->m, start, NULL);
+    if (a->scan_order(&d->rig, start, steps, n, order, err, sizeof err) ||
+        a->scan_time(&d->rig, start, steps, NULL, n, ms, &s0, err, sizeof err) ||
+        a->scan_time(&d->rig, start, steps, order, n, ms, &s1, err, sizeof err)) {
+        free(steps); free(order);
+        return NULL;
+    }
+    lm_say(d->io, LM_BOTH, P(SCAN_ORDER), s1.t_total, s0.t_total,
+           a->scan_limit_text(&s1, buf, sizeof buf));
+    free(steps);
+    return order;
+}
+
 static int do_scan(rdlg *d)
 {
     double n, hmax, ms;
@@ -413,14 +452,21 @@ static int do_scan(rdlg *d)
     d->outside = 0;
     d->nframes = 0;
     d->fworst_um = d->fworst_lim_um = d->fsigma_um = d->foff_um = 0;
-    /* a sunflower (Vogel) spiral: even cover of the disc, no two points on a ring */
-    for (long k = 0; k < (long)n; k++) {
-        rg_target t;
-        t.kind = RG_T_HEIGHT;
-        t.a = hmax * sqrt((k + 0.5) / n);
-        t.b = fmod(k * 137.50776405, 360) * DEG;
-        lm_say(d->io, LM_BOTH, P(SCAN_POINT), (int)k + 1, (int)n, t.a, t.b / DEG);
-        if ((rc = visit(d, &t, ms))) return rc;
+    /* a sunflower (Vogel) spiral: even cover of the disc, no two points on a ring;
+     * visited in the order the engine's scan planner gives (doc/scan-time.md) when
+     * every target solves, else in the spiral's order (visit refuses the bad one) */
+    {
+        long *order = plan_scan(d, (long)n, hmax, ms);
+        for (long k = 0; k < (long)n; k++) {
+            rg_target t;
+            long i = order ? order[k] : k;
+            t.kind = RG_T_HEIGHT;
+            t.a = hmax * sqrt((i + 0.5) / n);
+            t.b = fmod(i * 137.50776405, 360) * DEG;
+            lm_say(d->io, LM_BOTH, P(SCAN_POINT), (int)k + 1, (int)n, t.a, t.b / DEG);
+            if ((rc = visit(d, &t, ms))) { free(order); return rc; }
+        }
+        free(order);
     }
     lm_say(d->io, LM_BOTH, P(SCAN_DONE), (int)n, d->worst_um, d->worst_bound_um, d->outside);
     if (d->nframes)

@@ -84,6 +84,15 @@ void rg_position(const rg_machine *m, long steps[RG_NJOINTS], rg_pose *p);
 int64_t rg_tick_ns(const rg_rig *rig);
 int  rg_plan_move(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
                   double *seconds, char *err, size_t cap);
+double rg_move_time(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
+                    int *vj, int *aj, double *t_acc, double *t_cruise);
+/* rg_scan.c */
+int  rg_scan_order(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps, long n,
+                   long *order, char *err, size_t cap);
+int  rg_scan_time(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps,
+                  const long *order, long n, double expose_ms, rg_scan_stats *st, char *err,
+                  size_t cap);
+const char *rg_scan_limit_text(const rg_scan_stats *st, char *buf, size_t cap);
 void rg_wait(rg_machine *m, int64_t deadline);  /* sleep_until + lateness record */
 /* rg_safety.c */
 int  rg_open(const rg_rig *rig, const rg_open_opts *o, rg_machine **m, char *err,

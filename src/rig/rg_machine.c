@@ -108,6 +108,8 @@ static int motors(const rg_machine *m, long steps[RG_NJOINTS])
     return 0;
 }
 
+static double clock_s(const rg_machine *m) { return m->chip->ops->now(m->chip) / 1e9; }
+
 void rg_machine_fill(rig_api *a)
 {
     a->rig_load = rg_rig_load;
@@ -131,4 +133,8 @@ void rg_machine_fill(rig_api *a)
     a->dose_plan = rg_dose_plan;
     a->dose_rig = rg_dose_rig;
     a->mpe = rg_mpe;
+    a->scan_order = rg_scan_order;
+    a->scan_time = rg_scan_time;
+    a->scan_limit_text = rg_scan_limit_text;
+    a->clock_s = clock_s;
 }

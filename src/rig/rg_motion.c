@@ -182,6 +182,35 @@ static int plan(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG
     return 0;
 }
 
+/* A move's duration without the travel check (the scan planner's cost: called a
+ * million times), and what set it: the joint whose speed capped the shared profile
+ * (*vj, its cruise time *t_cruise) and the joint whose acceleration did (*aj, the
+ * accelerating and braking time *t_acc); -1 for a null move. */
+double rg_move_time(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
+                    int *vj, int *aj, double *t_acc, double *t_cruise)
+{
+    double V = INFINITY, A = INFINITY;
+    int jv = -1, ja = -1;
+    trap tp;
+    for (int j = 0; j < RG_NJOINTS; j++) {
+        const rg_axis *x = &rig->axis[j];
+        long n = labs(to[j] - from[j]);
+        double v, a;
+        if (!n) continue;
+        v = x->speed * x->steps_per / n;
+        a = x->accel * x->steps_per / n;
+        if (v < V) { V = v; jv = j; }
+        if (a < A) { A = a; ja = j; }
+    }
+    if (vj) *vj = jv;
+    if (aj) *aj = ja;
+    if (ja < 0) { if (t_acc) *t_acc = 0; if (t_cruise) *t_cruise = 0; return 0; }
+    trap_plan(&tp, V, A);
+    if (t_acc) *t_acc = 2 * tp.ta;
+    if (t_cruise) *t_cruise = tp.tc;
+    return tp.T;
+}
+
 int rg_plan_move(const rg_rig *rig, const long from[RG_NJOINTS], const long to[RG_NJOINTS],
                  double *seconds, char *err, size_t cap)
 {

@@ -355,6 +355,24 @@ typedef struct rg_sim_shared {
                                            (the light follows the laser line) */
     volatile int32_t shutter, indicator;
 } rg_sim_shared;
+/* The scan planner (rg_scan.c, doc/scan-time.md): a scan's predicted machine time
+ * from the rig's profiles, split by what set it.  Every move is the machine's own
+ * coordinated trapezoid (rig_api.move_steps), so its time is the tightest joint's:
+ * the one whose speed caps the cruise and the one whose acceleration caps the ramps. */
+#define RG_SCAN_ORDER_MAX 20000
+typedef struct rg_scan_stats {
+    long n;                     /* targets */
+    double t_total;             /* predicted: moves + settle + exposures (s) */
+    double t_moves;             /* the profiles' durations, summed (s) */
+    double t_ticks;             /* what the control step adds to them (DIR set-up
+                                   tick, rounding to whole ticks) (s) */
+    double t_settle;            /* settle_ms after every move (s) */
+    double t_expose;            /* the exposures (s) */
+    double t_speed[RG_NJOINTS]; /* cruise time each joint's speed set (s) */
+    double t_accel[RG_NJOINTS]; /* ramp time each joint's acceleration set (s) */
+    double path[RG_NJOINTS];    /* each joint's summed travel (steps) */
+    const char *limit;          /* the largest single share, in words (static) */
+} rg_scan_stats;
 /* ==== end of the machine ========================================================= */
 
 
@@ -474,6 +492,28 @@ typedef struct rig_api {
     /* MPE at the cornea (J/m^2) for a small source, wavelength nm, duration s: IEC
      * 60825-1:2014 Table A.1 (see rg_dose.c); NAN outside 400-700 nm or t < 18 us. */
     double (*mpe)(double wavelength_nm, double t, const char **limit);
+    /* ---- the scan planner (doc/scan-time.md) ---- */
+    /* Order n targets (steps: n rows of RG_NJOINTS step counts, e.g. from
+     * quantise) to shorten the machine's time from start: greedy nearest neighbour
+     * by the move's own duration (rig_api.plan_move's profile), then 2-opt until no
+     * reversal gains; deterministic (ties: the lower index).  order[0..n-1] gets a
+     * permutation of 0..n-1.  The work is O(n^2): above 2048 targets the nearest
+     * neighbour alone, above RG_SCAN_ORDER_MAX the given order (identity).  RG_OK,
+     * RG_ETRAVEL (a target outside travel, before anything is ordered) or RG_EINVAL /
+     * RG_ENOMEM. */
+    int (*scan_order)(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps,
+                      long n, long *order, char *err, size_t cap);
+    /* The predicted time of visiting the targets in order (NULL: as given) from start,
+     * a settle after every move and an exposure of expose_ms at every target; st
+     * filled (st->limit names what limits it).  RG_OK or RG_ETRAVEL. */
+    int (*scan_time)(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps,
+                     const long *order, long n, double expose_ms, rg_scan_stats *st,
+                     char *err, size_t cap);
+    /* One line saying where the time goes (the shares above 5 %), into buf. */
+    const char *(*scan_limit_text)(const rg_scan_stats *st, char *buf, size_t cap);
+    /* The machine's clock (s): simulated time on the simulator, the real clock on
+     * a chip. */
+    double (*clock_s)(const rg_machine *m);
 } rig_api;
 
 typedef const rig_api *(*rig_get_api_fn)(int abi);
