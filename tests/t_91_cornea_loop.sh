@@ -111,6 +111,23 @@ cl_sim() {
         ! grep -q VIOLATION "$CL/sim.log" && grep -q '^Spots: 30 fitted' "$CL/srep.txt"
 }
 check "cornea loop: a 30-point scan on the simulated chip (30 exposures, laser off at the end)" cl_sim
+# the scan's dose in the record, against an independent model: a Gaussian beam of
+# power P and 1/e^2 diameter d averaged over the 7 mm aperture, the MPE 18 t^0.75 J/m^2
+# (IEC 60825-1 Table A.1, 400-700 nm) for the summed on-time
+cl_dose() {
+    line=$(grep '^Dose: ' "$CL/s.rec") || { echo "no Dose line"; return 1; }
+    echo "$line" | awk '{
+        n = $2; t = $5 / 1e3; P = $8 / 1e3; d = $12 / 1e3; H1 = $15; Ht = $18
+        for (i = 1; i <= NF; i++) { if ($i == "limit") mpe = $(i + 1); if ($i == "of" && $(i + 1) == "the") f = $(i - 1) }
+        a = 3.5e-3; w = d / 2
+        e1 = P * (1 - exp(-2 * a * a / (w * w))) / (3.14159265358979 * a * a) * t
+        m = 18 * (n * t) ^ 0.75
+        ok = (H1 / e1 - 1) ^ 2 < 1e-6 && (Ht / (n * e1) - 1) ^ 2 < 1e-6 && (mpe / m - 1) ^ 2 < 1e-6 &&
+             (f / (n * e1 / m) - 1) ^ 2 < 1e-4
+        if (!ok) printf "got H1 %s Ht %s mpe %s f %s; want %g %g %g %g\n", H1, Ht, mpe, f, e1, n * e1, m, n * e1 / m
+        exit !ok }'
+}
+check "cornea loop: the scan's dose and its margin in the record, as an independent model gives them" cl_dose
 # 8. SIGTERM mid-scan on the simulated chip: exit 143, the laser off, drivers disabled,
 # no report (nor its .part) and the simulator's log complete
 cl_term() {

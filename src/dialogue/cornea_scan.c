@@ -639,6 +639,10 @@ static int run(cs *s, tp_run *r, rg_machine **m)
         *e = 0;
         say(s, CS(LINE), l);
     }
+    if (r->have_dose)      /* the margin the scan kept to the limit (doc/rig-safety.md) */
+        say(s, CS(DOSE), (int)r->dose.n, r->expose_ms, r->rig->laser_power_mw,
+            r->rig->wavelength_nm, r->rig->beam_diameter_mm, r->dose.H_one, r->dose.H_total,
+            r->dose.mpe_total, r->dose.limit, r->dose.fraction, 1 / r->dose.fraction);
     say(s, CS(SPOTS), counts[CN_S_OK],
         counts[CN_S_NONE] + counts[CN_S_SEVERAL] + counts[CN_S_OUTLIER] + counts[CN_S_MISS],
         counts[CN_S_NONE], counts[CN_S_SEVERAL], counts[CN_S_OUTLIER], counts[CN_S_MISS],

@@ -119,6 +119,9 @@ typedef struct tp_run {
                                    noise seen) */
     double shot_factor;         /* mean factor applied to the centroid sigmas (1) */
     tp_times tm;
+    rg_dose dose;               /* the scan's dose at the cornea against the MPE, checked
+                                   before the first pulse (have_dose: on a machine) */
+    int have_dose;
     const char *phase;          /* the part of the loop running (or where it stopped):
                                    "planning", "the scan on the machine", ... */
 } tp_run;

@@ -488,6 +488,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
     r->check_max = NAN;
     r->check_n = 0;
     r->phase = "planning";
+    r->have_dose = 0;
     progress_tty = isatty(2);
     if (r->source == TP_SRC_FRAMES && (!r->im || !r->im->frame)) {
         snprintf(err, cap, "frames need the imaging engine");
@@ -549,6 +550,8 @@ int tp_measure(tp_run *r, char *err, size_t cap)
             snprintf(err, cap, "the scan is refused before its first pulse: %.400s", e);
             return CN_EINVAL;
         }
+        r->dose = dz;
+        r->have_dose = 1;
     }
     r->phase = "the scan on the machine";
     if (r->m) {
