@@ -30,9 +30,9 @@ static char *slurp(const char *path, size_t *len, char *msg, size_t cap)
     return buf;
 }
 
-static int check_file(void *ctx, const char *word, char *msg, size_t cap)
+int lr_read_file(lm_io *io, const char *word, int finite_angles, ln_lens *out,
+                 ln_notes *out_notes, char *msg, size_t cap)
 {
-    lr_lens *L = ctx;
     size_t len;
     char err[LN_ERR_MAX];
     char *text;
@@ -40,7 +40,7 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
     ln_notes notes = {0};
     int r, read_ok;
     /* the session's file registry (an input may not be an output of this session) */
-    if (lm_check_input(L->c->io, word, "the lens file", msg, cap)) return 1;
+    if (lm_check_input(io, word, "the lens file", msg, cap)) return 1;
     if (!(text = slurp(word, &len, msg, cap))) return 1;
     if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
     else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
@@ -53,7 +53,8 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
                  "(the object is at infinity: give field angles)", word);
         r = LN_BAD;
     }
-    if (r == LN_OK && !isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_ANGLE) {
+    if (r == LN_OK && !finite_angles && !isinf(l.object) && l.nfield &&
+        l.field_kind == LN_FIELD_ANGLE) {
         snprintf(err, sizeof err, "%s: field angles with a finite object: give the "
                  "fields as object heights", word);
         r = LN_BAD;
@@ -75,6 +76,17 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
         snprintf(msg, cap, "%s", err);
         return 1;
     }
+    *out = l;
+    *out_notes = notes;
+    return 0;
+}
+
+static int check_file(void *ctx, const char *word, char *msg, size_t cap)
+{
+    lr_lens *L = ctx;
+    ln_lens l;
+    ln_notes notes = {0};
+    if (lr_read_file(L->c->io, word, 0, &l, &notes, msg, cap)) return 1;
     if (L->have) ln_free(&L->lens);
     ln_notes_free(&L->notes);
     L->lens = l;

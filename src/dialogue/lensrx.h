@@ -45,6 +45,12 @@ typedef struct lr_wl {
     double s;                  /* marginal-ray scale: primary stop size / this one */
 } lr_wl;
 
+/* Read and check the lens file `word` for aimed rays (the session's file registry, the
+ * lens model's checks and shape check, a real object, at most PX_PUPIL_MAXSURF
+ * surfaces; field angles with a finite object only if finite_angles): 0 with the lens
+ * and its notes, or 1 with "why" in msg.  --pupil's and lr_ask_lens's reader. */
+int lr_read_file(lm_io *io, const char *word, int finite_angles, ln_lens *l,
+                 ln_notes *notes, char *msg, size_t cap);
 /* Ask the lens file and what it leaves out; print its notes.  LM_GO, LM_QUIT, LM_FAIL. */
 int lr_ask_lens(lr_lens *L, calc *c, const lr_texts *t);
 /* A whole number lo..hi (t->count_what, t->count_bad). */

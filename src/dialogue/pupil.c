@@ -11,6 +11,7 @@
 #include <string.h>
 #include <strings.h>
 #include "calcio.h"
+#include "lensrx.h"
 #include "dialogues.h"
 #include "engine.h"
 #include "../lens/lens.h"
@@ -23,7 +24,6 @@
 #define WORD 4096
 #define MAXFIELD 16
 #define MAXSAMPLE 4096
-#define FILE_MAX (16 << 20)
 #define DEG (3.14159265358979323846 / 180)
 
 typedef struct pdlg {
@@ -60,65 +60,14 @@ static double snap(const pdlg *d, double v)
 
 /* ---- the lens file ---------------------------------------------------------------- */
 
-static char *slurp(const char *path, size_t *len, char *msg, size_t cap)
-{
-    FILE *f = fopen(path, "rb");
-    char *buf = NULL;
-    size_t n = 0, got;
-    if (!f) { snprintf(msg, cap, "%s: cannot be read", path); return NULL; }
-    buf = malloc(FILE_MAX + 1);
-    if (!buf) { fclose(f); snprintf(msg, cap, "out of memory"); return NULL; }
-    while ((got = fread(buf + n, 1, FILE_MAX + 1 - n, f)) > 0) n += got;
-    fclose(f);
-    if (n > FILE_MAX) {
-        free(buf);
-        snprintf(msg, cap, "%s: larger than 16 MiB: not a lens file", path);
-        return NULL;
-    }
-    buf[n] = '\0';
-    *len = n;
-    return buf;
-}
-
+/* the file read and checked as every aimed-ray dialogue reads it (lensrx.c); --pupil
+   turns field angles with a finite object into heights (angles_to_heights) */
 static int check_file(void *ctx, const char *word, char *msg, size_t cap)
 {
     pdlg *d = ctx;
-    size_t len;
-    char err[LN_ERR_MAX];
-    char *text;
     ln_lens l;
     ln_notes notes = {0};
-    int r, read_ok;
-    if (lm_check_input(d->io, word, "the lens file", msg, cap)) return 1;
-    if (!(text = slurp(word, &len, msg, cap))) return 1;
-    if (ln_is_zmx(text, len)) r = ln_read_zmx(text, len, word, &l, &notes, err, sizeof err);
-    else r = ln_read_rx(text, len, word, &l, &notes, err, sizeof err);
-    free(text);
-    read_ok = r == LN_OK;
-    if (r == LN_OK && ln_check(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
-    if (r == LN_OK && ln_check_shape(&l, word, err, sizeof err) != LN_OK) r = LN_BAD;
-    if (r == LN_OK && isinf(l.object) && l.nfield && l.field_kind == LN_FIELD_HEIGHT) {
-        snprintf(err, sizeof err, "%s: object heights as fields need a finite object "
-                 "(the object is at infinity: give field angles)", word);
-        r = LN_BAD;
-    }
-    if (r == LN_OK && !isinf(l.object) && !(l.object > 0)) {
-        snprintf(err, sizeof err, "%s: the object lies %s surface 1 (a virtual object): "
-                 "rays are aimed only from a real object left of it, or from infinity",
-                 word, l.object == 0 ? "on" : "right of");
-        r = LN_BAD;
-    }
-    if (r == LN_OK && l.nsurf > PX_PUPIL_MAXSURF) {
-        snprintf(err, sizeof err, "%s: %d surfaces: at most %d", word, l.nsurf,
-                 PX_PUPIL_MAXSURF);
-        r = LN_BAD;
-    }
-    if (r != LN_OK) {
-        if (read_ok) ln_free(&l);
-        ln_notes_free(&notes);
-        snprintf(msg, cap, "%s", err);
-        return 1;
-    }
+    if (lr_read_file(d->io, word, 1, &l, &notes, msg, cap)) return 1;
     if (d->have) ln_free(&d->lens);
     ln_notes_free(&d->notes);
     d->lens = l;
