@@ -68,6 +68,10 @@ typedef struct obs {
 /* With stop_ms set, the observer also stops the controller (SIGSTOP) at stop_at_ms
  * for stop_ms: a preemption, as a loaded machine does it. */
 static int stop_at_ms = -1, stop_ms;
+/* With stop_on_laser, stop_at_ms counts from the first poll that saw the laser high:
+ * "mid-exposure" by the line itself, not by a guess of when the exposure starts (on a
+ * loaded host the emission delay and shutter can take longer than any guess). */
+static int stop_on_laser;
 
 static pid_t observe(int line, int up, int at_ms, int ms, int fd[2])
 {
@@ -78,7 +82,7 @@ static pid_t observe(int line, int up, int at_ms, int ms, int fd[2])
         struct sched_param sp = {.sched_priority = 90};
         obs o;
         int last[32];
-        int64_t t0 = now_ms(), t, prev = -1;
+        int64_t t0 = now_ms(), t, prev = -1, laser_t = -1;
         int done = line < 0;
         memset(&o, 0, sizeof o);
         for (int i = 0; i < 32; i++) { o.rise[i] = o.fall[i] = -1; last[i] = sysval(i); }
@@ -88,7 +92,9 @@ static pid_t observe(int line, int up, int at_ms, int ms, int fd[2])
             if (prev >= 0 && t - prev > o.gap) o.gap = t - prev;
             prev = t;
             if (!done && t >= at_ms) { pull(line, up); done = 1; }
-            if (stop_at_ms >= 0 && t >= stop_at_ms) {
+            if (o.laser_seen && laser_t < 0) laser_t = t;
+            if (stop_at_ms >= 0 && (stop_on_laser ? laser_t >= 0 && t >= laser_t + stop_at_ms
+                                                  : t >= stop_at_ms)) {
                 kill(parent, SIGSTOP);
                 usleep(2000);                           /* stopped now */
                 last[26] = sysval(26);
@@ -238,9 +244,9 @@ static void test_preempted(const rg_rig *rig0)
     rg->close(m);
     if (!(m = open_m(&rig))) return;
     rg->home(m, NULL, NULL, err, sizeof err);
-    stop_at_ms = 400; stop_ms = 300;
-    pid = observe(-1, 0, 0, 1500, fd);
-    stop_at_ms = -1;
+    stop_at_ms = 100; stop_ms = 300; stop_on_laser = 1;   /* 100 ms into the light */
+    pid = observe(-1, 0, 0, 3000, fd);
+    stop_at_ms = -1; stop_on_laser = 0;
     rc = rg->expose(m, 1000, NULL, NULL, err, sizeof err);
     o = result(pid, fd);
     CHECK(rc == RG_EFAULT && rg->fault(m, why, sizeof why) == RG_F_HEARTBEAT && sysval(24) == 0,
