@@ -682,3 +682,27 @@ int lm_ask_index(lm_io *io, const char *out, const char *rec, const lm_numspec *
     named.flags |= LM_INDEX;
     return lm_ask_number(io, out, rec, &named, v);
 }
+
+typedef struct count_ctx { int lo, hi, value; const char *bad; } count_ctx;
+static int check_count(void *ctx, const char *w, char *msg, size_t cap)
+{
+    count_ctx *k = ctx;
+    char *end;
+    long v = strtol(w, &end, 10);
+    if (end == w || *end || v < k->lo || v > k->hi) {
+        snprintf(msg, cap, k->bad, w, k->lo, k->hi);
+        return 1;
+    }
+    k->value = (int)v;
+    return 0;
+}
+
+int lm_ask_count(lm_io *io, const char *out, const char *rec, const char *what,
+                 const char *bad, int lo, int hi, int *v)
+{
+    char buf[32];
+    count_ctx k = {lo, hi, 0, bad};
+    int rc = lm_ask_word(io, out, rec, what, check_count, &k, buf, sizeof buf);
+    if (rc == LM_GO) *v = k.value;
+    return rc;
+}

@@ -98,6 +98,11 @@ int lm_ask_word(lm_io *io, const char *out, const char *rec, const char *what,
 int lm_ask_file(lm_io *io, const char *out, const char *rec, const char *what,
                 int (*check)(void *ctx, const char *word, char *msg, size_t cap),
                 void *ctx, char *buf, size_t cap);
+/* lm_ask_word for a whole number lo..hi: *v.  A bad answer's message is `bad`
+ * formatted with the answer (%s), lo and hi (%d, %d: a text may leave the last ones
+ * out). */
+int lm_ask_count(lm_io *io, const char *out, const char *rec, const char *what,
+                 const char *bad, int lo, int hi, int *v);
 /* Stopping (SIGINT, SIGTERM, SIGHUP).  A signal while lensmat waits for an answer,
  * or a second signal, runs the stop hooks and exits with 128+N at once.  During a
  * computation it only sets the stop flag: every long operation polls

@@ -22,18 +22,6 @@ typedef struct colour_session {
     double wl[PX_COLOUR_MAXWL];
 } colour_session;
 
-/* A whole number 1..max. */
-typedef struct count_ctx { int max; const char *bad; int value; } count_ctx;
-static int check_count(void *ctx, const char *w, char *msg, size_t cap)
-{
-    count_ctx *k = ctx;
-    char *end;
-    long v = strtol(w, &end, 10);
-    if (end == w || *end || v < 1 || v > k->max) { snprintf(msg, cap, k->bad, w); return 1; }
-    k->value = (int)v;
-    return 0;
-}
-
 static int check_wl(void *ctx, const char *w, char *msg, size_t cap)
 {
     double *l = ctx;
@@ -70,11 +58,7 @@ static int air_note(calc *c, const char *glass)
 static int ask_count(calc *c, const char *q, const char *what, const char *bad, int max,
                      int *k)
 {
-    char buf[32];
-    count_ctx x = {max, bad, 0};
-    int rc = lm_ask_word(c->io, q, q, what, check_count, &x, buf, sizeof buf);
-    *k = x.value;
-    return rc;
+    return lm_ask_count(c->io, q, q, what, bad, 1, max, k);
 }
 
 /* The question with its numbers filled in, for stdout and the record. */

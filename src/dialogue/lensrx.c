@@ -86,7 +86,7 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
     lr_lens *L = ctx;
     ln_lens l;
     ln_notes notes = {0};
-    if (lr_read_file(L->c->io, word, 0, &l, &notes, msg, cap)) return 1;
+    if (lr_read_file(L->c->io, word, L->finite_angles, &l, &notes, msg, cap)) return 1;
     if (L->have) ln_free(&L->lens);
     ln_notes_free(&L->notes);
     L->lens = l;
@@ -95,55 +95,23 @@ static int check_file(void *ctx, const char *word, char *msg, size_t cap)
     return 0;
 }
 
-typedef struct count_ctx { int lo, hi, value; const char *bad; } count_ctx;
-static int check_count(void *ctx, const char *w, char *msg, size_t cap)
-{
-    count_ctx *k = ctx;
-    char *end;
-    long v = strtol(w, &end, 10);
-    if (end == w || *end || v < k->lo || v > k->hi) {
-        snprintf(msg, cap, k->bad, w, k->lo, k->hi);
-        return 1;
-    }
-    k->value = (int)v;
-    return 0;
-}
-
 int lr_ask_count(lr_lens *L, const char *q, const char *bad, int lo, int hi, int *v)
 {
-    char buf[32];
-    count_ctx k = {lo, hi, 0, bad};
-    int rc = lm_ask_word(L->c->io, q, q, L->t->count_what, check_count, &k, buf, sizeof buf);
-    *v = k.value;
-    return rc;
-}
-
-typedef struct stop_ctx { int hi, value; const char *bad; } stop_ctx;
-static int check_stop(void *ctx, const char *w, char *msg, size_t cap)
-{
-    stop_ctx *k = ctx;
-    char *end;
-    long v = strtol(w, &end, 10);
-    if (end == w || *end || v < 1 || v > k->hi) {
-        snprintf(msg, cap, k->bad, w, k->hi);
-        return 1;
-    }
-    k->value = (int)v;
-    return 0;
+    return lm_ask_count(L->c->io, q, q, L->t->count_what, bad, lo, hi, v);
 }
 
 static int ask_missing(lr_lens *L)
 {
     ln_lens *l = &L->lens;
     const lr_texts *t = L->t;
-    char q[256], buf[32];
+    char q[256];
     int rc;
     if (l->stop < 0) {
-        stop_ctx k = {l->nsurf, 0, t->stop_bad};
+        int k;
         snprintf(q, sizeof q, t->stop, l->nsurf);
-        if ((rc = lm_ask_word(L->c->io, q, q, t->stop_what, check_stop, &k, buf, sizeof buf)))
+        if ((rc = lm_ask_count(L->c->io, q, q, t->stop_what, t->stop_bad, 1, l->nsurf, &k)))
             return rc;
-        l->stop = k.value - 1;
+        l->stop = k - 1;
     }
     if (l->ap_kind == LN_AP_NONE) {
         static const char *const kinds[] = {"epd", "fnum", "na", NULL};

@@ -26,6 +26,8 @@ typedef struct lr_lens {
     ln_lens lens;
     int have;
     ln_notes notes;
+    int finite_angles;         /* set by the caller: field angles accepted with a finite
+                                  object (--pupil turns them into heights) */
     /* lr_prepare: */
     px_csurf cs[PX_PUPIL_MAXSURF];
     char names[PX_PUPIL_MAXSURF + 1][LN_NAME_MAX];

@@ -23,19 +23,6 @@ typedef struct odlg {
     char out[4096];
 } odlg;
 
-typedef struct count_ctx { int lo, hi, value; } count_ctx;
-static int check_count(void *ctx, const char *w, char *msg, size_t cap)
-{
-    count_ctx *k = ctx;
-    char *end;
-    long v = strtol(w, &end, 10);
-    if (end == w || *end || v < k->lo || v > k->hi) {
-        snprintf(msg, cap, P(ITER_BAD), w, k->lo, k->hi);
-        return 1;
-    }
-    k->value = (int)v;
-    return 0;
-}
 
 static int check_out(void *ctx, const char *w, char *msg, size_t cap)
 {
@@ -128,8 +115,6 @@ static int run(odlg *d)
 int lm_optimise(lm_io *io)
 {
     odlg dd, *d = &dd;
-    char buf[64];
-    count_ctx k = {1, 10000, 0};
     int rc;
     memset(d, 0, sizeof *d);
     d->io = io;
@@ -139,8 +124,7 @@ int lm_optimise(lm_io *io)
     if (!(d->ds = dz_api())) return LM_FAIL;
     rc = dz_ask_files(io, P(FILE), P(FILE_WHAT), P(MERIT), P(MERIT_WHAT), &d->f);
     if (rc == LM_GO)
-        rc = lm_ask_word(io, P(ITER), P(ITER), P(ITER_WHAT), check_count, &k, buf, sizeof buf);
-    d->iters = k.value;
+        rc = lm_ask_count(io, P(ITER), P(ITER), P(ITER_WHAT), P(ITER_BAD), 1, 10000, &d->iters);
     if (rc == LM_GO)
         rc = lm_ask_word(io, P(OUT), P(OUT), P(OUT_WHAT), check_out, d, d->out, sizeof d->out);
     if (rc == LM_GO) rc = lm_stop_requested() ? LM_FAIL : run(d);

@@ -18,26 +18,9 @@
 #define DEG (3.14159265358979323846 / 180)
 #define MAXEL 20
 
-typedef struct count_ctx { int lo, hi, value; } count_ctx;
-static int check_count(void *ctx, const char *w, char *msg, size_t cap)
-{
-    count_ctx *k = ctx;
-    char *end;
-    long v = strtol(w, &end, 10);
-    if (end == w || *end || v < k->lo || v > k->hi) {
-        snprintf(msg, cap, P(COUNT_BAD), w, k->lo, k->hi);
-        return 1;
-    }
-    k->value = (int)v;
-    return 0;
-}
 static int ask_count(calc *c, const char *q, int lo, int hi, int *v)
 {
-    char buf[32];
-    count_ctx k = {lo, hi, 0};
-    int rc = lm_ask_word(c->io, q, q, P(COUNT_WHAT), check_count, &k, buf, sizeof buf);
-    *v = k.value;
-    return rc;
+    return lm_ask_count(c->io, q, q, P(COUNT_WHAT), P(COUNT_BAD), lo, hi, v);
 }
 
 static double z0(double v) { return fabs(v) < 1e-15 ? 0.0 : v; }

@@ -21,7 +21,6 @@
 
 #define P(k) pupil_prompts[PUPIL_##k]
 #define CL(v) lm_clean(d->io, snap(d, (v)))
-#define WORD 4096
 #define MAXFIELD 16
 #define MAXSAMPLE 4096
 #define DEG (3.14159265358979323846 / 180)
@@ -29,9 +28,8 @@
 typedef struct pdlg {
     lm_io *io;
     calc c;
-    ln_lens lens;
-    int have;                  /* lens holds the accepted file */
-    ln_notes notes;
+    lr_lens L;                 /* the lens file, read and completed by lensrx.c */
+    lr_texts t;
     const trace_api *tr;
     int sampling, nsamp_arg, fans, fan_rays;
     int nsamp;
@@ -47,7 +45,7 @@ typedef struct pdlg {
 } pdlg;
 
 /* The lens the paraxial engine sees. */
-static const ln_lens *plens(const pdlg *d) { return d->unf.nsurf ? &d->unf : &d->lens; }
+static const ln_lens *plens(const pdlg *d) { return d->unf.nsurf ? &d->unf : &d->L.lens; }
 /* An image-space position along the unfolded axis as the folded lens's z. */
 static double real_z(const pdlg *d, double u) { return d->zl + d->sig * (u - d->zl_u); }
 
@@ -58,108 +56,11 @@ static double snap(const pdlg *d, double v)
     return fabs(v) <= 1e-13 * d->scale ? 0.0 : v;
 }
 
-/* ---- the lens file ---------------------------------------------------------------- */
-
-/* the file read and checked as every aimed-ray dialogue reads it (lensrx.c); --pupil
-   turns field angles with a finite object into heights (angles_to_heights) */
-static int check_file(void *ctx, const char *word, char *msg, size_t cap)
-{
-    pdlg *d = ctx;
-    ln_lens l;
-    ln_notes notes = {0};
-    if (lr_read_file(d->io, word, 1, &l, &notes, msg, cap)) return 1;
-    if (d->have) ln_free(&d->lens);
-    ln_notes_free(&d->notes);
-    d->lens = l;
-    d->notes = notes;
-    d->have = 1;
-    return 0;
-}
-
 /* ---- small questions -------------------------------------------------------------- */
-
-typedef struct count_ctx { int lo, hi, value; const char *bad; } count_ctx;
-static int check_count(void *ctx, const char *w, char *msg, size_t cap)
-{
-    count_ctx *k = ctx;
-    char *end;
-    long v = strtol(w, &end, 10);
-    if (end == w || *end || v < k->lo || v > k->hi) {
-        snprintf(msg, cap, k->bad, w, k->lo, k->hi);
-        return 1;
-    }
-    k->value = (int)v;
-    return 0;
-}
 
 static int ask_count(pdlg *d, const char *q, const char *bad, int lo, int hi, int *v)
 {
-    char buf[32];
-    count_ctx k = {lo, hi, 0, bad};
-    int rc = lm_ask_word(d->io, q, q, P(COUNT_WHAT), check_count, &k, buf, sizeof buf);
-    *v = k.value;
-    return rc;
-}
-
-static int check_stop(void *ctx, const char *w, char *msg, size_t cap)
-{
-    count_ctx *k = ctx;
-    char *end;
-    long v = strtol(w, &end, 10);
-    if (end == w || *end || v < 1 || v > k->hi) {
-        snprintf(msg, cap, P(STOP_BAD), w, k->hi);
-        return 1;
-    }
-    k->value = (int)v;
-    return 0;
-}
-
-/* Whatever the file leaves out: the stop, the aperture, the fields. */
-static int ask_missing(pdlg *d)
-{
-    ln_lens *l = &d->lens;
-    char q[256], buf[32];
-    int rc;
-    if (l->stop < 0) {
-        count_ctx k = {1, l->nsurf, 0, NULL};
-        snprintf(q, sizeof q, P(STOP), l->nsurf);
-        if ((rc = lm_ask_word(d->io, q, q, P(STOP_WHAT), check_stop, &k, buf, sizeof buf)))
-            return rc;
-        l->stop = k.value - 1;
-    }
-    if (l->ap_kind == LN_AP_NONE) {
-        static const char *const kinds[] = {"epd", "fnum", "na", NULL};
-        int i = 0;
-        double v;
-        if ((rc = calc_choice(&d->c, P(AP_KIND), P(AP_KIND_WHAT), kinds, &i)) ||
-            (rc = calc_num(&d->c, P(AP_VALUE), P(AP_VALUE_WHAT), LM_POSITIVE, &v)))
-            return rc;
-        l->ap_kind = i == 0 ? LN_AP_EPD : i == 1 ? LN_AP_FNUM : LN_AP_NA;
-        l->ap_value = v;
-    }
-    if (l->nfield == 0) {
-        int n, inf = isinf(l->object);
-        if ((rc = ask_count(d, P(NFIELD), P(NFIELD_BAD), 1, MAXFIELD, &n))) return rc;
-        l->field_kind = inf ? LN_FIELD_ANGLE : LN_FIELD_HEIGHT;
-        for (int i = 0; i < n; i++) {
-            double v;
-            for (;;) {
-                lm_mark m;
-                snprintf(q, sizeof q, inf ? P(FIELD_ANGLE) : P(FIELD_HEIGHT), i + 1);
-                calc_mark(&d->c, &m);
-                if ((rc = calc_num(&d->c, q, P(FIELD_WHAT), 0, &v))) return rc;
-                if (!inf || fabs(v) < 90) break;
-                if ((rc = calc_reject(&d->c, &m, P(FIELD_WHAT), q, P(AGAIN_FIELD), "%s",
-                                      P(FIELD_BAD))))
-                    return rc;
-            }
-            l->field[i].x = 0;
-            l->field[i].y = v;
-            l->field[i].weight = 1;
-        }
-        l->nfield = n;
-    }
-    return LM_GO;
+    return lr_ask_count(&d->L, q, bad, lo, hi, v);
 }
 
 /* Grid: cell centres of n x n across [-1, 1]^2 inside the unit circle; hexapolar: the
@@ -259,7 +160,7 @@ static int pupil_at(pdlg *d, const px_csurf *cs, const char *obj, double lambda,
 static int build_rx(pdlg *d, wl_ctx *w, double lambda, double r_stop, double z_image,
                     char *why, size_t cap)
 {
-    const ln_lens *l = &d->lens;
+    const ln_lens *l = &d->L.lens;
     double z = 0;
     memset(w->surf, 0, sizeof w->surf);
     if (ln_index(l, -1, lambda, &w->rx.n_object, NULL, why, cap) != LN_OK) return -1;
@@ -297,7 +198,7 @@ static void request(const pdlg *d, const wl_ctx *w, const ln_field *f, double px
     memset(rq, 0, sizeof *rq);
     rq->px = px;
     rq->py = py;
-    if (isinf(d->lens.object)) {
+    if (isinf(d->L.lens.object)) {
         double tx = tan(f->x * DEG), ty = tan(f->y * DEG), n = sqrt(tx * tx + ty * ty + 1);
         rq->infinite = 1;
         rq->dir[0] = tx / n; rq->dir[1] = ty / n; rq->dir[2] = 1 / n;
@@ -305,7 +206,7 @@ static void request(const pdlg *d, const wl_ctx *w, const ln_field *f, double px
         rq->guess[0] = tx * p->yb[0] + px * p->y[0] * w->s;
         rq->guess[1] = ty * p->yb[0] + py * p->y[0] * w->s;
     } else {
-        rq->obj[0] = f->x; rq->obj[1] = f->y; rq->obj[2] = -d->lens.object;
+        rq->obj[0] = f->x; rq->obj[1] = f->y; rq->obj[2] = -d->L.lens.object;
         rq->guess[0] = f->x * p->ub[0] + px * p->u[0] * w->s;
         rq->guess[1] = f->y * p->ub[0] + py * p->u[0] * w->s;
     }
@@ -380,7 +281,7 @@ static void wavefront_init(const pdlg *d, const wl_ctx *w, const trace_aim_ray *
     if (!isfinite(p->z_xp) || chief->img_dir[2] == 0) return;
     double t = (real_z(d, p->z_xp) - chief->img[2]) / chief->img_dir[2];
     if (!(fabs(t) > 0)) return;
-    wf->inf = isinf(d->lens.object);
+    wf->inf = isinf(d->L.lens.object);
     memcpy(wf->c, chief->img, sizeof wf->c);
     wf->R = fabs(t);
     wf->sign = t < 0 ? 1 : -1;
@@ -394,7 +295,7 @@ static void wavefront_init(const pdlg *d, const wl_ctx *w, const trace_aim_ray *
 
 static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
 {
-    const ln_lens *l = &d->lens;
+    const ln_lens *l = &d->L.lens;
     const ln_field *f = &l->field[fi];
     const px_pupil *p = &w->p;
     trace_aim_ray chief, r;
@@ -505,7 +406,7 @@ static int one_field(pdlg *d, const wl_ctx *w, int fi, double lambda)
 static void report_pupil(pdlg *d, const wl_ctx *w, double fbig)
 {
     const px_pupil *p = &w->p;
-    const ln_lens *l = &d->lens;
+    const ln_lens *l = &d->L.lens;
     int inf = isinf(l->object), N = plens(d)->nsurf - 1;
     double k = inf ? tan(fbig * DEG) : fbig;
     char a[32], b[32], c[32], e[32];
@@ -558,7 +459,7 @@ static int refuse(pdlg *d, const char *why)
  * (said, field by field), so the rest runs as for heights. */
 static int angles_to_heights(pdlg *d, const px_pupil *prim)
 {
-    ln_lens *l = &d->lens;
+    ln_lens *l = &d->L.lens;
     double L = l->object + prim->z_ep;
     char z[32];
     if (!isfinite(prim->z_ep) || !(fabs(L) > 0)) return refuse(d, P(ANGLE_FINITE_TELE));
@@ -577,7 +478,7 @@ static int angles_to_heights(pdlg *d, const px_pupil *prim)
 
 static int compute(pdlg *d)
 {
-    const ln_lens *l = &d->lens;
+    const ln_lens *l = &d->L.lens;
     px_csurf cs[PX_PUPIL_MAXSURF];
     char names[PX_PUPIL_MAXSURF + 1][LN_NAME_MAX], why[LN_ERR_MAX], ob[64];
     const char *obj;
@@ -648,7 +549,6 @@ static int compute(pdlg *d)
 int lm_pupil(lm_io *io)
 {
     pdlg dd, *d = &dd;
-    char name[WORD];
     int rc;
     memset(d, 0, sizeof *d);
     ln_init(&d->unf);
@@ -656,29 +556,18 @@ int lm_pupil(lm_io *io)
     d->c.io = io;
     d->c.unit = PX_MM;
     d->c.uname = "mm";
-    rc = lm_ask_file(io, P(FILE), P(FILE), P(FILE_WHAT), check_file, d, name, sizeof name);
-    if (rc == LM_GO) {
-        if (d->notes.s && d->notes.len) {
-            char *s = d->notes.s, *e;
-            while (*s) {
-                e = strchr(s, '\n');
-                if (e) *e = '\0';
-                calc_say(&d->c, P(NOTE), s);
-                if (!e) break;
-                s = e + 1;
-            }
-        }
-        d->c.uname = d->lens.unit[0] ? d->lens.unit : "mm";
-        if ((rc = ask_missing(d)) == LM_GO && (rc = ask_sampling(d)) == LM_GO) {
-            if (lm_stop_requested()) rc = LM_FAIL;
-            else rc = compute(d);
-        }
-    }
+    d->t = (lr_texts){P(FILE), P(FILE_WHAT), P(NOTE), P(STOP), P(STOP_WHAT), P(STOP_BAD),
+                      P(AP_KIND), P(AP_KIND_WHAT), P(AP_VALUE), P(AP_VALUE_WHAT), P(NFIELD),
+                      P(NFIELD_WHAT), P(NFIELD_BAD), P(FIELD_ANGLE), P(FIELD_HEIGHT),
+                      P(FIELD_WHAT), P(FIELD_BAD), P(AGAIN_FIELD), P(COUNT_WHAT), P(COUNT_BAD)};
+    d->L.finite_angles = 1;    /* angles with a finite object become heights */
+    rc = lr_ask_lens(&d->L, &d->c, &d->t);
+    if (rc == LM_GO && (rc = ask_sampling(d)) == LM_GO)
+        rc = lm_stop_requested() ? LM_FAIL : compute(d);
     if (rc == LM_GO) rc = calc_done(&d->c);
-    if (d->have) ln_free(&d->lens);
+    lr_free(&d->L);
     ln_free(&d->unf);
     free(d->map);
-    ln_notes_free(&d->notes);
     return rc;
 }
 const char *lm_pupil_example(void) { return P(EXAMPLE); }
