@@ -30,6 +30,26 @@ unit() {
     if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
         fail "$1 exited $rc"; tail -20 "$WORK/unit.out"; fi
 }
+# gpio_vm MIN_CHECKS FILES PROGRAM ARGS...: PROGRAM run in the gpio-vm guest (a
+# gpio-sim chip in qemu) with FILES copied in; each PASS/FAIL line it prints counts,
+# and fewer than MIN_CHECKS PASS lines fail (the guest stopped early)
+gpio_vm() {
+    min=$1; files=$2; shift 2
+    vm=${GPIO_VM:-$SHARED/tools/gpio-vm/run}     # GPIO_VM: another checkout's copy
+    if [ ! -x "$vm" ]; then fail "gpio-vm: $vm not found"; return; fi
+    if [ ! -x "$TOP/$1" ]; then fail "$1 not built"; return; fi
+    (cd "$TOP" && GPIO_VM_FILES="$files" "$vm" "$@") > "$WORK/vm.out" 2>&1
+    rc=$?
+    tr -d '\r' < "$WORK/vm.out" | grep -E '^(PASS|FAIL)' > "$WORK/vm.res"
+    p=$(grep -c '^PASS' "$WORK/vm.res"); f=$(grep -c '^FAIL' "$WORK/vm.res")
+    PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
+    grep '^FAIL' "$WORK/vm.res" | sed "s|^|$(basename "$1"): |"
+    if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
+        fail "gpio-vm $1 exited $rc"; tail -20 "$WORK/vm.out"
+    elif [ "$p" -lt "$min" ]; then
+        fail "gpio-vm $1: only $p checks ran"; tail -20 "$WORK/vm.out"
+    fi
+}
 # trace_session BIN DIR ANSWERS...: lensmat --trace in DIR with the answers (one per
 # line) read from DIR/in; stdout in DIR/out, stderr in DIR/err, record DIR/r.rec.
 trace_session() {

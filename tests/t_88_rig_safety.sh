@@ -106,21 +106,4 @@ else
 fi
 
 # the libgpiod backend on the gpio-sim chip
-safe_vm() {   # safe_vm MIN FILES PROGRAM ARGS...
-    min=$1; files=$2; shift 2
-    vm=${GPIO_VM:-$SHARED/tools/gpio-vm/run}
-    if [ ! -x "$vm" ]; then fail "gpio-vm: $vm not found"; return; fi
-    if [ ! -x "$TOP/$1" ]; then fail "$1 not built"; return; fi
-    (cd "$TOP" && GPIO_VM_FILES="$files" "$vm" "$@") > "$WORK/vms.out" 2>&1
-    rc=$?
-    tr -d '\r' < "$WORK/vms.out" | grep -E '^(PASS|FAIL)' > "$WORK/vms.res"
-    p=$(grep -c '^PASS' "$WORK/vms.res"); f=$(grep -c '^FAIL' "$WORK/vms.res")
-    PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
-    grep '^FAIL' "$WORK/vms.res" | sed "s|^|$(basename "$1"): |"
-    if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
-        fail "gpio-vm $1 exited $rc"; tail -20 "$WORK/vms.out"
-    elif [ "$p" -lt "$min" ]; then
-        fail "gpio-vm $1: only $p checks ran"; tail -20 "$WORK/vms.out"
-    fi
-}
-safe_vm 23 tests/rig/vm.rig build/obj/rig_vm/vm_safety vm.rig
+gpio_vm 23 tests/rig/vm.rig build/obj/rig_vm/vm_safety vm.rig

@@ -21,38 +21,10 @@
 #include <unistd.h>
 #include "rig/rig.h"
 #include "unit.h"
+#include "vm_sim.h"
 
 static const rig_api *rg;
-static const char *sim_dir, *chip;
-
-static int64_t now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000;
-}
-
-static void msleep(int ms) { usleep((useconds_t)ms * 1000); }
-
-static int sysval(int line)
-{
-    char p[300], b[8] = "";
-    int fd;
-    snprintf(p, sizeof p, "%s/sim_gpio%d/value", sim_dir, line);
-    fd = open(p, O_RDONLY);
-    if (fd < 0) return -1;
-    if (read(fd, b, sizeof b - 1) < 1) b[0] = '?';
-    close(fd);
-    return b[0] == '1' ? 1 : b[0] == '0' ? 0 : -1;
-}
-
-static void pull(int line, int up)
-{
-    char p[300];
-    FILE *f;
-    snprintf(p, sizeof p, "%s/sim_gpio%d/pull", sim_dir, line);
-    if ((f = fopen(p, "w"))) { fputs(up ? "pull-up" : "pull-down", f); fclose(f); }
-}
+static const char *chip;
 
 /* A child above the controller's priority: after `at_ms` it pulls `line` to `up`
  * (line < 0: nothing), and counts rising edges of STEP line 0 before and after. */
