@@ -15,23 +15,12 @@
 #include <string.h>
 #include <unistd.h>
 #include "rig/rig.h"
-
-static char *slurp(const char *path)
-{
-    static char buf[1 << 20];
-    FILE *f = fopen(path, "rb");
-    size_t n;
-    if (!f) return NULL;
-    n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    return buf;
-}
+#include "unit.h"
 
 int main(int argc, char **argv)
 {
     const rig_api *rg = rig_get_api(RIG_ABI);
-    char *ex0 = slurp(argc > 1 ? argv[1] : "golden/rig/example.rig"), err[RG_ERRMAX];
+    char *ex0 = unit_slurp(argc > 1 ? argv[1] : "golden/rig/example.rig"), err[RG_ERRMAX];
     static char text[1 << 20], ex[1 << 16];
     char dir[] = "/tmp/bench_safety.XXXXXX", logp[600];
     double worst = 0, homed_at = -1;
@@ -54,7 +43,7 @@ int main(int argc, char **argv)
         }
         rg->close(m);
         {
-            char *log = slurp(logp), *p = log ? strstr(log, " homed") : NULL;
+            char *log = unit_slurp(logp), *p = log ? strstr(log, " homed") : NULL;
             while (p && p > log && p[-1] != '\n') p--;
             if (p) homed_at = atof(p);
         }
@@ -75,7 +64,7 @@ int main(int argc, char **argv)
         t[RG_J_M1A] += 2000;
         rg->move_steps(m, t, NULL, NULL, err, sizeof err);
         rg->close(m);
-        log = slurp(logp);
+        log = unit_slurp(logp);
         a = log ? strstr(log, "interlock open\n") : NULL;
         f = log ? strstr(log, "FAULT latched") : NULL;
         if (a && f && !strstr(log, "VIOLATION")) {

@@ -18,18 +18,6 @@ static const rig_api *rg;
 static char example[1 << 16];
 static char tmpdir[256];
 
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    static char buf[1 << 20];
-    size_t n;
-    if (!f) return NULL;
-    n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    return buf;
-}
-
 /* The example with `old` replaced by `new` (first occurrence), in a static buffer. */
 static const char *variant(const char *old, const char *new)
 {
@@ -284,7 +272,7 @@ static void test_motion(void)
           "emergency_off mid-exposure: laser off, then every driver disabled");
     rg->close(m);
     {
-        char *log = slurp(logp);
+        char *log = unit_slurp(logp);
         const char *a = log ? strstr(log, "stop: laser 0") : NULL;
         const char *b = a ? strstr(a, "stop: enable 0") : NULL;
         CHECK(a && b && strstr(b, "final (stopped) laser=0 light=0 enable=000000"),
@@ -319,7 +307,7 @@ static void test_interlock(void)
     }
     rg->close(m);
     {
-        char *log = slurp(logp);
+        char *log = unit_slurp(logp);
         const char *a = log ? strstr(log, "interlock open") : NULL;
         const char *b = a ? strstr(a, "laser 0") : NULL;
         double ta = 0, tb = 0;
@@ -366,8 +354,8 @@ static void test_replay(void)
     path(b, "r2.log");
     session(a);
     session(b);
-    ta = strdup(slurp(a) ? slurp(a) : "");
-    CHECK(ta[0] && !strcmp(ta, slurp(b) ? slurp(b) : "x"), "a replay writes an identical log");
+    ta = strdup(unit_slurp(a) ? unit_slurp(a) : "");
+    CHECK(ta[0] && !strcmp(ta, unit_slurp(b) ? unit_slurp(b) : "x"), "a replay writes an identical log");
     CHECK(access(a, F_OK) == 0 && access(strcat(strcpy((char[600]){0}, a), ".part"), F_OK) != 0,
           "the log is renamed from LOG.part when the machine closes");
     free(ta);
@@ -378,21 +366,16 @@ int main(int argc, char **argv)
     char *ex;
     rg = rig_get_api(RIG_ABI);
     if (!rg || !rg->rig_parse) { printf("FAIL no machine table\n"); return 1; }
-    ex = slurp(argc > 1 ? argv[1] : "tests/rig/machine.rig");
+    ex = unit_slurp(argc > 1 ? argv[1] : "tests/rig/machine.rig");
     if (!ex) { printf("FAIL cannot read the example rig file\n"); return 1; }
     snprintf(example, sizeof example, "%s", ex);
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/t_machine.XXXXXX");
-    if (!mkdtemp(tmpdir)) return 1;
+    if (unit_tmpdir(tmpdir, sizeof tmpdir, "t_machine")) return 1;
     test_reader();
     test_steps();
     test_motion();
     test_interlock();
     test_home_timeout();
     test_replay();
-    {
-        char cmd[300];
-        snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-        if (system(cmd)) {}
-    }
+    unit_rmtree(tmpdir);
     return unit_failed();
 }

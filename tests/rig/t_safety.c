@@ -19,18 +19,6 @@
 static const rig_api *rg;
 static char base[1 << 16], tmpdir[256];
 
-static char *slurp(const char *path)
-{
-    static char buf[1 << 20];
-    FILE *f = fopen(path, "rb");
-    size_t n;
-    if (!f) return NULL;
-    n = fread(buf, 1, sizeof buf - 1, f);
-    buf[n] = 0;
-    fclose(f);
-    return buf;
-}
-
 /* The base rig with extra lines appended (later keys are new keys, never repeats). */
 static const char *with(const char *extra)
 {
@@ -142,7 +130,7 @@ static void test_interlock_move(void)
           "homed again, the move runs (%s)", err);
     rg->close(m);
     {
-        char *log = slurp(logp);
+        char *log = unit_slurp(logp);
         double open = log ? stamp(log, "interlock open", NULL) : -1;
         double last = log ? field(log, "FAULT latched", "last STEP edge ") : -1;
         const char *f = NULL;
@@ -170,7 +158,7 @@ static void test_stages(void)
           rg->fault(m, why, sizeof why) == RG_F_INTERLOCK,
           "interlock open during homing: latched, not homed (%s)", why);
     rg->close(m);
-    log = slurp(logp);
+    log = unit_slurp(logp);
     CHECK(log && field(log, "FAULT latched", "last STEP edge ") - 5.0 <= 1e-3 &&
           !strstr(log, "VIOLATION") && !strstr(log, "laser 1"),
           "... its last STEP edge within 1 ms of 5 s, laser never on");
@@ -188,7 +176,7 @@ static void test_stages(void)
               "interlock open before the exposure: refused and latched (%s)", err);
     }
     rg->close(m);
-    log = slurp(logp);
+    log = unit_slurp(logp);
     CHECK(log && !strstr(log, "laser 1") && !strstr(log, "VIOLATION"),
           "... the laser never went on");
     /* mid-exposure */
@@ -203,7 +191,7 @@ static void test_stages(void)
               "interlock open mid-exposure: laser off, latched, home again (%s)", err);
     }
     rg->close(m);
-    log = slurp(logp);
+    log = unit_slurp(logp);
     {
         double open = log ? stamp(log, "interlock open", NULL) : -1;
         const char *f = log ? strstr(log, "interlock open") : NULL;
@@ -234,7 +222,7 @@ static void test_limit_deadline_lost(void)
     CHECK(rg->reset(m, err, sizeof err) == RG_EFAULT && strstr(err, "still tripped"),
           "reset refused while it is tripped (%s)", err);
     rg->close(m);
-    log = slurp(logp);
+    log = unit_slurp(logp);
     CHECK(log && field(log, "FAULT latched", "last STEP edge ") - 26.50005 <= 1e-3 &&
           !strstr(log, "VIOLATION"), "... the last STEP edge within 1 ms of the trip");
     /* soft limits stay separate: refused before the first pulse, nothing latched */
@@ -258,7 +246,7 @@ static void test_limit_deadline_lost(void)
     CHECK(t[RG_J_M1A] == real[RG_J_M1A], "... no step lost: the controller knows where it "
           "stopped (%ld = motor %ld)", t[RG_J_M1A], real[RG_J_M1A]);
     rg->close(m);
-    log = slurp(logp);
+    log = unit_slurp(logp);
     CHECK(log && !strstr(log, "VIOLATION"), "... and no pulse shorter than the driver's minimum");
     /* the same stall with a tolerance above it: late pulses keep their width, no loss */
     m = open_sim(with("sim_stall_at_ms 26300\nsim_stall_ms 3\nmax_late_us 5000"), "late2", err);
@@ -271,7 +259,7 @@ static void test_limit_deadline_lost(void)
     CHECK(real[RG_J_M1A] == t[RG_J_M1A], "... and arrives: every pulse at least step_pulse_us "
           "high after a preemption (motor %ld, want %ld)", real[RG_J_M1A], t[RG_J_M1A]);
     rg->close(m);
-    log = slurp(logp);
+    log = unit_slurp(logp);
     CHECK(log && strstr(log, "controller preempted") && !strstr(log, "VIOLATION"),
           "... no VIOLATION (the simulator drops pulses shorter than the minimum)");
     /* a lost step: the driver drops one pulse */
@@ -410,7 +398,7 @@ static void test_heartbeat(void)
         CHECK(rg->expose(m, 5, NULL, NULL, err, sizeof err) == RG_EINVAL &&
               strstr(err, "no 'heartbeat' line"), "... but refuses to emit (%s)", err);
         rg->close(m);
-        CHECK(strstr(slurp(logp), "no heartbeat: emission refused") != NULL,
+        CHECK(strstr(unit_slurp(logp), "no heartbeat: emission refused") != NULL,
               "the simulator's log says so at open");
     }
     strcat(buf, "\neye_safe_without_heartbeat yes\n");
@@ -434,7 +422,7 @@ static void test_heartbeat(void)
               "a stalled exposure loop: heartbeat fault latched (%s)", why);
         rg->close(m);
         {
-            char *log = slurp(logp);
+            char *log = unit_slurp(logp);
             const char *f = log ? strstr(log, "controller preempted") : NULL;
             double st = f ? stamp(log, "controller preempted", NULL) : -1;
             double off = f ? stamp(log, "light 0 (heartbeat stopped)", &f) : -1;
@@ -456,7 +444,7 @@ static void test_emission(void)
     CHECK(rg->expose(m, 20, NULL, NULL, err, sizeof err) == 0, "an exposure (%s)", err);
     rg->close(m);
     {
-        char *log = slurp(logp);
+        char *log = unit_slurp(logp);
         const char *f = NULL;
         double ind = stamp(log, "indicator on", &f), las = stamp(log, "laser 1", &f),
                sho = stamp(log, "shutter open", &f), li = stamp(log, "light 1", &f),
@@ -488,7 +476,7 @@ static void test_emission(void)
         CHECK(rg->reset(m, err, sizeof err) == RG_EFAULT && strstr(err, "key switch is off"),
               "reset refused while the key is off (%s)", err);
         rg->close(m);
-        CHECK(!strstr(slurp(logp), "VIOLATION"), "no violation");
+        CHECK(!strstr(unit_slurp(logp), "VIOLATION"), "no violation");
     }
 }
 
@@ -505,7 +493,7 @@ static void test_homing(void)
     CHECK(rg->expose(m, 5, NULL, NULL, err, sizeof err) == 0, "expose (%s)", err);
     rg->close(m);
     {
-        char *log = slurp(logp);
+        char *log = unit_slurp(logp);
         const char *f = NULL;
         double h = stamp(log, "homed", &f), e = stamp(log, "laser 1", &f);
         CHECK(h > 0 && fabs(e - h - 0.005) < 1e-9, "settle_ms after homing: laser on %.6f s "
@@ -523,11 +511,10 @@ int main(int argc, char **argv)
     char *b;
     rg = rig_get_api(RIG_ABI);
     if (!rg || !rg->reset) { printf("FAIL no safety table\n"); return 1; }
-    b = slurp(argc > 1 ? argv[1] : "tests/rig/machine.rig");
+    b = unit_slurp(argc > 1 ? argv[1] : "tests/rig/machine.rig");
     if (!b) { printf("FAIL no rig file\n"); return 1; }
     snprintf(base, sizeof base, "%s", b);
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/t_safety.XXXXXX");
-    if (!mkdtemp(tmpdir)) return 1;
+    if (unit_tmpdir(tmpdir, sizeof tmpdir, "t_safety")) return 1;
     test_interlock_move();
     test_stages();
     test_limit_deadline_lost();
@@ -535,10 +522,6 @@ int main(int argc, char **argv)
     test_heartbeat();
     test_emission();
     test_homing();
-    {
-        char cmd[300];
-        snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-        if (system(cmd)) {}
-    }
+    unit_rmtree(tmpdir);
     return unit_failed();
 }
