@@ -27,7 +27,15 @@ static void tol_info(const ds_problem *p, int i, ds_tol_info *out)
     static const char *const k[] = {"r", "t", "n", "k"};
     const ds_tol *t = &p->tol[i];
     memset(out, 0, sizeof *out);
-    snprintf(out->name, sizeof out->name, "%s %d", k[t->kind], t->surf + 1);
+    if (t->kind == DT_TILT || t->kind == DT_DEC) {
+        const ds_grp *g = &p->grp[t->grp];
+        char what[4] = {t->kind == DT_TILT ? 't' : 'd', t->axis ? 'y' : 'x', 0, 0};
+        if (g->s0 == g->s1) snprintf(out->name, sizeof out->name, "%s %d", what, g->s0 + 1);
+        else snprintf(out->name, sizeof out->name, "%s %d-%d", what, g->s0 + 1, g->s1 + 1);
+        out->angle = t->kind == DT_TILT;
+    } else {
+        snprintf(out->name, sizeof out->name, "%s %d", k[t->kind], t->surf + 1);
+    }
     out->delta = t->delta;
     out->line = t->line;
 }
