@@ -74,7 +74,8 @@ typedef struct ds_crit {
                                   mean of every field's polychromatic RMS about its
                                   centroid, after the back-focus compensator */
     double efl, bfd;           /* paraxial, primary wavelength */
-    double focus;              /* the compensator's image-plane shift */
+    double focus;              /* the compensator's image-plane shift, along the light
+                                  (the last thickness's change, sign as if unfolded) */
     double wave;               /* with ds_tol_opts.wave: RMS wavefront (waves, piston
                                   removed; field-weighted quadratic mean, every
                                   wavelength) on the compensated image plane; else NaN */

@@ -74,7 +74,7 @@ static int crit(ds_problem *p, const ds_tol_opts *o, ds_crit *c)
         r2 += fw * (v > 0 ? v : 0);
     }
     c->rms = wsum > 0 ? sqrt(r2 / wsum) : NAN;
-    c->focus = dz;
+    c->focus = dz * w[0].sig;               /* along the light: after odd mirrors it runs -z */
     /* the boresight: field 1's chief ray at the primary wavelength on the refocused
      * plane (linear in tilts and decentres, where the spot is quadratic) */
     if (ds_chief(p, &w[0], 0, zi, bp, bs)) return DS_OK;
