@@ -98,6 +98,9 @@ static int sens(tdlg *d)
             return LM_FAIL;
         if (!a.ok || !b.ok) { calc_say(&d->c, P(SENS_FAIL), t.name, t.delta, t.line); continue; }
         double bx = (b.bore[0] - a.bore[0]) / 2 * d->um, by = (b.bore[1] - a.bore[1]) / 2 * d->um;
+        /* a shift that is rounding (1e-18 um across a fold) prints as 0 on every build */
+        if (fabs(bx) < 1e-9) bx = 0;
+        if (fabs(by) < 1e-9) by = 0;
         calc_say(&d->c, P(SENS_ROW), t.name, t.delta, a.rms * d->um, b.rms * d->um, a.wave,
                  b.wave, a.efl, b.efl, a.bfd, b.bfd, lm_clean(d->io, bx), lm_clean(d->io, by),
                  t.line);

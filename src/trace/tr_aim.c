@@ -307,8 +307,11 @@ static void make_ray(const aim_sys *a, const trace_aim_req *rq, const double v[2
                      double o[3], double d[3], double q[3])
 {
     if (rq->infinite) {
-        double z0 = fmin(rq->z_ref, a->rx->surf[0].coordbrk ? a->rx->surf[0].z : a->g[0].lo[2]) -
-                    1e-3 * a->scale;
+        /* start left of the first surface; behind a leading break the surfaces are
+         * turned and may reach back past its z by up to their size, so start a system's
+         * size back (the path is counted from z_ref whatever the start) */
+        double z0 = a->rx->surf[0].coordbrk ? fmin(rq->z_ref, a->rx->surf[0].z) - a->scale
+                                            : fmin(rq->z_ref, a->g[0].lo[2]) - 1e-3 * a->scale;
         v_set(d, rq->dir);
         v_unit(d);
         q[0] = v[0]; q[1] = v[1]; q[2] = rq->z_ref;
