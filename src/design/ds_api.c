@@ -96,10 +96,22 @@ static void op_info(const ds_problem *p, int i, ds_op_info *out)
 
 static void describe(const ds_problem *p, char *buf, size_t cap)
 {
+    /* the half pupil only while the lens is symmetric in x (ds_setup's xsym): not with
+     * a break that decentres in x or turns about y or z, nor tolerances that do */
+    int whole = 0;
+    for (int i = 0; i < p->lens.nsurf; i++) {
+        const ln_surface *s = &p->lens.surf[i];
+        whole |= s->coordbrk && (s->cb_dec[0] != 0 || s->cb_tilt[1] != 0 || s->cb_tilt[2] != 0);
+    }
+    for (int i = 0; i < p->ntol; i++)
+        whole |= (p->tol[i].kind == DT_DEC && p->tol[i].axis == 0) ||
+                 (p->tol[i].kind == DT_TILT && p->tol[i].axis == 1);
     snprintf(buf, cap, "Gaussian quadrature pupil: %d ring%s x %d arm%s (%d rays per field "
-             "and wavelength, the x > 0 half traced for fields in y), %s, no vignetting; "
+             "and wavelength, %s), %s, no vignetting; "
              "method %s", p->rings, p->rings == 1 ? "" : "s", p->arms,
              p->arms == 1 ? "" : "s", p->rings * p->arms,
+             whole ? "the whole pupil traced: the lens or its tolerances are not symmetric in x"
+                   : "the x > 0 half traced for fields in y",
              p->aim_paraxial ? "rays sent at the paraxial entrance pupil" :
                                "rays aimed at the stop",
              p->method ? "Levenberg-Marquardt with geodesic acceleration" :

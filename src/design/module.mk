@@ -49,5 +49,5 @@ build/asan/design_tests/%: tests/design/%.c build/asan/lib/lensmat-design.so \
 
 all: build/lib/lensmat-design.so
 MODULE_TEST_BINS  += build/lib/lensmat-design.so build/asan/lib/lensmat-design.so $(DS_TBIN)
-MODULE_BENCH_BINS += build/lib/lensmat-design.so
+MODULE_BENCH_BINS += build/lib/lensmat-design.so build/obj/design_tests/t_toltilt
 -include $(DS_OBJ:.o=.d) $(DS_SOBJ:.o=.d)
