@@ -77,5 +77,5 @@ printf 'BENCH tol_mc_tilt_lenses_per_s %.1f lenses/s\n' "$(median < trate)"
 # against the first-order closed form of tests/design/t_toltilt.c
 T=$TOP/build/obj/design_tests/t_toltilt
 if [ -x "$T" ]; then
-    "$T" | awk '/^closed form: worst relative error/ { printf "BENCH tol_tilt_sens_rel_err %s ratio\n", $NF }'
+    (cd "$TOP" && "$T") | awk '/^closed form: worst relative error/ { printf "BENCH tol_tilt_sens_rel_err %s ratio\n", $NF }'
 fi
