@@ -120,7 +120,8 @@ check "--wave, folded: a Newtonian's axis wavefront flat, a fold = straight, a t
 check "--wave, folded: the same under ASan/UBSan" tt_wave_fold "$ASAN"
 
 # Refusals (FILE:LINE, exit 2): overlapping elements, an element kind on one surface,
-# a tilt of 45 degrees or more, a tilt of a coordinate break.
+# a tilt of 45 degrees or more, a tilt of a coordinate break, an element holding one
+# (the group's inverse break would not commute with it).
 tt_bad() (
     tt_dir && cd "$WORK/tt" || return 1
     one() {  # TOLFILE-TEXT EXPECTED [LENS]
@@ -133,6 +134,7 @@ tt_bad() (
         doc/design/sasian-triplet.rx &&
     one 'tol tetx 1 0.1\n' "bad.tol:1: 'tetx' tilts or decentres an element: give its surfaces S-E" &&
     one 'tol tx 1 45\n' "bad.tol:1: '45': a tilt tolerance is in degrees, < 45" &&
-    one 'tol dy 2 0.1\n' 'bad.tol:1: surface 2 is a coordinate break: tilt or decentre the surface after it'
+    one 'tol dy 2 0.1\n' 'bad.tol:1: surface 2 is a coordinate break: tilt or decentre the surface after it' &&
+    one 'tol tx 1-3 0.1\n' 'bad.tol:1: surface 2 is a coordinate break: an element that tilts or decentres as one holds surfaces only'
 )
-check "--tolerance: overlapping elements, an element tilt of one surface, 45 degrees, a break: FILE:LINE" tt_bad
+check "--tolerance: overlapping elements, an element tilt of one surface, 45 degrees, a break, an element with a break: FILE:LINE" tt_bad

@@ -302,6 +302,10 @@ static int tol_tilt(rdr *r, char **t, int kind, int axis, int element, double d)
         if (surface_no(r, t[2], &s0)) return DS_BAD;
         s1 = s0;
     }
+    for (int s = dash ? s0 : s1 + 1; s <= s1; s++)
+        if (l->surf[s].coordbrk)              /* its inverse would not commute with it */
+            return BAD("surface %d is a coordinate break: an element that tilts or "
+                       "decentres as one holds surfaces only", s + 1);
     for (int s = s0; s <= s1; s++) {
         const ln_surface *g = &l->surf[s];
         int e = dash ? s1 : s, gi = 0;
@@ -310,13 +314,13 @@ static int tol_tilt(rdr *r, char **t, int kind, int axis, int element, double d)
             return BAD("surface %d is a coordinate break: tilt or decentre the surface "
                        "after it", s + 1);
         }
-        if (dash && (l->surf[s0].coordbrk || l->surf[s1].coordbrk))
-            return BAD("an element starts and ends on a surface, not a coordinate break");
         if (all) {                            /* all: the surfaces it moves */
             const char *before = s ? l->surf[s - 1].glass : l->obj_glass;
             int plane = !isfinite(g->r) && !(g->type == LN_EVENASPH && g->nasph);
-            if (plane && (kind == DT_DEC || (!g->mirror && !strcasecmp(before, g->glass))))
-                continue;
+            int air0 = !before[0] || !strcasecmp(before, "air");
+            int air1 = !g->glass[0] || !strcasecmp(g->glass, "air");
+            int same = (air0 && air1) || !strcasecmp(before, g->glass);
+            if (plane && (kind == DT_DEC || (!g->mirror && same))) continue;
         }
         if (group_of(r, s, e, &gi)) return DS_BAD;
         if (p->ntol >= DS_MAXTOL) return BAD("more than %d tolerances", DS_MAXTOL);
