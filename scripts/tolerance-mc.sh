@@ -60,5 +60,5 @@ ls part-*.in | parallel "$@" "'$LENSMAT' --tolerance {.}.rec < {} > {.}.out 2>&1
 # 3. the rows in lens order (part names sort as numbers), then one summary
 for f in part-*.tab; do cat "$f"; done > table.txt.part && mv table.txt.part table.txt
 printf '%s\n%s\ntable\ntable.txt\n%s\n' "$LENS" "$TOL" "$LIMIT" | "$LENSMAT" --tolerance summary.rec > /dev/null
-grep -E '^  (.* lenses \(|RMS um|efl mean|yield)' summary.rec
+grep -E '^  (.* lenses \(|RMS um|efl mean|boresight|yield)' summary.rec
 echo "  $N lenses, $j jobs: $DIR/table.txt, $DIR/summary.rec"

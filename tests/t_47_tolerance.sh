@@ -53,7 +53,7 @@ check "--tolerance: a bad table row is refused with FILE:LINE" sh -c "
     printf 'doc/design/sasian-triplet.rx\ndoc/design/sasian.tol\ntable\nbad.tab\n0\n' > bt.in
     '$BIN' --tolerance -i bt.in bt.rec > /dev/null 2> bt.err; rc=\$?
     [ \$rc -eq 2 ] && grep -q 'bad.tab:3: not a row of a tolerance table' bt.err"
-check "--tolerance: a tilt tolerance is refused with FILE:LINE (not in the sequential model)" sh -c "
+check "--tolerance: an unknown tolerance kind (tilt: tx ty dx dy are the kinds) is refused with FILE:LINE" sh -c "
     cd '$WORK/tl' && printf 'tol tilt 1 0.1\n' > tilt.tol &&
     printf 'doc/design/sasian-triplet.rx\ntilt.tol\n' > tt.in
     '$BIN' --tolerance -i tt.in tt.rec > /dev/null 2> tt.err; rc=\$?

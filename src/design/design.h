@@ -11,7 +11,8 @@
  *     target efl 50 weight 1
  *     target rms 0 field 2 wave 0
  *     min ct 2 surface 1   (a bound: counts only when violated)
- *     tol r all 0.1%       tolerances; tolopt dist uniform, tolopt limit 25 ...
+ *     tol r all 0.1%       tolerances (r t n k; tx ty in degrees, dx dy, of a surface
+ *                          or an element 2-3); tolopt dist uniform, tolopt limit 25 ...
  *     design rings 3 arms 6 method lm
  * Get the table with
  *     ds_get_api_fn get = (ds_get_api_fn)lm_engine_symbol("design", DS_API_SYMBOL);
@@ -21,7 +22,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define DS_ABI 1
+#define DS_ABI 2     /* 2: ds_crit.bore, tilt and decentre tolerances, folded lenses */
 #define DS_API_SYMBOL "ds_get_api"
 #define DS_ERR_MAX 1024
 
@@ -62,7 +63,8 @@ typedef struct ds_opt_result {
 
 /* Tolerancing. */
 typedef struct ds_tol_info {
-    char name[32];             /* "r 1", "t 2", "n 3", "k 5" */
+    char name[32];             /* "r 1", "t 2", "n 3", "k 5", "tx 2", "dy 1-2" (an element) */
+    int angle;                 /* 1: delta is in degrees (tx, ty) */
     double delta;              /* the tolerance (absolute, in the parameter's unit) */
     long line;
 } ds_tol_info;
@@ -72,11 +74,15 @@ typedef struct ds_crit {
                                   mean of every field's polychromatic RMS about its
                                   centroid, after the back-focus compensator */
     double efl, bfd;           /* paraxial, primary wavelength */
-    double focus;              /* the compensator's image-plane shift */
+    double focus;              /* the compensator's image-plane shift, along the light
+                                  (the last thickness's change, sign as if unfolded) */
     double wave;               /* with ds_tol_opts.wave: RMS wavefront (waves, piston
                                   removed; field-weighted quadratic mean, every
                                   wavelength) on the compensated image plane; else NaN */
     int ok;                    /* 0: a ray failed (missed, TIR): rms is NaN */
+    double bore[2];            /* field 1's chief ray (primary wavelength) on the
+                                  compensated image plane, x and y (lens units): for an
+                                  on-axis field 1 the boresight error times the efl */
 } ds_crit;
 typedef struct ds_tol_opts {
     int dist;                  /* 0 uniform in [-d, d], 1 Gaussian sigma d/2 cut at +-d */

@@ -27,7 +27,15 @@ static void tol_info(const ds_problem *p, int i, ds_tol_info *out)
     static const char *const k[] = {"r", "t", "n", "k"};
     const ds_tol *t = &p->tol[i];
     memset(out, 0, sizeof *out);
-    snprintf(out->name, sizeof out->name, "%s %d", k[t->kind], t->surf + 1);
+    if (t->kind == DT_TILT || t->kind == DT_DEC) {
+        const ds_grp *g = &p->grp[t->grp];
+        char what[4] = {t->kind == DT_TILT ? 't' : 'd', t->axis ? 'y' : 'x', 0, 0};
+        if (g->s0 == g->s1) snprintf(out->name, sizeof out->name, "%s %d", what, g->s0 + 1);
+        else snprintf(out->name, sizeof out->name, "%s %d-%d", what, g->s0 + 1, g->s1 + 1);
+        out->angle = t->kind == DT_TILT;
+    } else {
+        snprintf(out->name, sizeof out->name, "%s %d", k[t->kind], t->surf + 1);
+    }
     out->delta = t->delta;
     out->line = t->line;
 }
@@ -88,10 +96,22 @@ static void op_info(const ds_problem *p, int i, ds_op_info *out)
 
 static void describe(const ds_problem *p, char *buf, size_t cap)
 {
+    /* the half pupil only while the lens is symmetric in x (ds_setup's xsym): not with
+     * a break that decentres in x or turns about y or z, nor tolerances that do */
+    int whole = 0;
+    for (int i = 0; i < p->lens.nsurf; i++) {
+        const ln_surface *s = &p->lens.surf[i];
+        whole |= s->coordbrk && (s->cb_dec[0] != 0 || s->cb_tilt[1] != 0 || s->cb_tilt[2] != 0);
+    }
+    for (int i = 0; i < p->ntol; i++)
+        whole |= (p->tol[i].kind == DT_DEC && p->tol[i].axis == 0) ||
+                 (p->tol[i].kind == DT_TILT && p->tol[i].axis == 1);
     snprintf(buf, cap, "Gaussian quadrature pupil: %d ring%s x %d arm%s (%d rays per field "
-             "and wavelength, the x > 0 half traced for fields in y), %s, no vignetting; "
+             "and wavelength, %s), %s, no vignetting; "
              "method %s", p->rings, p->rings == 1 ? "" : "s", p->arms,
              p->arms == 1 ? "" : "s", p->rings * p->arms,
+             whole ? "the whole pupil traced: the lens or its tolerances are not symmetric in x"
+                   : "the x > 0 half traced for fields in y",
              p->aim_paraxial ? "rays sent at the paraxial entrance pupil" :
                                "rays aimed at the stop",
              p->method ? "Levenberg-Marquardt with geodesic acceleration" :

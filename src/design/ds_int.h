@@ -14,11 +14,13 @@
 #define DS_MAXRING 32
 #define DS_MAXARM 64
 #define DS_MAXSURF PX_PUPIL_MAXSURF
+#define DS_MAXGRP 64           /* surfaces and elements that tilt and decentre */
+#define DS_MAXRX (DS_MAXSURF + 2 * DS_MAXGRP)   /* the rx with a break pair per group */
 
 enum { DV_C, DV_T, DV_K, DV_A, DV_ND, DV_VD };
 enum { DO_EFL, DO_BFD, DO_TOTR, DO_RMS, DO_DIST, DO_AXCL, DO_SPHA, DO_CT, DO_ET,
        DO_GMAP, DO_COMA, DO_ASTI, DO_FCUR, DO_SDIS, DO_LACL, DO_RMSW };
-enum { DT_R, DT_T, DT_N, DT_K };
+enum { DT_R, DT_T, DT_N, DT_K, DT_TILT, DT_DEC };
 
 typedef struct ds_var {
     int kind, surf, term;      /* term: DV_A's asph index (a4: 1) */
@@ -35,19 +37,29 @@ typedef struct ds_op {
 } ds_op;
 typedef struct ds_tol {
     int kind, surf;
-    double delta;              /* absolute */
+    int axis;                  /* DT_TILT, DT_DEC: 0 x, 1 y */
+    int grp;                   /* DT_TILT, DT_DEC: its group (ds_problem.grp) */
+    double delta;              /* absolute (tilts in degrees) */
     long line;
 } ds_tol;
+/* A surface (s0 == s1) or an element (s0..s1) that tilts and decentres as one: when
+ * perturbed, ds_setup puts a coordinate break before s0 (decentre, then tilt about x
+ * and y, pivoting on s0's vertex) and its inverse after s1 into the rx. */
+typedef struct ds_grp { int s0, s1; } ds_grp;
 
 /* One wavelength's trace set-up for one evaluation. */
 typedef struct ds_wl {
     double lambda;
     double n[DS_MAXSURF + 1];  /* n[0] object, n[i+1] right of surface i */
     char names[DS_MAXSURF + 1][32];
-    px_csurf cs[DS_MAXSURF];
+    px_csurf cs[DS_MAXSURF];   /* first order: the lens unfolded (ln_unfold) */
     px_pupil p;
-    trace_rx rx;
-    trace_rx_surface surf[DS_MAXSURF];
+    int nu, stop_u;            /* the unfolded lens's surfaces and stop */
+    /* the last surface's z folded (zl) and unfolded (zl_u), sig -1 when light leaves
+     * it going -z (odd mirrors): an unfolded image-space z u is zl + sig (u - zl_u) */
+    double zl, zl_u, sig;
+    trace_rx rx;               /* real rays: the lens folded, with the break pairs */
+    trace_rx_surface surf[DS_MAXRX];
     double s;                  /* primary stop radius / this wavelength's */
     int index;                 /* which of the lens's wavelengths */
 } ds_wl;
@@ -62,6 +74,10 @@ struct ds_problem {
     ds_op op[DS_MAXOP];
     ds_tol tol[DS_MAXTOL];
     double dn[DS_MAXSURF + 1]; /* index offsets (tolerancing), as ds_wl.n */
+    int ngrp;
+    ds_grp grp[DS_MAXGRP];
+    double gp[DS_MAXGRP][4];   /* each group's decentre x, y and tilt x, y (degrees) now */
+    int xsym;                  /* ds_setup: the rx is symmetric under x -> -x */
     int rings, arms, method;   /* method 0 lm, 1 lmaccel */
     int aim_paraxial;          /* 1: rays to the paraxial entrance pupil, no aiming */
     ds_tol_opts topt;
@@ -100,6 +116,9 @@ double ds_merit_of(const ds_problem *p, const double *f);
 int ds_field_rays(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, double *pts,
                   double *dirs, double *wt, int cap);
 double ds_image_z(const ln_lens *l, const ds_wl *prim);
+/* The chief ray of field fi at w on the plane z_image: point (x, y) and slopes
+ * (dx/dz, dy/dz).  0, -1 when it fails. */
+int ds_chief(ds_problem *p, ds_wl *w, int fi, double z_image, double pt[2], double sl[2]);
 /* The wavefront of field fi (waves, piston not removed) at every wavelength of w:
  * count, -1 on a failed ray (or no exit pupil), -2 when stopped. */
 int ds_field_wave(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, double *wv,

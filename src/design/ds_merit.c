@@ -12,98 +12,15 @@
  * rings at rho_i = sqrt(u_i), u_i the Gauss-Legendre nodes of (0, 1) in rho^2 (so the
  * rings are exact for polynomials up to rho^(4R-2)), A arms at angles (j + 1/2) 2pi/A
  * from +y; weights w_i / A.  For a field in the y-z plane the pupil's x > 0 half is
- * traced and mirrored (the lens is rotationally symmetric). */
+ * traced and mirrored when the rx is symmetric under x -> -x (ds_problem.xsym: no break
+ * decentres in x or turns about y or z).  The set-up of the lens (pupils, rx, folded
+ * and perturbed) is ds_setup.c's. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include "ds_int.h"
 
 #define DEG (3.14159265358979323846 / 180)
-
-static int index_at(const ds_problem *p, const ln_lens *l, int i, double lambda, double *n,
-                    char *why, size_t cap)
-{
-    if (ln_index(l, i, lambda, n, NULL, why, cap) != LN_OK) return -1;
-    *n += p->dn[i + 1];
-    if (!(*n > 0)) {
-        snprintf(why, cap, "surface %d: the index is not positive", i + 1);
-        return -1;
-    }
-    return 0;
-}
-
-int ds_setup(ds_problem *p, const ln_lens *l, ds_wl *w, int nwl, char *why, size_t cap)
-{
-    double z_prim_stop = 0;
-    for (int i = 0; i < l->nsurf; i++)     /* ds_setup's rx and pupils are centred, refracting */
-        if (l->surf[i].mirror || l->surf[i].coordbrk) {
-            snprintf(why, cap, "surface %d is a %s: optimisation and tolerancing take "
-                     "centred refracting lenses only (--pupil traces folded and tilted ones)",
-                     i + 1, l->surf[i].mirror ? "mirror" : "coordinate break");
-            return -1;
-        }
-    for (int k = 0; k < nwl; k++) {
-        ds_wl *x = &w[k];
-        double z = 0;
-        x->lambda = l->nwl ? l->wl[k] : ln_primary(l);
-        x->index = k;
-        if (index_at(p, l, -1, x->lambda, &x->n[0], why, cap)) return -1;
-        snprintf(x->names[0], sizeof x->names[0], "%.17g", x->n[0]);
-        memset(x->surf, 0, sizeof(trace_rx_surface) * (size_t)l->nsurf);
-        for (int i = 0; i < l->nsurf; i++) {
-            const ln_surface *s = &l->surf[i];
-            trace_rx_surface *t = &x->surf[i];
-            double c = ln_paraxial_curvature(s);
-            if (index_at(p, l, i, x->lambda, &x->n[i + 1], why, cap)) return -1;
-            snprintf(x->names[i + 1], sizeof x->names[i + 1], "%.17g", x->n[i + 1]);
-            x->cs[i].r = c == 0 ? INFINITY : 1 / c;
-            x->cs[i].t = s->t;
-            x->cs[i].glass = x->names[i + 1];
-            t->z = z;
-            t->radius = isfinite(s->r) ? s->r : 0;
-            t->conic = s->conic;
-            t->nasph = s->type == LN_EVENASPH ? (s->nasph < TRACE_MAXASPH ? s->nasph
-                                                                         : TRACE_MAXASPH) : 0;
-            for (int j = 0; j < t->nasph; j++) t->asph[j] = s->asph[j];
-            t->n_right = x->n[i + 1];
-            t->semi_diameter = 0;       /* no vignetting while designing */
-            if (i + 1 < l->nsurf) {
-                if (!(s->t >= 0)) {
-                    snprintf(why, cap, "surface %d: negative thickness %g", i + 1, s->t);
-                    return -1;
-                }
-                z += s->t;
-            }
-        }
-        px_pupil_in in = {x->cs, l->nsurf, l->stop < 0 ? 0 : l->stop, x->names[0],
-                          x->lambda, PX_AP_EPD, l->ap_value,
-                          isinf(l->object) ? INFINITY : l->object, isinf(l->object) ? 45 : 1};
-        in.aperture = l->ap_kind == LN_AP_FNUM ? PX_AP_FNUM :
-                      l->ap_kind == LN_AP_NA ? PX_AP_NA : PX_AP_EPD;
-        if (l->ap_kind == LN_AP_NONE) { in.aperture = PX_AP_EPD; in.ap_value = 1; }
-        if (px_pupil_run(&in, &x->p) != PX_OK) {
-            snprintf(why, cap, "%s", x->p.why);
-            return -1;
-        }
-        if (k == 0) z_prim_stop = x->p.r_stop;
-        x->s = z_prim_stop / x->p.r_stop;
-        x->rx.n_object = x->n[0];
-        x->rx.nsurf = l->nsurf;
-        x->rx.surf = x->surf;
-        x->rx.stop = l->stop < 0 ? 0 : l->stop;
-        x->rx.stop_radius = z_prim_stop;
-        x->rx.z_image = NAN;
-    }
-    return 0;
-}
-
-double ds_image_z(const ln_lens *l, const ds_wl *prim)
-{
-    double z = 0;
-    for (int i = 0; i + 1 < l->nsurf; i++) z += l->surf[i].t;
-    if (l->surf[l->nsurf - 1].t > 0) return z + l->surf[l->nsurf - 1].t;
-    return prim->p.z_img;
-}
 
 static int aim_from(const ds_problem *p, const ds_wl *w, const ln_field *f, double px,
                     double py, const double *g, trace_aim_ray *out);
@@ -183,7 +100,7 @@ int ds_field_rays(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
 {
     const ln_lens *l = &p->lens;
     const ln_field *f = &l->field[fi];
-    int sym = f->x == 0, n = 0, fails = 0;
+    int sym = f->x == 0 && p->xsym, n = 0, fails = 0;
     double wsum = 0;
     for (int k = 0; k < nwl; k++) wsum += l->nwl ? l->wl_weight[k] : 1;
     for (int k = 0; k < nwl; k++) {
@@ -220,6 +137,18 @@ int ds_field_rays(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
     return fails ? -1 : n;
 }
 
+int ds_chief(ds_problem *p, ds_wl *w, int fi, double z_image, double pt[2], double sl[2])
+{
+    trace_aim_ray r;
+    w->rx.z_image = z_image;
+    if (aim_at(p, w, fi, p->rings * p->arms, 0, 0, &r) || r.img_dir[2] == 0) return -1;
+    pt[0] = r.img[0];
+    pt[1] = r.img[1];
+    sl[0] = r.img_dir[0] / r.img_dir[2];
+    sl[1] = r.img_dir[1] / r.img_dir[2];
+    return 0;
+}
+
 static double unit_mm(const char *u)
 {
     return !strcmp(u, "cm") ? 10 : !strcmp(u, "m") ? 1000 : !strcmp(u, "in") ? 25.4 : 1;
@@ -246,7 +175,7 @@ int ds_field_wave(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
 {
     const ln_lens *l = &p->lens;
     const ln_field *f = &l->field[fi];
-    int sym = f->x == 0, n = 0, inf = isinf(l->object);
+    int sym = f->x == 0 && p->xsym, n = 0, inf = isinf(l->object);
     double wsum = 0, um = 1e-3 / unit_mm(l->unit);
     for (int k = 0; k < nwl; k++) wsum += l->nwl ? l->wl_weight[k] : 1;
     for (int k = 0; k < nwl; k++) {
@@ -255,11 +184,13 @@ int ds_field_wave(ds_problem *p, ds_wl *w, int nwl, int fi, double z_image, doub
         double wk = (l->nwl ? l->wl_weight[k] : 1) / wsum, lam = x->lambda * um;
         x->rx.z_image = z_image;
         if (aim_at(p, x, fi, p->rings * p->arms, 0, 0, &ch) || !isfinite(x->p.z_xp) ||
-            !(ch.img_dir[2] > 0))
+            ch.img_dir[2] == 0)
             return -1;
         /* the sphere: centred on the chief ray's image point, through its crossing of
-         * the paraxial exit pupil's plane */
-        double t = (x->p.z_xp - ch.img[2]) / ch.img_dir[2], R = fabs(t), sign = t < 0 ? 1 : -1;
+         * the paraxial exit pupil's plane (the unfolded z taken into the folded frame;
+         * after odd mirrors the rays run -z and t keeps its meaning) */
+        double zxp = x->zl + x->sig * (x->p.z_xp - x->zl_u);
+        double t = (zxp - ch.img[2]) / ch.img_dir[2], R = fabs(t), sign = t < 0 ? 1 : -1;
         double n0 = x->n[0], ni = x->n[l->nsurf];
         if (!(R > 0)) return -1;
         double w0 = sphere_path(&ch, inf, n0, ni, ch.img, R, sign);
@@ -341,15 +272,15 @@ static double scalar_res(const ds_op *o)
 int ds_eval(ds_problem *p, double *f, char *why, size_t cap)
 {
     const ln_lens *l = &p->lens;
-    int nwl = l->nwl ? l->nwl : 1, N = l->nsurf - 1;
+    int nwl = l->nwl ? l->nwl : 1;
     static _Thread_local ds_wl w[LN_WL_MAX];
-    double W = 0, zi, zlast = 0, fmax_deg = 0;
+    double W = 0, zi, zlast, fmax_deg = 0;
     long at = 0;
     p->evals++;
     if (ds_setup(p, l, w, nwl, why, cap)) return -1;
     zi = ds_image_z(l, &w[0]);
     if (!isfinite(zi)) { snprintf(why, cap, "the lens forms no image"); return -1; }
-    for (int i = 0; i < N; i++) zlast += l->surf[i].t;
+    zlast = w[0].zl_u;                     /* back focus: along the unfolded axis */
     for (int i = 0; i < l->nfield; i++) fmax_deg = fmax(fmax_deg, hypot(l->field[i].x, l->field[i].y));
     for (int i = 0; i < p->nop; i++) W += p->op[i].weight;
     if (!(W > 0)) W = 1;
@@ -383,9 +314,8 @@ int ds_eval(ds_problem *p, double *f, char *why, size_t cap)
              * pupil's rim, chief ray at the largest field through the stop's centre */
             px_seidel sd;
             if (!isinf(l->object)) { snprintf(why, cap, "the Seidel operands need the object at infinity"); return -1; }
-            if (px_seidel_run_stop(w[0].cs, l->nsurf, w[0].names[0], w[0].p.r_ep,
-                                   tan(fmax(fmax_deg, 1) * DEG), l->stop < 0 ? 0 : l->stop,
-                                   &sd) != PX_OK) {
+            if (px_seidel_run_stop(w[0].cs, w[0].nu, w[0].names[0], w[0].p.r_ep,
+                                   tan(fmax(fmax_deg, 1) * DEG), w[0].stop_u, &sd) != PX_OK) {
                 snprintf(why, cap, "the Seidel sums cannot be formed");
                 return -1;
             }
@@ -407,7 +337,9 @@ int ds_eval(ds_problem *p, double *f, char *why, size_t cap)
             const px_pupil *pp = &w[0].p;
             double fx = isinf(l->object) ? tan(fl->x * DEG) : fl->x;
             double fy = isinf(l->object) ? tan(fl->y * DEG) : fl->y;
-            double unit = pp->yb[N] + pp->ub[N + 1] * (zi - pp->z[N]);
+            int N = w[0].nu - 1;
+            double zu = w[0].zl_u + w[0].sig * (zi - w[0].zl);   /* the image, unfolded */
+            double unit = pp->yb[N] + pp->ub[N + 1] * (zu - pp->z[N]);
             double rp = hypot(fx * unit, fy * unit);
             w[0].rx.z_image = zi;
             if (aim_at(p, &w[0], o->field, p->rings * p->arms, 0, 0, &r)) o->value = 100;

@@ -134,6 +134,11 @@ static int line_vary(rdr *r, char **t, int n)
     if (n != 3) return BAD("vary KIND SURFACE (KIND: c r t k a4..a16 glass)");
     if (surface_no(r, t[2], &s)) return DS_BAD;
     const char *k = t[1];
+    const ln_surface *gs = &r->p->lens.surf[s];
+    if ((gs->coordbrk && strcmp(k, "t") && strcmp(k, "thic")) ||
+        (gs->mirror && (!strcmp(k, "glass") || !strcmp(k, "nd") || !strcmp(k, "vd"))))
+        return BAD("surface %d is a %s: '%s' cannot vary there", s + 1,
+                   gs->coordbrk ? "coordinate break" : "mirror", k);
     if (!strcmp(k, "c") || !strcmp(k, "r") || !strcmp(k, "curv")) return add_var(r, DV_C, s, 0);
     if (!strcmp(k, "t") || !strcmp(k, "thic")) return add_var(r, DV_T, s, 0);
     if (!strcmp(k, "k") || !strcmp(k, "conic")) return add_var(r, DV_K, s, 0);
@@ -248,28 +253,128 @@ static int line_op(rdr *r, char **t, int n, int bound)
     return DS_OK;
 }
 
+/* The group of surfaces s0..s1 (a surface, or an element) tilts and decentres use:
+ * found or made; groups must nest or stand apart (each is a break pair in the rx). */
+static int group_of(rdr *r, int s0, int s1, int *g)
+{
+    ds_problem *p = r->p;
+    for (int i = 0; i < p->ngrp; i++) {
+        const ds_grp *q = &p->grp[i];
+        if (q->s0 == s0 && q->s1 == s1) { *g = i; return DS_OK; }
+        int apart = s1 < q->s0 || q->s1 < s0;
+        int nested = (q->s0 <= s0 && s1 <= q->s1) || (s0 <= q->s0 && q->s1 <= s1);
+        if (!apart && !nested)
+            return BAD("surfaces %d-%d overlap the element %d-%d of an earlier tol line: "
+                       "elements that tilt or decentre must nest or stand apart",
+                       s0 + 1, s1 + 1, q->s0 + 1, q->s1 + 1);
+    }
+    if (p->ngrp >= DS_MAXGRP) return BAD("more than %d surfaces and elements tilt or decentre",
+                                         DS_MAXGRP);
+    p->grp[p->ngrp].s0 = s0;
+    p->grp[p->ngrp].s1 = s1;
+    *g = p->ngrp++;
+    return DS_OK;
+}
+
+/* Tilts and decentres: tx ty (degrees, about the x and y axes through the first
+ * vertex) and dx dy (lens units) of a surface S, an element S-E, or all (every
+ * surface that has an effect); OpticStudio's TSTX TSTY TSDX TSDY (a surface) and TETX
+ * TETY TEDX TEDY (an element) too. */
+static int tol_tilt(rdr *r, char **t, int kind, int axis, int element, double d)
+{
+    ds_problem *p = r->p;
+    const ln_lens *l = &p->lens;
+    int s0, s1, all = !strcmp(t[2], "all");
+    char *dash = all ? NULL : strchr(t[2], '-');
+    if (all) {
+        if (element) return BAD("an element tolerance takes surfaces S-E, not all");
+        s0 = 0;
+        s1 = l->nsurf - 1;
+    } else if (dash) {
+        *dash = '\0';
+        int bad = surface_no(r, t[2], &s0) || surface_no(r, dash + 1, &s1);
+        *dash = '-';
+        if (bad) return DS_BAD;
+        if (s1 <= s0) return BAD("'%s': an element is surfaces S-E with E after S", t[2]);
+    } else {
+        if (element) return BAD("'%s' tilts or decentres an element: give its surfaces S-E",
+                                t[1]);
+        if (surface_no(r, t[2], &s0)) return DS_BAD;
+        s1 = s0;
+    }
+    for (int s = dash ? s0 : s1 + 1; s <= s1; s++)
+        if (l->surf[s].coordbrk)              /* its inverse would not commute with it */
+            return BAD("surface %d is a coordinate break: an element that tilts or "
+                       "decentres as one holds surfaces only", s + 1);
+    for (int s = s0; s <= s1; s++) {
+        const ln_surface *g = &l->surf[s];
+        int e = dash ? s1 : s, gi = 0;
+        if (!dash && g->coordbrk) {
+            if (all) continue;
+            return BAD("surface %d is a coordinate break: tilt or decentre the surface "
+                       "after it", s + 1);
+        }
+        if (all) {                            /* all: the surfaces it moves */
+            const char *before = s ? l->surf[s - 1].glass : l->obj_glass;
+            int plane = !isfinite(g->r) && !(g->type == LN_EVENASPH && g->nasph);
+            int air0 = !before[0] || !strcasecmp(before, "air");
+            int air1 = !g->glass[0] || !strcasecmp(g->glass, "air");
+            int same = (air0 && air1) || !strcasecmp(before, g->glass);
+            if (plane && (kind == DT_DEC || (!g->mirror && same))) continue;
+        }
+        if (group_of(r, s, e, &gi)) return DS_BAD;
+        if (p->ntol >= DS_MAXTOL) return BAD("more than %d tolerances", DS_MAXTOL);
+        ds_tol *o = &p->tol[p->ntol++];
+        o->kind = kind;
+        o->axis = axis;
+        o->surf = s;
+        o->grp = gi;
+        o->delta = d;
+        o->line = r->line;
+        if (dash) break;
+    }
+    return DS_OK;
+}
+
 static int line_tol(rdr *r, char **t, int n)
 {
     ds_problem *p = r->p;
-    int kind, s0, s1, rel = 0;
+    int kind, s0, s1, rel = 0, axis = 0, element = 0;
     double d;
     char v[64];
-    if (n != 4) return BAD("tol KIND SURFACE|all DELTA[%%] (KIND: r t n k)");
+    static const char *const tilts[] = {"tx", "ty", "dx", "dy", "tstx", "tsty", "tsdx",
+                                        "tsdy", "tetx", "tety", "tedx", "tedy", NULL};
+    if (n != 4) return BAD("tol KIND SURFACE|S-E|all DELTA[%%] (KIND: r t n k tx ty dx dy)");
     if (!strcmp(t[1], "r")) kind = DT_R;
     else if (!strcmp(t[1], "t")) kind = DT_T;
     else if (!strcmp(t[1], "n")) kind = DT_N;
     else if (!strcmp(t[1], "k")) kind = DT_K;
-    else return BAD("'%s' is not a tolerance (r t n k; tilts and decentres are not "
-                    "in the sequential model)", t[1]);
+    else {
+        int i = 0;
+        while (tilts[i] && strcasecmp(tilts[i], t[1])) i++;
+        if (!tilts[i])
+            return BAD("'%s' is not a tolerance (r t n k; tx ty dx dy, or OpticStudio's "
+                       "TSTX TSTY TSDX TSDY TETX TETY TEDX TEDY)", t[1]);
+        kind = (i % 4) < 2 ? DT_TILT : DT_DEC;
+        axis = i % 2;
+        element = i >= 8;
+    }
     snprintf(v, sizeof v, "%s", t[3]);
     size_t lv = strlen(v);
     if (lv && v[lv - 1] == '%') { v[lv - 1] = '\0'; rel = 1; }
     if (!num(v, &d) || !(d > 0)) return BAD("'%s': a tolerance is a number > 0", t[3]);
     if (rel && kind != DT_R) return BAD("only radius tolerances may be relative (%%)");
+    if (kind == DT_TILT && d >= 45) return BAD("'%s': a tilt tolerance is in degrees, < 45", t[3]);
+    if (kind == DT_TILT || kind == DT_DEC) return tol_tilt(r, t, kind, axis, element, d);
     if (!strcmp(t[2], "all")) { s0 = 0; s1 = p->lens.nsurf; }
     else { if (surface_no(r, t[2], &s0)) return DS_BAD; s1 = s0 + 1; }
     for (int s = s0; s < s1; s++) {
         const ln_surface *g = &p->lens.surf[s];
+        if (g->coordbrk && kind != DT_T) {
+            if (s1 - s0 > 1) continue;
+            return BAD("surface %d is a coordinate break: it has no %s", s + 1,
+                       kind == DT_R ? "radius" : kind == DT_N ? "glass" : "conic");
+        }
         if (!strcmp(t[2], "all")) {            /* all: the ones that have it */
             if (kind == DT_R && !isfinite(g->r)) continue;
             if (kind == DT_T && (s == p->lens.nsurf - 1 || g->t == 0)) continue;
@@ -277,6 +382,8 @@ static int line_tol(rdr *r, char **t, int n)
         } else if (kind == DT_R && !isfinite(g->r)) {
             return BAD("surface %d is a plane: give its tolerance as a power (not here)", s + 1);
         }
+        if (kind == DT_N && g->mirror)
+            return BAD("surface %d is a mirror: its medium is the one before it", s + 1);
         if (p->ntol >= DS_MAXTOL) return BAD("more than %d tolerances", DS_MAXTOL);
         ds_tol *o = &p->tol[p->ntol++];
         o->kind = kind;
@@ -487,12 +594,22 @@ int ds_read(const char *lens_text, size_t lens_len, const char *lens_src,
     if (rc == LN_OK) rc = ln_check(&p->lens, lens_src, err, cap) == LN_OK ? DS_OK : DS_BAD;
     if (rc == DS_OK && p->lens.nsurf > DS_MAXSURF)
         rc = fail(err, cap, lens_src, 0, "%d surfaces: at most %d", p->lens.nsurf, DS_MAXSURF);
-    for (int i = 0; rc == DS_OK && i < p->lens.nsurf; i++)     /* ds_setup: centred, refracting */
-        if (p->lens.surf[i].mirror || p->lens.surf[i].coordbrk)
-            rc = fail(err, cap, lens_src, p->lens.surf[i].line, "surface %d is a %s: "
-                      "optimisation and tolerancing take centred refracting lenses only "
-                      "(--pupil traces folded and tilted ones)", i + 1,
-                      p->lens.surf[i].mirror ? "mirror" : "coordinate break");
+    if (rc == DS_OK && (ln_mirrors(&p->lens) || ln_breaks(&p->lens))) {
+        /* folded or tilted: first order from the lens unfolded (ds_setup.c) */
+        ln_lens u;
+        char why[LN_ERR_MAX];
+        if (ln_unfold(&p->lens, &u, NULL, why, sizeof why) != LN_OK) {
+            rc = fail(err, cap, lens_src, 0, "%s", why);
+        } else {
+            if (u.nsurf > DS_MAXSURF)
+                rc = fail(err, cap, lens_src, 0, "%d surfaces unfolded: at most %d", u.nsurf,
+                          DS_MAXSURF);
+            ln_free(&u);
+        }
+        if (rc == DS_OK && p->lens.stop >= 0 && p->lens.surf[p->lens.stop].coordbrk)
+            rc = fail(err, cap, lens_src, p->lens.surf[p->lens.stop].line,
+                      "surface %d: a coordinate break cannot be the stop", p->lens.stop + 1);
+    }
     if (rc == DS_OK && clean) rc = read_lines(p, lens_text, lens_len, lens_src, 1, err, cap);
     free(clean);
     if (rc == DS_OK && merit_text)

@@ -1,6 +1,9 @@
 /* ds_tol.c -- tolerancing: the criteria of a lens as built (RMS spot after the
- * back-focus compensator, EFL, back focus), a tolerance applied alone (sensitivities)
- * and Monte Carlo lenses drawn from every tolerance at once.
+ * back-focus compensator, EFL, back focus, the boresight), a tolerance applied alone
+ * (sensitivities) and Monte Carlo lenses drawn from every tolerance at once.  Tilts
+ * and decentres are offsets of their group (ds_problem.gp) that ds_setup turns into
+ * coordinate breaks; first order (EFL, back focus) takes them as zero, as a
+ * designer's paraxial data do.
  *
  * The compensator in closed form: rays aimed at the stop do not depend on where the
  * image plane is, and each ray's point on a plane moved by dz is p + dz d (d its
@@ -25,13 +28,13 @@ static int crit(ds_problem *p, const ds_tol_opts *o, ds_crit *c)
     static ds_wl w[LN_WL_MAX];
     static double pts[2 * MAXRAY], dir[2 * MAXRAY], wt[MAXRAY];
     const ln_lens *l = &p->lens;
-    int nwl = l->nwl ? l->nwl : 1, N = l->nsurf - 1;
+    int nwl = l->nwl ? l->nwl : 1;
     char why[256];
-    double zi, zlast = 0, sab = 0, sbb = 0, wsum = 0;
+    double zi, zlast, sab = 0, sbb = 0, wsum = 0, bp[2], bs[2];
     memset(c, 0, sizeof *c);
-    c->rms = c->efl = c->bfd = c->wave = NAN;
+    c->rms = c->efl = c->bfd = c->wave = c->bore[0] = c->bore[1] = NAN;
     if (ds_setup(p, l, w, nwl, why, sizeof why)) return DS_OK;
-    for (int i = 0; i < N; i++) zlast += l->surf[i].t;
+    zlast = w[0].zl_u;
     zi = ds_image_z(l, &w[0]);
     c->efl = w[0].p.efl;
     c->bfd = w[0].p.z_img - zlast;
@@ -71,7 +74,12 @@ static int crit(ds_problem *p, const ds_tol_opts *o, ds_crit *c)
         r2 += fw * (v > 0 ? v : 0);
     }
     c->rms = wsum > 0 ? sqrt(r2 / wsum) : NAN;
-    c->focus = dz;
+    c->focus = dz * w[0].sig;               /* along the light: after odd mirrors it runs -z */
+    /* the boresight: field 1's chief ray at the primary wavelength on the refocused
+     * plane (linear in tilts and decentres, where the spot is quadratic) */
+    if (ds_chief(p, &w[0], 0, zi, bp, bs)) return DS_OK;
+    c->bore[0] = bp[0] + dz * bs[0];
+    c->bore[1] = bp[1] + dz * bs[1];
     c->ok = 1;
     if (o->wave) {
         double v2 = 0;
@@ -94,6 +102,7 @@ static void restore(ds_problem *p)
 {
     memcpy(p->lens.surf, p->base.surf, sizeof(ln_surface) * (size_t)p->base.nsurf);
     memset(p->dn, 0, sizeof p->dn);
+    memset(p->gp, 0, sizeof p->gp);
 }
 
 static void apply(ds_problem *p, int i, double v)
@@ -104,6 +113,8 @@ static void apply(ds_problem *p, int i, double v)
     case DT_R: ln_set_radius(s, s->r + v); break;
     case DT_T: s->t += v; break;
     case DT_N: p->dn[t->surf + 1] += v; break;
+    case DT_DEC: p->gp[t->grp][t->axis] += v; break;
+    case DT_TILT: p->gp[t->grp][2 + t->axis] += v; break;
     default: s->conic += v; break;
     }
 }

@@ -3,7 +3,8 @@
 # engine (src/paraxial) inside as hidden position-independent objects (nothing of them
 # exported), and its sanitizer twin; the real rays come from lensmat-trace.so through
 # the trace_api table its caller hands in.  Tests: tests/design/t_*.c (both builds, run
-# by tests/t_46_optimise.sh and t_47_tolerance.sh), linked to the two modules.
+# by tests/t_44_tol_tilt.sh, t_46_optimise.sh and t_47_tolerance.sh), linked to the two
+# modules; t_toltilt is also a bench binary (bench_design.sh: tol_tilt_sens_rel_err).
 DS_SRC   := $(wildcard src/design/ds_*.c)
 DS_LX    := $(wildcard src/lens/*.c src/paraxial/*.c)
 DS_OBJ   := $(patsubst src/%.c,build/obj/%.o,$(DS_SRC)) \
@@ -49,5 +50,5 @@ build/asan/design_tests/%: tests/design/%.c build/asan/lib/lensmat-design.so \
 
 all: build/lib/lensmat-design.so
 MODULE_TEST_BINS  += build/lib/lensmat-design.so build/asan/lib/lensmat-design.so $(DS_TBIN)
-MODULE_BENCH_BINS += build/lib/lensmat-design.so
+MODULE_BENCH_BINS += build/lib/lensmat-design.so build/obj/design_tests/t_toltilt
 -include $(DS_OBJ:.o=.d) $(DS_SOBJ:.o=.d)

@@ -1,6 +1,7 @@
 /* lensrx.c -- a lens file made ready for aimed rays (see lensrx.h): reading and
  * checking it, the missing answers, the first-order pupils and the trace_rx per
- * wavelength.  The steps are --pupil's (pupil.c), here shared for other dialogues. */
+ * wavelength.  The steps are --pupil's (pupil.c), here shared for other dialogues;
+ * a folded lens as --pupil takes one (first order unfolded, rays folded). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -170,9 +171,13 @@ int lr_ask_lens(lr_lens *L, calc *c, const lr_texts *t)
     return ask_missing(L);
 }
 
+/* The lens first-order optics sees: unfolded when folded. */
+static const ln_lens *plens(const lr_lens *L) { return L->unf.nsurf ? &L->unf : &L->lens; }
+static double real_z(const lr_lens *L, double u) { return L->zl + L->sig * (u - L->zl_u); }
+
 static int pupil_at(const lr_lens *L, double lambda, px_pupil *p, char *why, size_t cap)
 {
-    const ln_lens *l = &L->lens;
+    const ln_lens *l = plens(L);
     px_pupil_in in = {L->cs, l->nsurf, l->stop, L->obj, lambda, PX_AP_EPD, l->ap_value,
                       isinf(l->object) ? INFINITY : l->object, isinf(l->object) ? 45 : 1};
     in.aperture = l->ap_kind == LN_AP_FNUM ? PX_AP_FNUM : l->ap_kind == LN_AP_NA ? PX_AP_NA
@@ -181,6 +186,10 @@ static int pupil_at(const lr_lens *L, double lambda, px_pupil *p, char *why, siz
         snprintf(why, cap, "%s", p->why);
         return -1;
     }
+    if (L->unf.nsurf) {                    /* image space into the folded frame */
+        p->z_xp = real_z(L, p->z_xp);
+        p->z_img = real_z(L, p->z_img);
+    }
     return 0;
 }
 
@@ -188,11 +197,25 @@ int lr_prepare(lr_lens *L, char *why, size_t cap)
 {
     const ln_lens *l = &L->lens;
     double zl = 0;
-    if (ln_to_csurf(l, L->cs, L->names, &L->obj, why, cap) != LN_OK) return -1;
+    int nm = ln_mirrors(l);
+    L->sig = nm % 2 ? -1 : 1;
+    L->zl_u = 0;
+    ln_free(&L->unf);
+    if (nm || ln_breaks(l)) {
+        if (ln_unfold(l, &L->unf, NULL, why, cap) != LN_OK) return -1;
+        if (L->unf.nsurf > PX_PUPIL_MAXSURF) {
+            snprintf(why, cap, "%d surfaces unfolded: at most %d", L->unf.nsurf,
+                     PX_PUPIL_MAXSURF);
+            return -1;
+        }
+        for (int i = 0; i + 1 < L->unf.nsurf; i++) L->zl_u += L->unf.surf[i].t;
+    }
+    for (int i = 0; i + 1 < l->nsurf; i++) zl += l->surf[i].t;
+    L->zl = zl;
+    if (ln_to_csurf(plens(L), L->cs, L->names, &L->obj, why, cap) != LN_OK) return -1;
     if (pupil_at(L, ln_primary(l), &L->prim, why, cap)) return -1;
     L->scale = fmax(fabs(L->prim.efl), L->prim.r_stop);
-    for (int i = 0; i + 1 < l->nsurf; i++) zl += l->surf[i].t;
-    if (l->surf[l->nsurf - 1].t > 0) {
+    if (l->surf[l->nsurf - 1].t * L->sig > 0) {   /* after odd mirrors: negative */
         L->z_image = zl + l->surf[l->nsurf - 1].t;
         L->image_from_file = 1;
     } else {
@@ -219,6 +242,12 @@ int lr_at(const lr_lens *L, double lambda, lr_wl *w, char *why, size_t cap)
         t->nasph = s->nasph < TRACE_MAXASPH ? s->nasph : TRACE_MAXASPH;
         for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
         t->semi_diameter = s->semi;
+        t->mirror = s->mirror;
+        t->coordbrk = s->coordbrk;
+        t->order = s->cb_order;
+        t->decenter[0] = s->cb_dec[0];
+        t->decenter[1] = s->cb_dec[1];
+        for (int k = 0; k < 3; k++) t->tilt[k] = s->cb_tilt[k];
         if (ln_index(l, i, lambda, &t->n_right, NULL, why, cap) != LN_OK) return -1;
         z += s->t;
     }
@@ -254,6 +283,7 @@ void lr_request(const lr_lens *L, const lr_wl *w, const ln_field *f, double px, 
 
 void lr_free(lr_lens *L)
 {
+    ln_free(&L->unf);
     if (L->have) ln_free(&L->lens);
     L->have = 0;
     ln_notes_free(&L->notes);

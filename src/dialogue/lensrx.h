@@ -37,11 +37,17 @@ typedef struct lr_lens {
                                   afocal at the image, no plane to carry them to) */
     int image_from_file;       /* 1: the file's last thickness; 0: paraxial focus */
     double scale;              /* the lens's size (efl, stop) */
+    /* A folded or tilted lens (mirrors, coordinate breaks): first order from it
+     * unfolded (ln_unfold, as --pupil), real rays traced folded.  unf.nsurf 0: not
+     * folded; zl, zl_u the last surface's z folded and unfolded, sig -1 when light
+     * leaves it going -z: an unfolded image-space z u is zl + sig (u - zl_u). */
+    ln_lens unf;
+    double zl, zl_u, sig;
 } lr_lens;
 
 typedef struct lr_wl {
     double lambda;             /* um */
-    px_pupil p;
+    px_pupil p;                /* z_xp, z_img: in the folded lens's last frame */
     trace_rx rx;
     trace_rx_surface surf[PX_PUPIL_MAXSURF];
     double s;                  /* marginal-ray scale: primary stop size / this one */

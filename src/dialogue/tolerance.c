@@ -1,7 +1,8 @@
 /* tolerance.c -- the --tolerance dialogue: a lens file with its tolerances (tol
  * lines, doc/design.md), then (sens) each tolerance alone at -delta and +delta with
  * the criteria of the design module (RMS spot after the back-focus compensator, EFL,
- * back focus) and the EFL spread the linear sensitivities predict; (mc) N lenses
+ * back focus, the boresight: field 1's chief ray on the image plane) and the EFL and
+ * boresight spreads the linear sensitivities predict; (mc) N lenses
  * drawn from every tolerance, one table row each, percentiles and yield; (table) the
  * same summary of a table that scripts/tolerance-mc.sh merged from many jobs.  The
  * summary is always computed from the table's text, so one process and many jobs
@@ -83,7 +84,7 @@ static int sens(tdlg *d)
     const ds_api *ds = d->ds;
     ds_problem *p = d->f.p;
     ds_crit n, a, b;
-    double ve = 0, vb = 0, k = d->o.dist ? 0.25 * 0.7737413 : 1.0 / 3;
+    double ve = 0, vb = 0, vx = 0, vy = 0, k = d->o.dist ? 0.25 * 0.7737413 : 1.0 / 3;
     d->o.wave = 1;
     if (ds->tol_nominal(p, &d->o, &n) == DS_STOPPED) return LM_FAIL;
     calc_say(&d->c, P(NOMINAL), n.rms * d->um, n.wave, n.efl, n.bfd, lm_clean(d->io, n.focus));
@@ -96,14 +97,22 @@ static int sens(tdlg *d)
             ds->tol_one(p, &d->o, i, 1, &b) == DS_STOPPED)
             return LM_FAIL;
         if (!a.ok || !b.ok) { calc_say(&d->c, P(SENS_FAIL), t.name, t.delta, t.line); continue; }
+        double bx = (b.bore[0] - a.bore[0]) / 2 * d->um, by = (b.bore[1] - a.bore[1]) / 2 * d->um;
+        /* a shift that is rounding (1e-18 um across a fold) prints as 0 on every build */
+        if (fabs(bx) < 1e-9) bx = 0;
+        if (fabs(by) < 1e-9) by = 0;
         calc_say(&d->c, P(SENS_ROW), t.name, t.delta, a.rms * d->um, b.rms * d->um, a.wave,
-                 b.wave, a.efl, b.efl, a.bfd, b.bfd, t.line);
+                 b.wave, a.efl, b.efl, a.bfd, b.bfd, lm_clean(d->io, bx), lm_clean(d->io, by),
+                 t.line);
         /* the half-difference is the linear change at +delta; its variance factor
          * that of the distribution over [-delta, delta] in delta^2 */
         ve += k * pow((b.efl - a.efl) / 2, 2);
         vb += k * pow((b.bfd - a.bfd) / 2, 2);
+        vx += k * bx * bx;
+        vy += k * by * by;
     }
     calc_say(&d->c, P(PREDICT), sqrt(ve), sqrt(vb));
+    calc_say(&d->c, P(PREDICT_BORE), n.bore[0] * d->um, n.bore[1] * d->um, sqrt(vx), sqrt(vy));
     return LM_GO;
 }
 
@@ -122,12 +131,14 @@ static double pct(const double *v, long n, double q)
     return v[r - 1];
 }
 
-/* The summary of a table's text (rows "lens rms_um efl bfd focus", '#' comments). */
+/* The summary of a table's text (rows "lens rms_um efl bfd focus [bx_um by_um]", '#'
+ * comments; the boresight columns summarised when every good row has them). */
 static int summary(tdlg *d, const char *src, const char *text, double limit_um)
 {
     long n = 0, cap = 1024, fails = 0, good = 0, line = 0;
     double *rms = malloc(sizeof(double) * (size_t)cap), se = 0, se2 = 0, sb = 0, sb2 = 0;
-    int nf = 0;
+    double sx = 0, sx2 = 0, sy = 0, sy2 = 0;
+    int nf = 0, nbore = 0;
     const char *s = text;
     if (!rms) return LM_FAIL;
     while (*s) {
@@ -135,13 +146,15 @@ static int summary(tdlg *d, const char *src, const char *text, double limit_um)
         size_t len = e ? (size_t)(e - s) : strlen(s);
         char buf[256], r[64];
         long k;
-        double efl, bfd, foc;
+        double efl, bfd, foc, bx, by;
+        int got;
         line++;
         if (len && s[0] != '#') {
             if (len >= sizeof buf) len = sizeof buf - 1;
             memcpy(buf, s, len);
             buf[len] = '\0';
-            if (sscanf(buf, "%ld %63s %lf %lf %lf", &k, r, &efl, &bfd, &foc) != 5) {
+            got = sscanf(buf, "%ld %63s %lf %lf %lf %lf %lf", &k, r, &efl, &bfd, &foc, &bx, &by);
+            if (got != 5 && got != 7) {
                 char m[512];
                 snprintf(m, sizeof m, P(BAD_TABLE), src, line);
                 calc_say(&d->c, P(REFUSED), m);
@@ -160,6 +173,7 @@ static int summary(tdlg *d, const char *src, const char *text, double limit_um)
                 rms[n++] = v;
                 if (limit_um > 0 && v <= limit_um) good++;
                 se += efl; se2 += efl * efl; sb += bfd; sb2 += bfd * bfd; nf++;
+                if (got == 7) { sx += bx; sx2 += bx * bx; sy += by; sy2 += by * by; nbore++; }
             }
         }
         s = e ? e + 1 : s + len;
@@ -174,6 +188,12 @@ static int summary(tdlg *d, const char *src, const char *text, double limit_um)
         double me = se / nf, mb = sb / nf;
         double ve = (se2 - nf * me * me) / (nf - 1), vb = (sb2 - nf * mb * mb) / (nf - 1);
         calc_say(&d->c, P(EFL), me, sqrt(ve > 0 ? ve : 0), mb, sqrt(vb > 0 ? vb : 0));
+    }
+    if (nf > 1 && nbore == nf) {
+        double mx = sx / nf, my = sy / nf;
+        double vx = (sx2 - nf * mx * mx) / (nf - 1), vy = (sy2 - nf * my * my) / (nf - 1);
+        calc_say(&d->c, P(BORE), lm_clean(d->io, mx), sqrt(vx > 0 ? vx : 0),
+                 lm_clean(d->io, my), sqrt(vy > 0 ? vy : 0));
     }
     if (limit_um > 0 && n) calc_say(&d->c, P(YIELD), limit_um, good, n, 100.0 * good / n);
     free(rms);
@@ -206,10 +226,10 @@ static int mc(tdlg *d)
     snprintf(sd, sizeof sd, "%llu", seed);
     calc_say(&d->c, P(MC_HEAD), first, first + count - 1, sd, di ? "Gaussian, sigma delta/2 cut "
              "at 2 sigma" : "uniform in [-delta, delta]");
-    size_t cap = (size_t)count * 96 + 128, len = 0;
+    size_t cap = (size_t)count * 160 + 128, len = 0;
     char *tab = malloc(cap);
     if (!tab) return LM_FAIL;
-    if (first == 1) len += (size_t)snprintf(tab, cap, "# lens rms_um efl bfd focus\n");
+    if (first == 1) len += (size_t)snprintf(tab, cap, "# lens rms_um efl bfd focus bx_um by_um\n");
     for (long k = first; k < first + count; k++) {
         ds_crit c;
         if (lm_stop_requested() || ds->tol_mc(p, &d->o, seed, k, &c) == DS_STOPPED) {
@@ -221,9 +241,10 @@ static int mc(tdlg *d)
         char r[32];
         if (c.ok) snprintf(r, sizeof r, "%.6f", c.rms * d->um);
         else snprintf(r, sizeof r, "fail");
-        len += (size_t)snprintf(tab + len, cap - len, "%ld %s %.9f %.9f %.6e\n", k, r,
-                                isfinite(c.efl) ? c.efl : 0.0, isfinite(c.bfd) ? c.bfd : 0.0,
-                                c.ok ? c.focus : 0.0);
+        len += (size_t)snprintf(tab + len, cap - len, "%ld %s %.9f %.9f %.6e %.6f %.6f\n", k,
+                                r, isfinite(c.efl) ? c.efl : 0.0, isfinite(c.bfd) ? c.bfd : 0.0,
+                                c.ok ? c.focus : 0.0, c.ok ? lm_clean(d->io, c.bore[0] * d->um) : 0.0,
+                                c.ok ? lm_clean(d->io, c.bore[1] * d->um) : 0.0);
     }
     rc = summary(d, "-", tab, limit);
     if (rc == LM_GO && strcmp(out, "-")) {

@@ -307,8 +307,25 @@ static void make_ray(const aim_sys *a, const trace_aim_req *rq, const double v[2
                      double o[3], double d[3], double q[3])
 {
     if (rq->infinite) {
-        double z0 = fmin(rq->z_ref, a->rx->surf[0].coordbrk ? a->rx->surf[0].z : a->g[0].lo[2]) -
-                    1e-3 * a->scale;
+        /* start left of the first surface; behind leading breaks the first surface
+         * is turned and may reach back past the breaks' z by its own depth and up to
+         * its size times the sine of the turn (the path counts from z_ref whatever the
+         * start, but a start far back costs rounding in the stop residual) */
+        const trace_rx *rx = a->rx;
+        double z0;
+        if (rx->surf[0].coordbrk) {
+            double turn = 0;
+            int k = 0;
+            while (k + 1 < rx->nsurf && rx->surf[k].coordbrk) {
+                turn += fabs(rx->surf[k].tilt[0]) + fabs(rx->surf[k].tilt[1]);
+                k++;
+            }
+            double back = rx->surf[k].coordbrk ? 0 : fmax(0, rx->surf[k].z - a->g[k].lo[2]);
+            back += a->scale * sin(fmin(turn, 90) * AIM_DEG);
+            z0 = fmin(rq->z_ref, fmin(rx->surf[0].z, rx->surf[k].z) - back) - 1e-3 * a->scale;
+        } else {
+            z0 = fmin(rq->z_ref, a->g[0].lo[2]) - 1e-3 * a->scale;
+        }
         v_set(d, rq->dir);
         v_unit(d);
         q[0] = v[0]; q[1] = v[1]; q[2] = rq->z_ref;

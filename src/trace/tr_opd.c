@@ -47,8 +47,10 @@ int tr_rx_opd(const trace_rx *rx, const trace_aim_req *rq, int n, double z_xp, d
         snprintf(err, errcap, "the chief ray does not pass (surface %d)", c.surface + 1);
         return TRACE_EINVAL;
     }
-    if (!(c.img_dir[2] > 0) || !isfinite(c.img[2])) {
-        snprintf(err, errcap, "the chief ray does not reach the image plane forwards");
+    /* after an odd number of mirrors the light runs -z (img_dir[2] < 0): the sphere's
+     * construction holds either way, only a ray parallel to the image plane has none */
+    if (c.img_dir[2] == 0 || !isfinite(c.img[2])) {
+        snprintf(err, errcap, "the chief ray does not reach the image plane");
         return TRACE_EINVAL;
     }
     t = (z_xp - c.img[2]) / c.img_dir[2];
