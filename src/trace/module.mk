@@ -5,8 +5,9 @@
 # Everything in src/trace/*.c goes into the module; lensmat itself never links Embree.
 
 TRACE_SRC   := $(wildcard src/trace/*.c)
-# The outputs' shortest numbers: libdouble-conversion (C++) behind one C function
-# (scene_dtoa.cpp); HDF5 outputs: libhdf5 (Debian's serial build, its own folders).
+# The outputs' shortest numbers: libfmt's Dragonbox (header-only), libdouble-conversion
+# the fallback (C++, behind one C function: scene_dtoa.cpp); HDF5 outputs: libhdf5
+# (Debian's serial build, its own folders).
 TRACE_XSRC  := $(wildcard src/trace/*.cpp)
 TRACE_OBJ   := $(patsubst src/%.c,build/obj/%.o,$(TRACE_SRC)) \
                $(patsubst src/%.cpp,build/obj/%.o,$(TRACE_XSRC))
@@ -81,6 +82,15 @@ build/asan/trace_tests/%: tests/trace/%.c build/asan/lib/lensmat-trace.so src/tr
 
 all: build/lib/lensmat-trace.so
 MODULE_TEST_BINS  += build/lib/lensmat-trace.so build/asan/lib/lensmat-trace.so $(TRACE_TBIN)
+# tests/t_71_hits.sh: the hit writer's digits, linked to scene_dtoa's object (its
+# functions are hidden in the module)
+build/obj/trace_tests/dtoa_check: tests/trace/dtoa_check.c build/obj/trace/scene_dtoa.o
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -o $@ $^ -ldouble-conversion -lstdc++ -lm
+build/asan/trace_tests/dtoa_check: tests/trace/dtoa_check.c build/asan/trace/scene_dtoa.o
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -o $@ $^ -ldouble-conversion -lstdc++ -lm
+MODULE_TEST_BINS  += build/obj/trace_tests/dtoa_check build/asan/trace_tests/dtoa_check
 MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
 -include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d) \
     $(patsubst src/paraxial/%.c,build/obj/trace/px/%.d,$(TRACE_PX))
