@@ -105,16 +105,27 @@ static const char D2[201] =
     "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
     "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
     "8081828384858687888990919293949596979899";
-static inline void w4(char *p, unsigned n)
+// 8 decimal digits of n < 10^8, two at a time: y = n * ceil(2^57 / 10^6) holds n / 10^6
+// in 57.57 fixed point (within 10^8 units of 2^-57: under the 2^57 / 10^6 a digit
+// step needs), each step takes the integer part and multiplies the fraction by 100
+// (James Anhalt's method; checked for every n < 10^8 when it was written).
+static inline void w8(char *p, uint32_t n)
 {
-    std::memcpy(p, D2 + 2 * (n / 100), 2);
-    std::memcpy(p + 2, D2 + 2 * (n % 100), 2);
+    const uint64_t m = (1ull << 57) - 1;
+    uint64_t y = (uint64_t)n * 144115188076ull;
+    std::memcpy(p, D2 + 2 * (y >> 57), 2);
+    y = (y & m) * 100;
+    std::memcpy(p + 2, D2 + 2 * (y >> 57), 2);
+    y = (y & m) * 100;
+    std::memcpy(p + 4, D2 + 2 * (y >> 57), 2);
+    y = (y & m) * 100;
+    std::memcpy(p + 6, D2 + 2 * (y >> 57), 2);
 }
-static inline void w8(char *p, uint32_t n) { w4(p, n / 10000); w4(p + 4, n % 10000); }
-static const uint64_t P10[17] = {
+static const uint64_t P10[18] = {
     1ull, 10ull, 100ull, 1000ull, 10000ull, 100000ull, 1000000ull, 10000000ull,
     100000000ull, 1000000000ull, 10000000000ull, 100000000000ull, 1000000000000ull,
-    10000000000000ull, 100000000000000ull, 1000000000000000ull, 10000000000000000ull};
+    10000000000000ull, 100000000000000ull, 1000000000000000ull, 10000000000000000ull,
+    100000000000000000ull};
 #endif
 
 // Writes the digits of v at buf (room for 32 bytes and SC_DTOA_SLACK more),
@@ -122,19 +133,25 @@ static const uint64_t P10[17] = {
 extern "C" int sc_dtoa(double v, char *buf)
 {
 #ifdef SC_DRAGONBOX
-    char *p = special(v, buf);
-    if (!p) {
-        p = buf;
-        if (v < 0) { *p++ = '-'; v = -v; }
-        auto r = fmt::detail::dragonbox::to_decimal(v);
+    uint64_t u;
+    std::memcpy(&u, &v, 8);
+    char *p;
+    // zeros, infinities and nan aside; no branch on the sign (x, y, dx, dy are as
+    // often negative as not) nor on the digit count
+    if ((u << 1) - 1 >= (0x7ffull << 53) - 1) {
+        p = special(v, buf);
+    } else {
+        buf[0] = '-';
+        p = buf + (u >> 63);
+        auto r = fmt::detail::dragonbox::to_decimal(std::fabs(v));
         uint64_t n = r.significand;              // < 10^17, no trailing zeros
         char t[40];
         uint64_t hi = n / 100000000u;
         t[0] = (char)('0' + hi / 100000000u);
         w8(t + 1, (uint32_t)(hi % 100000000u));
         w8(t + 9, (uint32_t)(n - hi * 100000000u));
-        int len = 17;
-        while (len > 1 && n < P10[len - 1]) len--;
+        int g = (64 - __builtin_clzll(n)) * 1233 >> 12;   // floor(log10(2^bits))
+        int len = g + (n >= P10[g]);
         p = layout(p, t + 17 - len, len, len + r.exponent);
     }
     *p = '\0';
