@@ -47,6 +47,10 @@ $(TRACE_SPXA): $(patsubst src/paraxial/%.c,build/asan/trace/px/%.o,$(TRACE_PX))
 # rounds the same whatever the thread count or the build.
 TRACE_HOT   := -O3 -fno-math-errno -flto=auto
 build/obj/trace/tr_%.o: TRACE_XOPT := $(TRACE_HOT)
+# The 4-lane base kernel, reached only through tr_isa.c's pointer, is built without
+# LTO and without -Wpsabi (which the header's pragma does not reach in the clones GCC makes: GCC notes
+# that 32-byte vectors pass differently without AVX; they never leave the file).
+build/obj/trace/tr_pk_sse2x4.o: TRACE_XOPT := -O3 -fno-math-errno -Wno-psabi
 
 # Module objects need -fPIC (the generic rules make position-independent executables).
 build/obj/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
