@@ -229,9 +229,11 @@ so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int threads, cha
     if (fmt == SC_OUT_TEXT || fmt == SC_OUT_NPY) {
         size_t rows = CHUNK / t->row;
         long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        /* formatters: the trace's thread count, at most 8 (each has two chunks in the
+         * ring: 4.5 MB with their text) */
         int n = fmt == SC_OUT_NPY ? 1 : threads > 0 ? threads : cores > 0 ? (int)cores : 1;
         t->cap = rows * t->row;
-        t->q = soq_new(f, n > 16 ? 16 : n, t->cap, rows * (size_t)t->ncol * FIELD_MAX +
+        t->q = soq_new(f, n > 8 ? 8 : n, t->cap, rows * (size_t)t->ncol * FIELD_MAX +
                        LINE_SLACK, fmt == SC_OUT_TEXT ? csv_rows : NULL, t,
                        fmt == SC_OUT_TEXT ? sizeof(csv_cache) : 0);
         if (!t->q) {
