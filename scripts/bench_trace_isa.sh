@@ -8,7 +8,9 @@
 # BENCH trace_triplet_<isa>_cpu_mrays_per_s the same per second of the tracing
 # thread's CPU time (what other processes on a busy machine do not halve), and
 # BENCH trace_triplet_<isa>_vs_scalar the median of the five ratios to scalar's run
-# of the same round.
+# of the same round; BENCH trace_sse2_4lane_vs_2lane (and _cpu) the median ratio of
+# the 4-lane base kernel (sse2x4: two SSE2 registers a vector; neonx4 on arm64) to the
+# 2-lane one in the same round.
 B=build/obj/trace_tests/bench_trace
 [ -x "$B" ] || { echo "bench_trace_isa: $B not built (make bench builds it)" >&2; exit 1; }
 isas=$("$B" isas) || exit 1
@@ -37,5 +39,13 @@ echo "$runs" | awk -v order="$(echo $isas)" '
             if (name[i] == "scalar") continue
             n = 0; for (r in round) x[++n] = v[name[i], r] / v["scalar", r]
             printf "BENCH trace_triplet_%s_vs_scalar %.2f ratio\n", name[i], median(x, n)
+        }
+        # issue 23: four lanes on the base registers (sse2x4 / neonx4) over two, per round
+        w = ("sse2x4", 1) in v ? "sse2" : ("neonx4", 1) in v ? "neon" : ""
+        if (w != "") {
+            n = 0
+            for (r in round) { n++; x[n] = v[w "x4", r] / v[w, r]; y[n] = c[w "x4", r] / c[w, r] }
+            printf "BENCH trace_sse2_4lane_vs_2lane %.2f ratio\n", median(x, n)
+            printf "BENCH trace_sse2_4lane_vs_2lane_cpu %.2f ratio\n", median(y, n)
         }
     }'

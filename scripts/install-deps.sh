@@ -11,6 +11,7 @@ PKGS="$PKGS parallel"   # scripts/cornea-study.sh: GNU parallel fans the eyes ou
 PKGS="$PKGS rsync openssh-client"   # cornea-study.sh -S: parallel sends files with rsync over ssh
 PKGS="$PKGS libfftw3-dev"   # the wave-optics engine: PSF and MTF transforms
 PKGS="$PKGS libdouble-conversion-dev libhdf5-dev python3-numpy"   # trace outputs: shortest round-trip numbers, HDF5; .npy read back by NumPy in tests
+PKGS="$PKGS libfmt-dev"   # trace outputs: Dragonbox shortest digits (header-only use)
 PKGS="$PKGS python3-h5py"   # tests/t_69_trace_out.sh: HDF5 outputs read back by h5py
 PKGS="$PKGS stress-ng"   # make check on a loaded machine (tests and the stop check)
 missing=""

@@ -5,8 +5,9 @@
 # Everything in src/trace/*.c goes into the module; lensmat itself never links Embree.
 
 TRACE_SRC   := $(wildcard src/trace/*.c)
-# The outputs' shortest numbers: libdouble-conversion (C++) behind one C function
-# (scene_dtoa.cpp); HDF5 outputs: libhdf5 (Debian's serial build, its own folders).
+# The outputs' shortest numbers: libfmt's Dragonbox (header-only), libdouble-conversion
+# the fallback (C++, behind one C function: scene_dtoa.cpp); HDF5 outputs: libhdf5
+# (Debian's serial build, its own folders).
 TRACE_XSRC  := $(wildcard src/trace/*.cpp)
 TRACE_OBJ   := $(patsubst src/%.c,build/obj/%.o,$(TRACE_SRC)) \
                $(patsubst src/%.cpp,build/obj/%.o,$(TRACE_XSRC))
@@ -46,6 +47,10 @@ $(TRACE_SPXA): $(patsubst src/paraxial/%.c,build/asan/trace/px/%.o,$(TRACE_PX))
 # rounds the same whatever the thread count or the build.
 TRACE_HOT   := -O3 -fno-math-errno -flto=auto
 build/obj/trace/tr_%.o: TRACE_XOPT := $(TRACE_HOT)
+# The 4-lane base kernel, reached only through tr_isa.c's pointer, is built without
+# LTO and without -Wpsabi (which the header's pragma does not reach in the clones GCC makes: GCC notes
+# that 32-byte vectors pass differently without AVX; they never leave the file).
+build/obj/trace/tr_pk_sse2x4.o: TRACE_XOPT := -O3 -fno-math-errno -Wno-psabi
 
 # Module objects need -fPIC (the generic rules make position-independent executables).
 build/obj/trace/%.o: src/trace/%.c $(GEN) | $(DEPS)
@@ -81,6 +86,15 @@ build/asan/trace_tests/%: tests/trace/%.c build/asan/lib/lensmat-trace.so src/tr
 
 all: build/lib/lensmat-trace.so
 MODULE_TEST_BINS  += build/lib/lensmat-trace.so build/asan/lib/lensmat-trace.so $(TRACE_TBIN)
+# tests/t_71_hits.sh: the hit writer's digits, linked to scene_dtoa's object (its
+# functions are hidden in the module)
+build/obj/trace_tests/dtoa_check: tests/trace/dtoa_check.c build/obj/trace/scene_dtoa.o
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(OPT) -o $@ $^ -ldouble-conversion -lstdc++ -lm
+build/asan/trace_tests/dtoa_check: tests/trace/dtoa_check.c build/asan/trace/scene_dtoa.o
+	@mkdir -p $(@D)
+	$(CC) $(BASE) $(SAN) -o $@ $^ -ldouble-conversion -lstdc++ -lm
+MODULE_TEST_BINS  += build/obj/trace_tests/dtoa_check build/asan/trace_tests/dtoa_check
 MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
 -include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d) \
     $(patsubst src/paraxial/%.c,build/obj/trace/px/%.d,$(TRACE_PX))

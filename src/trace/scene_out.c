@@ -11,40 +11,44 @@
  * for any row count and rewritten with the real one when the table ends (the file must
  * be seekable).  HDF5 is assembled in memory (the core driver) and its image written
  * through the same stream, so where the bytes go stays scene_run.c's business.
- * CSV hits and .npy tables are written by a thread of their own: the trace's thread
- * packs each record into a binary row (a memcpy); the writer formats the rows (CSV:
- * the digits are most of the cost) and writes them, one 1 MiB chunk while the trace
- * fills the next, so the formatting and the kernel's copy into the page cache run
- * beside the trace instead of inside it (measured: scripts/bench_trace_out.sh). */
+ * CSV hits and .npy tables go through an ordered chunk queue (scene_outq.c): the
+ * trace's thread packs each record into a binary row (a memcpy into a 512 KiB chunk);
+ * CSV chunks are formatted by as many threads as the trace has, in parallel, and
+ * written in order, one fwrite a chunk; .npy chunks are written as they are, off the
+ * trace's thread (measured: scripts/bench_trace_out.sh).  A CSV line is made column by
+ * column from the table below: a column added there (and packed in so_hit) is in
+ * every format. */
 #if defined(__has_include) && !__has_include(<hdf5.h>)
 #include <hdf5/serial/hdf5.h>   /* Debian's serial build, without its -I */
 #else
 #include <hdf5.h>
 #endif
-#include <pthread.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "scene_out.h"
 
-int sc_dtoa(double v, char *buf);   /* scene_dtoa.cpp */
+int sc_dtoa(double v, char *buf);   /* scene_dtoa.cpp: buf has room for 40 bytes */
 
 /* ---- the tables' columns ---------------------------------------------------------- */
 
 /* One row of a binary table: every column at its natural alignment, no padding (the
- * offsets below are what NumPy and HDF5 are told). */
-enum { C_U64, C_I32, C_I64, C_F64 };
+ * offsets below are what NumPy and HDF5 are told).  C_NM: the wavelength, a double in
+ * nm in the binary tables (as "%.10g" prints it); the CSV's rows carry the um value
+ * and print it so. */
+enum { C_U64, C_I32, C_I64, C_F64, C_NM };
 typedef struct { const char *name; int type; } column;
 
 static const column hit_cols[] = {
     {"ray", C_U64}, {"depth", C_I32}, {"surface", C_I32}, {"triangle", C_I64},
     {"x", C_F64}, {"y", C_F64}, {"z", C_F64}, {"dx", C_F64}, {"dy", C_F64}, {"dz", C_F64},
     {"power_s", C_F64}, {"power_p", C_F64}, {"power", C_F64}, {"length", C_F64},
-    {"opl", C_F64}, {"lambda_nm", C_F64}};
+    {"opl", C_F64}, {"lambda_nm", C_NM}};
 static const column seg_cols[] = {
     {"x0", C_F64}, {"y0", C_F64}, {"z0", C_F64}, {"x1", C_F64}, {"y1", C_F64},
-    {"z1", C_F64}, {"lambda_nm", C_F64}};
+    {"z1", C_F64}, {"lambda_nm", C_NM}};
 #define NHIT (int)(sizeof hit_cols / sizeof hit_cols[0])
 #define NSEG (int)(sizeof seg_cols / sizeof seg_cols[0])
 
@@ -57,29 +61,21 @@ struct so_table {
     size_t row;                /* bytes a binary row */
     uint64_t nrows;
     long header;               /* .npy: bytes of the header (rewritten at the end) */
-    unsigned char *buf;        /* rows being filled (.npy, CSV: a chunk; HDF5: all) */
+    unsigned char *buf;        /* rows being filled (queue: its chunk; HDF5: all) */
     size_t used, cap;
-    /* the writer thread (CSV hits, .npy): it owns f between so_open and so_finish */
-    int async;
-    FILE *f;
-    pthread_t th;
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
-    unsigned char *wbuf;       /* the chunk handed to the writer (NULL: none pending) */
-    size_t wused;
-    unsigned char *spare;      /* the chunk it gave back */
-    int quit, werr;
-    char *text;                /* the writer's CSV text (a chunk of lines) */
-    so_table *wt;              /* the writer's own caches: the wavelength, and ... */
-    uint64_t last[11];         /* ... each column's last value (a detector plane's z,
-                                  a constant length: the digits are made once) */
-    char last_text[11][32];
-    unsigned char last_len[11];
+    soq *q;                    /* CSV hits, .npy: the chunk queue (it owns f's writes) */
     double nm_of, nm;          /* the last wavelength (um) and its "%.10g" nm value */
-    char nm_text[40];          /* and that text, for the CSV */
+    char nm_text[40];          /* and that text */
 };
 
 static const column *cols(const so_table *t) { return t->hits ? hit_cols : seg_cols; }
+
+/* lambda um in nm as "%.10g" prints it, into text; the value that reads back. */
+static double nm_text(double lambda, char *text, size_t cap)
+{
+    snprintf(text, cap, "%.10g", lambda * 1e3);
+    return strtod(text, NULL);
+}
 
 /* The wavelength column's value: lambda um in nm, as the CSV's "%.10g" reads back (the
  * binary tables and the CSV agree to the bit); one conversion per wavelength. */
@@ -87,8 +83,7 @@ static double nm_of(so_table *t, double lambda)
 {
     if (lambda != t->nm_of || !t->nm_text[0]) {
         t->nm_of = lambda;
-        snprintf(t->nm_text, sizeof t->nm_text, "%.10g", lambda * 1e3);
-        t->nm = strtod(t->nm_text, NULL);
+        t->nm = nm_text(lambda, t->nm_text, sizeof t->nm_text);
     }
     return t->nm;
 }
@@ -100,7 +95,7 @@ static double nm_of(so_table *t, double lambda)
 static long npy_header(const so_table *t, uint64_t n, char *out, long len)
 {
     const column *c = cols(t);
-    static const char *const descr[] = {"u8", "i4", "i8", "f8"};
+    static const char *const descr[] = {"u8", "i4", "i8", "f8", "f8"};
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
     const char end = '>';
 #else
@@ -125,12 +120,90 @@ static long npy_header(const so_table *t, uint64_t n, char *out, long len)
     return total;
 }
 
+
+/* ---- CSV lines (in the formatter threads) ----------------------------------------- */
+
+/* A formatter's own memory of each column's last value and its digits (a detector
+ * plane's z, a constant length: the digits are made once a run of them). */
+typedef struct {
+    uint64_t last[NHIT];
+    char text[NHIT][40];
+    unsigned char len[NHIT];
+    double nm_of;
+    char nm_text[40];
+    unsigned char nm_len;
+} csv_cache;
+
+/* The longest a CSV field can be ("-2.2250738585072014e-308", a 20-digit integer) and
+ * its comma; the digit writer's copies reach 11 bytes past a number (the slack). */
+enum { FIELD_MAX = 25, LINE_SLACK = 64 };
+
+static char *put_u64(char *p, uint64_t v)
+{
+    char tmp[24];
+    int n = 0;
+    do tmp[n++] = (char)('0' + v % 10); while (v /= 10);
+    while (n) *p++ = tmp[--n];
+    return p;
+}
+
+static char *put_i64(char *p, int64_t v)
+{
+    if (v < 0) { *p++ = '-'; return put_u64(p, 0 - (uint64_t)v); }
+    return put_u64(p, (uint64_t)v);
+}
+
+/* n bytes of binary hit rows as CSV lines at `text`; their length. */
+static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n, char *text)
+{
+    const so_table *t = ctx;
+    const column *col = cols(t);
+    csv_cache *c = cache;
+    char *p = text;
+    for (const unsigned char *end = r + n; r < end; ) {
+        for (int i = 0; i < t->ncol; i++) {
+            uint64_t u;
+            int32_t i32;
+            double v;
+            if (i) *p++ = ',';
+            switch (col[i].type) {
+            case C_U64: memcpy(&u, r, 8); p = put_u64(p, u); r += 8; break;
+            case C_I32: memcpy(&i32, r, 4); p = put_i64(p, i32); r += 4; break;
+            case C_I64: memcpy(&u, r, 8); p = put_i64(p, (int64_t)u); r += 8; break;
+            case C_F64:
+                memcpy(&u, r, 8);
+                r += 8;
+                if (!c->len[i] || u != c->last[i]) {
+                    memcpy(&v, &u, 8);
+                    c->last[i] = u;
+                    c->len[i] = (unsigned char)sc_dtoa(v, c->text[i]);
+                }
+                memcpy(p, c->text[i], 32);   /* the rest is the next field's room */
+                p += c->len[i];
+                break;
+            default:   /* C_NM: the um value, printed as "%.10g" of nm */
+                memcpy(&v, r, 8);
+                r += 8;
+                if (!c->nm_len || v != c->nm_of) {
+                    c->nm_of = v;
+                    nm_text(v, c->nm_text, sizeof c->nm_text);
+                    c->nm_len = (unsigned char)strlen(c->nm_text);
+                }
+                memcpy(p, c->nm_text, c->nm_len);
+                p += c->nm_len;
+            }
+        }
+        *p++ = '\n';
+    }
+    return (size_t)(p - text);
+}
+
 /* ---- opening, rows, closing ------------------------------------------------------- */
 
-enum { CHUNK = 1 << 20, TEXTBUF = 1 << 18 };   /* rows a hand-over, CSV text a write */
-static void *writer(void *arg);
+enum { CHUNK = 1 << 19 };   /* bytes of rows a hand-over (CSV: about 1 MB of text) */
 
-so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, char *err, size_t errmax)
+so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int threads, char *err,
+                  size_t errmax)
 {
     so_table *t = calloc(1, sizeof *t);
     if (!t) return snprintf(err, errmax, "out of memory"), NULL;
@@ -138,12 +211,10 @@ so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, char *err, size_
     t->hits = hits;
     t->ncol = (hits ? NHIT : NSEG) - (wl ? 0 : 1);
     for (int i = 0; i < t->ncol; i++) t->row += col_size(cols(t)[i].type);
-    t->f = f;
     if (fmt == SC_OUT_TEXT || fmt == SC_OUT_CSV17) {
         if (hits)
-            fputs(wl ? "ray,depth,surface,triangle,x,y,z,dx,dy,dz,power_s,power_p,power,"
-                  "length,opl,lambda_nm\n" : "ray,depth,surface,triangle,x,y,z,dx,dy,dz,"
-                  "power_s,power_p,power,length,opl\n", f);
+            for (int i = 0; i < t->ncol; i++)
+                fprintf(f, "%s%s", hit_cols[i].name, i + 1 < t->ncol ? "," : "\n");
         if (fmt == SC_OUT_CSV17 || !hits) return t;   /* written as they come */
     }
     if (fmt == SC_OUT_NPY) {
@@ -155,90 +226,41 @@ so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, char *err, size_
             return NULL;
         }
     }
-    if (fmt == SC_OUT_TEXT || fmt == SC_OUT_NPY) {   /* the writer thread */
-        t->buf = malloc(CHUNK);
-        t->spare = malloc(CHUNK);
-        t->text = fmt == SC_OUT_TEXT ? malloc(TEXTBUF) : NULL;
-        t->wt = calloc(1, sizeof *t->wt);
-        t->cap = CHUNK;
-        if (!t->buf || !t->spare || !t->wt || (fmt == SC_OUT_TEXT && !t->text)) goto oom;
-        pthread_mutex_init(&t->mu, NULL);
-        pthread_cond_init(&t->cv, NULL);
-        if (pthread_create(&t->th, NULL, writer, t) == 0) {
-            t->async = 1;
-        } else {   /* no thread: the rows are written as the chunks fill */
-            pthread_mutex_destroy(&t->mu);
-            pthread_cond_destroy(&t->cv);
+    if (fmt == SC_OUT_TEXT || fmt == SC_OUT_NPY) {
+        size_t rows = CHUNK / t->row;
+        long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        /* formatters: the trace's thread count, at most 8 (each has two chunks in the
+         * ring: 4.5 MB with their text) */
+        int n = fmt == SC_OUT_NPY ? 1 : threads > 0 ? threads : cores > 0 ? (int)cores : 1;
+        t->cap = rows * t->row;
+        t->q = soq_new(f, n > 8 ? 8 : n, t->cap, rows * (size_t)t->ncol * FIELD_MAX +
+                       LINE_SLACK, fmt == SC_OUT_TEXT ? csv_rows : NULL, t,
+                       fmt == SC_OUT_TEXT ? sizeof(csv_cache) : 0);
+        if (!t->q) {
+            snprintf(err, errmax, "out of memory");
+            free(t);
+            return NULL;
         }
+        t->buf = soq_rows(t->q);
     }
     return t;
-oom:
-    snprintf(err, errmax, "out of memory");
-    so_free(t);
-    return NULL;
 }
 
-
-static int write_rows(so_table *t, const unsigned char *b, size_t n);
-
-/* The writer thread: takes each chunk handed over, writes it (CSV: formats it first),
- * gives the buffer back. */
-static void *writer(void *arg)
+/* Room for one more binary row: a full chunk goes to the queue; HDF5 keeps growing. */
+static unsigned char *row_slot(so_table *t)
 {
-    so_table *t = arg;
-    pthread_mutex_lock(&t->mu);
-    for (;;) {
-        while (!t->wbuf && !t->quit) pthread_cond_wait(&t->cv, &t->mu);
-        if (!t->wbuf) break;
-        unsigned char *b = t->wbuf;
-        size_t n = t->wused;
-        int bad = t->werr;
-        pthread_mutex_unlock(&t->mu);
-        if (!bad) bad = write_rows(t, b, n);
-        pthread_mutex_lock(&t->mu);
-        t->werr |= bad;
-        t->spare = b;
-        t->wbuf = NULL;
-        pthread_cond_broadcast(&t->cv);
-    }
-    pthread_mutex_unlock(&t->mu);
-    return NULL;
-}
-
-/* Hand the filled chunk to the writer (waiting for it to finish the one before); the
- * chunk it gave back becomes the one to fill.  0, or non-zero after a write error. */
-static int hand_over(so_table *t)
-{
-    pthread_mutex_lock(&t->mu);
-    while (t->wbuf) pthread_cond_wait(&t->cv, &t->mu);
-    int bad = t->werr;
-    if (t->used) {
-        t->wbuf = t->buf;
-        t->wused = t->used;
-        t->buf = t->spare;
-        t->spare = NULL;
-        t->used = 0;
-        pthread_cond_broadcast(&t->cv);
-    }
-    pthread_mutex_unlock(&t->mu);
-    return bad || !t->buf;
-}
-
-/* Room for one more binary row: a full chunk goes to the writer (or, without one, to
- * f); HDF5 keeps growing. */
-static unsigned char *row_slot(so_table *t, FILE *f)
-{
-    if (t->fmt != SC_OUT_H5 && t->used + t->row > CHUNK) {
-        if (t->async ? hand_over(t) : write_rows(t, t->buf, t->used)) return NULL;
-        if (!t->async) t->used = 0;
-    }
-    (void)f;
     if (t->used + t->row > t->cap) {
-        size_t cap = t->cap ? t->cap * 2 : 65536;
-        unsigned char *b = realloc(t->buf, cap);
-        if (!b) return NULL;
-        t->buf = b;
-        t->cap = cap;
+        if (t->q) {
+            if (soq_submit(t->q, t->used)) return NULL;
+            t->buf = soq_rows(t->q);
+            t->used = 0;
+        } else {
+            size_t cap = t->cap ? t->cap * 2 : 65536;
+            unsigned char *b = realloc(t->buf, cap);
+            if (!b) return NULL;
+            t->buf = b;
+            t->cap = cap;
+        }
     }
     unsigned char *p = t->buf + t->used;
     t->used += t->row;
@@ -248,24 +270,9 @@ static unsigned char *row_slot(so_table *t, FILE *f)
 
 #define PUT(p, v) (memcpy((p), &(v), sizeof (v)), (p) += sizeof (v))
 
-/* Decimal digits of v at p; returns the end. */
-static char *put_u64(char *p, uint64_t v)
-{
-    char tmp[24];
-    int n = 0;
-    do tmp[n++] = (char)('0' + v % 10); while (v /= 10);
-    while (n) *p++ = tmp[--n];
-    return p;
-}
-
-static char *put_i64(char *p, long long v)
-{
-    if (v < 0) { *p++ = '-'; return put_u64(p, 0 - (uint64_t)v); }
-    return put_u64(p, (uint64_t)v);
-}
-
 int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray)
 {
+    /* the double columns, in hit_cols' order */
     const double v[11] = {h->pos[0], h->pos[1], h->pos[2], h->dir[0], h->dir[1], h->dir[2],
                           h->power_s, h->power_p, h->power_s + h->power_p, h->length,
                           h->opl};
@@ -278,7 +285,7 @@ int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray)
         return (t->ncol == NHIT ? fprintf(f, ",%.10g\n", h->lambda * 1e3)
                                 : fputs("\n", f)) < 0;
     }
-    unsigned char *p = row_slot(t, f);
+    unsigned char *p = row_slot(t);
     if (!p) return 1;
     int32_t depth = h->depth, surf = h->surface;
     int64_t prim = h->prim;
@@ -288,69 +295,11 @@ int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray)
     PUT(p, prim);
     memcpy(p, v, sizeof v);
     p += sizeof v;
-    if (t->ncol == NHIT) {   /* CSV: the wavelength as it came (the writer prints it) */
+    if (t->ncol == NHIT) {   /* CSV: the wavelength as it came (the formatter prints it) */
         double nm = t->fmt == SC_OUT_TEXT ? h->lambda : nm_of(t, h->lambda);
         PUT(p, nm);
     }
     return 0;
-}
-
-/* One binary hit row as a CSV line at p; returns the end. */
-static char *csv_line(so_table *t, const unsigned char *r, char *p)
-{
-    uint64_t ray;
-    int32_t depth, surf;
-    int64_t prim;
-    double v[12];
-    memcpy(&ray, r, 8);
-    memcpy(&depth, r + 8, 4);
-    memcpy(&surf, r + 12, 4);
-    memcpy(&prim, r + 16, 8);
-    memcpy(v, r + 24, t->row - 24);
-    p = put_u64(p, ray);
-    *p++ = ',';
-    p = put_i64(p, depth);
-    *p++ = ',';
-    p = put_i64(p, surf);
-    *p++ = ',';
-    p = put_i64(p, prim);
-    so_table *c = t->wt;
-    for (int i = 0; i < 11; i++) {
-        uint64_t bits;
-        memcpy(&bits, &v[i], 8);
-        *p++ = ',';
-        if (!c->last_len[i] || bits != c->last[i]) {
-            c->last[i] = bits;
-            c->last_len[i] = (unsigned char)sc_dtoa(v[i], c->last_text[i]);
-        }
-        memcpy(p, c->last_text[i], c->last_len[i]);
-        p += c->last_len[i];
-    }
-    if (t->ncol == NHIT) {
-        nm_of(t->wt, v[11]);
-        *p++ = ',';
-        size_t n = strlen(t->wt->nm_text);
-        memcpy(p, t->wt->nm_text, n);
-        p += n;
-    }
-    *p++ = '\n';
-    return p;
-}
-
-/* n bytes of rows into t's file: as they are (.npy) or as CSV lines.  0 or 1. */
-static int write_rows(so_table *t, const unsigned char *b, size_t n)
-{
-    if (t->fmt != SC_OUT_TEXT) return fwrite(b, 1, n, t->f) != n;
-    char *p = t->text;
-    for (size_t k = 0; k < n; k += t->row) {
-        if (p - t->text > TEXTBUF - 512) {
-            if (fwrite(t->text, 1, (size_t)(p - t->text), t->f) != (size_t)(p - t->text))
-                return 1;
-            p = t->text;
-        }
-        p = csv_line(t, b + k, p);
-    }
-    return fwrite(t->text, 1, (size_t)(p - t->text), t->f) != (size_t)(p - t->text);
 }
 
 int so_segment(so_table *t, FILE *f, const trace_segment *s)
@@ -365,7 +314,7 @@ int so_segment(so_table *t, FILE *f, const trace_segment *s)
         return fprintf(f, "%.10g %.10g %.10g\n%.10g %.10g %.10g\n", s->p0[0], s->p0[1],
                        s->p0[2], s->p1[0], s->p1[1], s->p1[2]) < 0;
     }
-    unsigned char *p = row_slot(t, f);
+    unsigned char *p = row_slot(t);
     if (!p) return 1;
     memcpy(p, s->p0, sizeof s->p0);
     memcpy(p + 24, s->p1, sizeof s->p1);
@@ -376,28 +325,9 @@ int so_segment(so_table *t, FILE *f, const trace_segment *s)
     return 0;
 }
 
-/* The writer's last chunk and its end (joined): 0, or 1 after a write error. */
-static int stop_writer(so_table *t)
-{
-    int bad;
-    if (!t->async) return 0;
-    bad = hand_over(t);
-    pthread_mutex_lock(&t->mu);
-    t->quit = 1;
-    pthread_cond_broadcast(&t->cv);
-    pthread_mutex_unlock(&t->mu);
-    pthread_join(t->th, NULL);
-    pthread_mutex_destroy(&t->mu);
-    pthread_cond_destroy(&t->cv);
-    t->async = 0;
-    return bad | t->werr;
-}
-
 int so_finish(so_table *t, FILE *f, char *err, size_t errmax)
 {
-    int bad = stop_writer(t);
-    if (!bad && t->fmt != SC_OUT_H5 && t->used && t->buf)   /* rows of a thread-less table */
-        bad = write_rows(t, t->buf, t->used);
+    int bad = t->q ? soq_finish(t->q, t->used) : 0;
     t->used = 0;
     if (bad) return snprintf(err, errmax, "write error"), -1;
     if (t->fmt == SC_OUT_NPY) {
@@ -416,11 +346,8 @@ int so_finish(so_table *t, FILE *f, char *err, size_t errmax)
 void so_free(so_table *t)
 {
     if (!t) return;
-    stop_writer(t);
-    free(t->buf);
-    free(t->spare);
-    free(t->text);
-    free(t->wt);
+    if (t->q) soq_free(t->q);
+    else free(t->buf);
     free(t);
 }
 

@@ -12,8 +12,10 @@
 typedef struct so_table so_table;
 /* A hits (hits=1) or segments table in format fmt written to f (its header now;
  * nothing written to f for SC_OUT_H5: the rows are kept for so_h5_write); wl: with the
- * wavelength column.  NULL with a message on failure. */
-so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, char *err, size_t errmax);
+ * wavelength column; threads: the trace's (0: all cores), as many formatter threads
+ * for a CSV.  NULL with a message on failure. */
+so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int threads, char *err,
+                  size_t errmax);
 /* One row; 0, or non-zero on a write error (or out of memory). */
 int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray);
 int so_segment(so_table *t, FILE *f, const trace_segment *s);
@@ -33,4 +35,18 @@ typedef struct {
  * to f; 0 or -1 with a message. */
 int so_h5_write(FILE *f, const so_table *hits, const so_table *segs, const so_summary *sum,
                 char *err, size_t errmax);
+
+/* The ordered chunk queue (scene_outq.c).  fmt turns n bytes of rows into text at
+ * `text` (returning its length) with a per-thread cache of cache_size bytes (zeroed
+ * at the start); NULL: the rows are written as they are.  nthread formatter threads
+ * (0: the filling thread does everything). */
+typedef struct soq soq;
+typedef size_t (*soq_format)(void *ctx, void *cache, const unsigned char *rows, size_t n,
+                             char *text);
+soq *soq_new(FILE *f, int nthread, size_t chunk, size_t text_cap, soq_format fmt,
+             void *ctx, size_t cache_size);
+unsigned char *soq_rows(soq *q);          /* the chunk to fill */
+int soq_submit(soq *q, size_t used);      /* hand it over; 0, or 1 after a write error */
+int soq_finish(soq *q, size_t used);      /* the last one, every chunk written */
+void soq_free(soq *q);
 #endif

@@ -419,11 +419,13 @@ static int h5_with(const sc_scene *sc, int i, int j)
 static int h5_shared(const sc_scene *sc, int i) { return h5_with(sc, i, 0) || h5_with(sc, i, 1); }
 
 /* A table of the format the scene gave output `name` (f: its file, NULL for an HDF5
- * table written with another's); NULL with a message. */
-static so_table *table(FILE *f, int fmt, int hits, int wl, const char *name, char *err)
+ * table written with another's; a CSV is formatted on the trace's thread count);
+ * NULL with a message. */
+static so_table *table(const sc_scene *sc, FILE *f, int fmt, int hits, int wl,
+                       const char *name, char *err)
 {
     char why[SC_ERRMAX / 2];
-    so_table *t = so_open(f, (sc_out_format)fmt, hits, wl, why, sizeof why);
+    so_table *t = so_open(f, (sc_out_format)fmt, hits, wl, sc->threads, why, sizeof why);
     if (!t) snprintf(err, SC_ERRMAX, "%s: %s", name, why);
     return t;
 }
@@ -584,13 +586,13 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     sink.progress = w_progress;
     if (sc->out_segments) {
         if (!(o.seg = open_part(sc->out_segments, &o.seg_out, err)) ||
-            !(o.seg_t = table(o.seg, sc->out_format[0], 0, o.wl, sc->out_segments, err)))
+            !(o.seg_t = table(sc, o.seg, sc->out_format[0], 0, o.wl, sc->out_segments, err)))
             goto out;
         sink.segment = w_segment;
     }
     if (sc->out_hits) {
         if ((!h5_shared(sc, 1) && !(o.hit = open_part(sc->out_hits, &o.hit_out, err))) ||
-            !(o.hit_t = table(o.hit, sc->out_format[1], 1, o.wl, sc->out_hits, err)))
+            !(o.hit_t = table(sc, o.hit, sc->out_format[1], 1, o.wl, sc->out_hits, err)))
             goto out;
         sink.hit = w_hit;
     }

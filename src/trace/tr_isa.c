@@ -18,8 +18,10 @@ static const tr_isa isas[] = {
     {"avx512", tr_pk_step_avx512},
     {"avx2", tr_pk_step_avx2},
     {"sse2", tr_pk_step_base},
+    {"sse2x4", tr_pk_step_base4},
 #elif defined(__aarch64__)
     {"neon", tr_pk_step_base},
+    {"neonx4", tr_pk_step_base4},
 #else
     {"generic", tr_pk_step_base},
 #endif

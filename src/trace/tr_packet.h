@@ -107,6 +107,8 @@ unsigned tr_pk_step_avx2(const tr_pk *, tr_pk *, tr_pk_aux *, const tr_pk_set *,
                          unsigned, const tr_pk_opt *);
 unsigned tr_pk_step_base(const tr_pk *, tr_pk *, tr_pk_aux *, const tr_pk_set *,
                          unsigned, const tr_pk_opt *);
+unsigned tr_pk_step_base4(const tr_pk *, tr_pk *, tr_pk_aux *, const tr_pk_set *,
+                          unsigned, const tr_pk_opt *);   /* tr_pk_sse2x4.c: 4 lanes */
 
 /* 1 if the packets run in this process (0: LENSMAT_ISA=scalar, rays one by one). */
 int tr_pk_usable(void);

@@ -69,7 +69,34 @@ static inline vd pick4(const double t[TR_PK], vm ix)
     return __builtin_shuffle(ld(t), ld(t + PK_W), ix);
 #endif
 }
-static inline vm finite(vd x) { return vabs(x) <= DBL_MAX; }
+/* The comparisons of doubles.  Four lanes on 2-lane registers (PK_SPLIT, tr_pk_sse2x4.c):
+ * GCC lowers a comparison it has no instruction for element by element (scalar
+ * compares and branches, though it splits the arithmetic into 2-lane halves), so
+ * there each is two 2-lane comparisons; elsewhere the operator itself. */
+#if PK_SPLIT
+typedef double vd2 __attribute__((vector_size(16)));
+typedef long long vm2 __attribute__((vector_size(16)));
+#define PK_CMP(name, op)                                                              \
+    static inline vm name(vd a, vd b)                                                 \
+    {                                                                                 \
+        vd2 a0, a1, b0, b1;                                                           \
+        vm r;                                                                         \
+        memcpy(&a0, &a, 16); memcpy(&a1, (char *)&a + 16, 16);                        \
+        memcpy(&b0, &b, 16); memcpy(&b1, (char *)&b + 16, 16);                        \
+        vm2 r0 = a0 op b0, r1 = a1 op b1;                                             \
+        memcpy(&r, &r0, 16); memcpy((char *)&r + 16, &r1, 16);                        \
+        return r;                                                                     \
+    }
+#else
+#define PK_CMP(name, op) static inline vm name(vd a, vd b) { return a op b; }
+#endif
+PK_CMP(lt, <)
+PK_CMP(le, <=)
+PK_CMP(gt, >)
+PK_CMP(ge, >=)
+PK_CMP(eq, ==)
+PK_CMP(ne, !=)
+static inline vm finite(vd x) { return le(vabs(x), splat(DBL_MAX)); }
 static inline vd vsqrt(vd x)
 {
     vd r = x;
@@ -91,7 +118,7 @@ static inline void cross(const vd a[3], const vd b[3], vd c[3])
 static inline void unit(vd a[3])
 {
     vd l = vsqrt(dot(a, a));
-    vm ok = (l > 0) & finite(l);
+    vm ok = gt(l, splat(0)) & finite(l);
     vd r = 1.0 / l;
     for (int i = 0; i < 3; i++) a[i] = sel(ok, a[i] * r, a[i]);
 }
@@ -137,10 +164,10 @@ static inline void pk_store(const vpk *v, tr_pk *p, int b)
 /* tr_in_aperture */
 static inline vm in_aperture(const tr_shape *g, vd x, vd y)
 {
-    if (g->aperture == TRACE_AP_RECT) return (vabs(x) <= g->hw) & (vabs(y) <= g->hh);
+    if (g->aperture == TRACE_AP_RECT) return le(vabs(x), splat(g->hw)) & le(vabs(y), splat(g->hh));
     vd s2 = x * x + y * y;
-    vm ok = s2 >= g->r_inner2;
-    if (g->r_outer2 > 0) ok &= ~(s2 > g->r_outer2);
+    vm ok = ge(s2, splat(g->r_inner2));
+    if (g->r_outer2 > 0) ok &= ~gt(s2, splat(g->r_outer2));
     return ok;
 }
 
@@ -148,9 +175,9 @@ static inline vm in_aperture(const tr_shape *g, vd x, vd y)
 static inline vm axial_ok(const tr_shape *g, const vd p[3])
 {
     vm ok = mask_all();
-    if (g->c != 0) ok &= ~((1.0 - g->ck1 * p[2]) <= 0);
+    if (g->c != 0) ok &= ~le(1.0 - g->ck1 * p[2], splat(0));
     if (g->r_outer2 == 0 && g->aperture == TRACE_AP_DISC && g->c != 0)
-        ok &= ~((1.0 - g->k1 * g->c * g->c * (p[0] * p[0] + p[1] * p[1])) < 0);
+        ok &= ~lt(1.0 - g->k1 * g->c * g->c * (p[0] * p[0] + p[1] * p[1]), splat(0));
     return ok & in_aperture(g, p[0], p[1]);
 }
 
@@ -165,7 +192,7 @@ static inline vm conic_hit(const tr_shape *g, int leaving, int farok, const vd o
     vm far = mask_none();
     if (!leaving && farok) {             /* tr_advance: a far start */
         t0 = -(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach;
-        far = t0 > TR_FAR * g->reach;
+        far = gt(t0, splat(TR_FAR * g->reach));
         if (any(far))
             for (int j = 0; j < 3; j++) lo[j] = sel(far, lo[j] + t0 * d[j], lo[j]);
     }
@@ -174,7 +201,7 @@ static inline vm conic_hit(const tr_shape *g, int leaving, int farok, const vd o
     vd ra, rb;
     vm va, vb;
     if (leaving) {                       /* roots 0 and -2B/A */
-        va = A != 0;
+        va = ne(A, splat(0));
         ra = rb = -2.0 * B / A;
         vb = mask_none();
     } else {
@@ -182,8 +209,8 @@ static inline vm conic_hit(const tr_shape *g, int leaving, int farok, const vd o
         vd disc = B * B - A * C;
         vd q = -(B + with_sign(vsqrt(disc), B));
         vd r0 = q / A, r1 = C / q;       /* each where it is defined */
-        vm real = ~(disc < 0), hasA = A != 0, hasq = q != 0, both = hasA & hasq;
-        vm swap = both & (r0 > r1);
+        vm real = ~lt(disc, splat(0)), hasA = ne(A, splat(0)), hasq = ne(q, splat(0));
+        vm both = hasA & hasq, swap = both & gt(r0, r1);
         ra = sel(hasA, sel(swap, r1, r0), r1);
         rb = sel(swap, r0, r1);
         va = real & (hasA | hasq);
@@ -191,7 +218,7 @@ static inline vm conic_hit(const tr_shape *g, int leaving, int farok, const vd o
     }
     vd pa[3], pb[3];
     for (int j = 0; j < 3; j++) pa[j] = lo[j] + ra * d[j];
-    vm oka = va & (ra > 0) & axial_ok(g, pa);
+    vm oka = va & gt(ra, splat(0)) & axial_ok(g, pa);
     int anyfar = !leaving && farok && any(far);
     *farout = far;
     *t = anyfar ? sel(far, t0 + ra, ra) : ra;
@@ -199,7 +226,7 @@ static inline vm conic_hit(const tr_shape *g, int leaving, int farok, const vd o
     vm need = vb & ~oka;
     if (!any(need)) return oka;            /* the usual case: no lane looks further */
     for (int j = 0; j < 3; j++) pb[j] = lo[j] + rb * d[j];
-    vm okb = need & (rb > 0) & axial_ok(g, pb);
+    vm okb = need & gt(rb, splat(0)) & axial_ok(g, pb);
     if (anyfar) { ra = sel(far, t0 + ra, ra); rb = sel(far, t0 + rb, rb); }
     *t = sel(oka, ra, rb);
     for (int j = 0; j < 3; j++) p[j] = sel(oka, pa[j], pb[j]);
@@ -224,8 +251,9 @@ static inline vm plane_hit(const tr_shape *g, int leaving, int farok, const vd o
     p[2] = splat(0);
     *far = mask_none();
     if (farok)
-        *far = (-(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach) > TR_FAR * g->reach;
-    return (d[2] != 0) & (tt > 0) & in_aperture(g, p[0], p[1]);
+        *far = gt(-(lo[0] * d[0] + lo[1] * d[1] + lo[2] * d[2]) - g->reach,
+                  splat(TR_FAR * g->reach));
+    return ne(d[2], splat(0)) & gt(tt, splat(0)) & in_aperture(g, p[0], p[1]);
 }
 
 /* The chosen candidate of each lane and what the step needs of it. */
@@ -252,7 +280,7 @@ static inline void nearest(const tr_pk_set *s, const vd o[3], const vd d[3], pic
         int cone = s->g[i]->fast == TR_FAST_CONIC;
         vm ok = cone ? conic_hit(s->g[i], s->leaving[i], s->farok[i], o, d, &t, p, &far)
                      : plane_hit(s->g[i], s->leaving[i], s->farok[i], o, d, &t, p, &far);
-        vm up = ok & (t < best);
+        vm up = ok & lt(t, best);
         best = sel(up, t, best);
         k->k = seli(up, msplat(i), k->k);
         if (s->farok[i]) k->far = seli(up, far, k->far);
@@ -261,7 +289,7 @@ static inline void nearest(const tr_pk_set *s, const vd o[3], const vd d[3], pic
     }
     k->t = best;
     vm ix = k->k & 3;                      /* lanes without a hit leave the packet */
-    k->conic = pick4(s->cone, ix) != 0;
+    k->conic = ne(pick4(s->cone, ix), splat(0));
     k->kind = pick4(s->kind, ix);
     k->c = pick4(s->c, ix);
     k->ck1 = pick4(s->ck1, ix);
@@ -287,21 +315,21 @@ static inline void rotate(const vpk *in, const vd n[3], vd e[3], vd j[4])
     vd s[3], f[3];
     cross(in->d, n, s);
     vd l = vsqrt(dot(s, s));
-    vm small = ~(l >= 1e-12);
+    vm small = ~ge(l, splat(1e-12));
     vd il = 1.0 / l;
     for (int i = 0; i < 3; i++) s[i] = sel(small, in->e[i], s[i] * il);
-    vm iso = (in->jss == in->jpp) & (in->jre == 0) & (in->jim == 0);
+    vm iso = eq(in->jss, in->jpp) & eq(in->jre, splat(0)) & eq(in->jim, splat(0));
     cross(in->d, in->e, f);
     vd c = dot(in->e, s), sn = dot(f, s);
-    vm same = iso | ((c == 1.0) & (sn == 0.0));
+    vm same = iso | (eq(c, splat(1.0)) & eq(sn, splat(0.0)));
     vd a = in->jss, b = in->jpp, re = in->jre, im = in->jim;
     vd cc = c * c, ss = sn * sn, cs = c * sn;
     vd jss = cc * a + 2.0 * cs * re + ss * b;
     vd jpp = ss * a - 2.0 * cs * re + cc * b;
     vd jre = cs * (b - a) + (cc - ss) * re;
     vd jim = (cc + ss) * im;
-    jss = sel(jss < 0, splat(0), jss);
-    jpp = sel(jpp < 0, splat(0), jpp);
+    jss = sel(lt(jss, splat(0)), splat(0), jss);
+    jpp = sel(lt(jpp, splat(0)), splat(0), jpp);
     j[0] = sel(same, a, jss);
     j[1] = sel(same, b, jpp);
     j[2] = sel(same, re, jre);
@@ -321,11 +349,11 @@ static inline void fresnel(vd n1, vd n2, vd ci, fres *f)
     vd c2 = (1.0 - eta * eta) + eta * eta * ci * ci;
     f->ct = vsqrt(c2);
     vd ds = n1 * ci + n2 * f->ct, dp = n2 * ci + n1 * f->ct;
-    f->bad = (c2 <= 0) | (ds == 0) | (dp == 0);
+    f->bad = le(c2, splat(0)) | eq(ds, splat(0)) | eq(dp, splat(0));
     vd is = 1.0 / ds, ip = 1.0 / dp;
     vd rs = (n1 * ci - n2 * f->ct) * is;
     vd rp = (n2 * ci - n1 * f->ct) * ip;
-    vm ns = rs < 0, np = rp < 0;
+    vm ns = lt(rs, splat(0)), np = lt(rp, splat(0));
     rs = sel(ns, -rs, rs);
     rp = sel(np, -rp, rp);
     f->Rs = rs * rs;
@@ -352,8 +380,8 @@ static inline __attribute__((always_inline)) unsigned chunk(const tr_pk *pin, tr
     vd n[3], q[3], e[3], j[4];
     pk_load(pin, b, &vi);
     /* trace_rest's depth limit and seq_cands's direction checks */
-    vm go = on & (in->depth < o->max_depth) & (in->d[2] > 0);
-    if (o->entry) go &= in->o[2] < o->entry_z;
+    vm go = on & (in->depth < o->max_depth) & gt(in->d[2], splat(0));
+    if (o->entry) go &= lt(in->o[2], splat(o->entry_z));
     nearest(cs, in->o, in->d, &k);
     normal(&k, n);
     st(x->t + b, k.t);
@@ -375,11 +403,11 @@ static inline __attribute__((always_inline)) unsigned chunk(const tr_pk *pin, tr
 
     /* interact: the indices seen from the incident side, m back into it */
     vd dn = dot(in->d, n), m[3];
-    vm back = dn > 0;
+    vm back = gt(dn, splat(0));
     vd n1 = sel(back, k.nb, k.nf), n2 = sel(back, k.nf, k.nb);
     for (int i = 0; i < 3; i++) m[i] = sel(back, -n[i], n[i]);
     vd adn = vabs(dn);
-    vd ci = sel(adn < 1.0, adn, splat(1.0));
+    vd ci = sel(lt(adn, splat(1.0)), adn, splat(1.0));
     fres f;
     fresnel(n1, n2, ci, &f);
     st(x->jss + b, j[0]); st(x->jpp + b, j[1]); st(x->jre + b, j[2]); st(x->jim + b, j[3]);
@@ -398,14 +426,14 @@ static inline __attribute__((always_inline)) unsigned chunk(const tr_pk *pin, tr
 
     /* what each lane did */
     vm hit = go & (k.k >= 0) & fin;
-    vm refr = hit & (k.kind == TRACE_REFRACT) & ~f.bad;
-    vm det = hit & (k.kind == TRACE_DETECT), abso = hit & (k.kind == TRACE_ABSORB);
+    vm refr = hit & eq(k.kind, splat(TRACE_REFRACT)) & ~f.bad;
+    vm det = hit & eq(k.kind, splat(TRACE_DETECT)), abso = hit & eq(k.kind, splat(TRACE_ABSORB));
     vm rot = refr | det;
     stm(x->status + b, seli(refr, msplat(TR_PK_REFRACT), seli(det, msplat(TR_PK_DETECT),
                        seli(abso, msplat(TR_PK_ABSORB), seli(on, msplat(TR_PK_SCALAR),
                                                              msplat(TR_PK_IDLE))))));
     stm(x->cand + b, k.k);
-    vm mismatch = refr & (vabs(in->n - n1) > 1e-9 * n1);
+    vm mismatch = refr & gt(vabs(in->n - n1), 1e-9 * n1);
     stm(x->mismatch + b, mismatch);
     for (int i = 0; i < 3; i++) {
         out->e[i] = sel(rot, e[i], in->e[i]);
@@ -436,12 +464,12 @@ static inline __attribute__((always_inline)) unsigned chunk(const tr_pk *pin, tr
     out->ncutr = in->ncutr;
     if (o->fresnel && !o->reflections) {
         vd pr = f.Rs * pj[0] + f.Rp * pj[1];
-        vm lost = refr & (pr > 0);
+        vm lost = refr & gt(pr, splat(0));
         out->cut = sel(lost, in->cut + pr, in->cut);
         out->ncutr = in->ncutr + (lost & 1);
     }
     vd pw = out->jss + out->jpp;
-    vm strong = refr & ~(pw <= 0) & ~(pw < o->cutoff * in->p0);
+    vm strong = refr & ~le(pw, splat(0)) & ~lt(pw, o->cutoff * in->p0);
     pk_store(out, pout, b);
     unsigned calm = 0;
     for (int l = 0; l < W; l++) calm |= strong[l] ? 1u << l : 0;
