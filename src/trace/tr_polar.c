@@ -71,7 +71,7 @@ int tr_polarization(trace_scene *sc, int on, const double xref[3],
     double x[3] = {1, 0, 0};
     if (xref) {
         v_set(x, xref);
-        if (!(isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2])) || !v_unit(x))
+        if (!(isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2])) || v_unit(x))
             return pfail(sc, "the Stokes reference must be a finite, nonzero vector");
     }
     if (!sc->polar && !(sc->polar = calloc(1, sizeof *sc->polar)))
@@ -321,12 +321,17 @@ static void frame_x(const struct tr_polar *pl, const double k[3], double x[3])
 }
 
 /* The hit's record: P, gain, Stokes, the Jones matrix's retardance and diattenuation. */
-static void emit_polar(tr_worker *w, const pray *q, const ptree *t)
+static void emit_polar(tr_worker *w, const pray *q, const ptree *t, uint64_t ray,
+                       int surf, const double pos[3])
 {
     if (!w->want_hit) return;
     trace_polar_hit *h = buf_slot(&w->out.pol);
     if (!h) { w->nomem = 1; return; }
     memset(h, 0, sizeof *h);
+    h->ray = ray;
+    h->depth = q->r.depth;
+    h->surface = surf;
+    v_set(h->pos, pos);
     const struct tr_polar *pl = w->sc->polar;
     double x[3], y[3];
     frame_x(pl, q->r.d, x);
@@ -533,7 +538,7 @@ static int on_hit(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
         if (r->alpha > 0) absorb_along(ty, q, h->t);
         ty->detected += power(q);
         ty->hits++;
-        emit_polar(w, q, t);
+        emit_polar(w, q, t, ray, h->surf, x);
         tr_emit_hit(w, &w->out, r, ray, h, x);
         return 0;
     }

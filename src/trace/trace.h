@@ -378,6 +378,9 @@ typedef struct trace_polar_surface {
     double layer_d[TRACE_MAXLAYER];   /* thickness, um (as trace_source.lambda) */
 } trace_polar_surface;
 typedef struct trace_polar_hit {
+    uint64_t ray;              /* the hit's ray, depth, surface and point (trace_hit) */
+    int depth, surface;
+    double pos[3];
     double prt[3][3][2];       /* P (re, im), row-major, global coordinates */
     double gain;               /* the radiometric factor (above) */
     double stokes[4];          /* S0..S3 (power units) in the frame x', y' = dir x x',
