@@ -30,6 +30,7 @@ typedef struct pray {
     tr_wray r;
     cplx P[3][3];
     double g;
+    int cx;                    /* P has imaginary parts (else they are all 0) */
 } pray;
 
 /* What every ray of one source ray's tree shares: its source coherency as
@@ -37,6 +38,7 @@ typedef struct pray {
  * input frame of its Jones matrix. */
 typedef struct ptree {
     double a[2][3];
+    int na;                    /* 1: linearly polarized (a[1] = 0), else 2 */
     double xin[3], yin[3];
 } ptree;
 
@@ -169,18 +171,24 @@ static void film(const trace_polar_surface *ps, int rev, double n1, double n2, d
 }
 
 /* The interface's amplitudes: a coating's, else the bare Fresnel ones (fc). */
-static void amplitudes(const trace_polar_surface *ps, int rev, double n1, double n2,
-                       double ci, double lambda, const trace_fresnel_coef *fc, cplx a[4])
+static int amplitudes(const trace_polar_surface *ps, int rev, double n1, double n2,
+                      double ci, double lambda, const trace_fresnel_coef *fc, cplx a[4])
 {
     if (ps && ps->nlayer > 0 && ci > 0) {
         film(ps, rev, n1, n2, ci, lambda > 0 ? lambda : 0.5875618, &a[0], &a[1], &a[2], &a[3]);
         if (fc->tir) a[2] = a[3] = 0;
-        return;
+        return 1;
+    }
+    a[2] = fc->ts;
+    a[3] = fc->tp;
+    if (!fc->tir) {                   /* phases 0 or pi: real */
+        a[0] = fc->rs_phase == 0 ? fc->rs : -fc->rs;
+        a[1] = fc->rp_phase == 0 ? fc->rp : -fc->rp;
+        return 0;
     }
     a[0] = fc->rs * cexp(I * fc->rs_phase);
     a[1] = fc->rp * cexp(I * fc->rp_phase);
-    a[2] = fc->ts;
-    a[3] = fc->tp;
+    return 1;
 }
 
 /* M = O_out diag(as, ap, 1) O_in^T, O = [s, k x s, k]. */
@@ -214,13 +222,32 @@ static void element_of(const trace_polar_surface *ps, const double k[3], cplx M[
                          : k[i] * k[j];   /* an axis along the ray passes nothing */
 }
 
-static void mul(cplx A[3][3], cplx P[3][3])   /* P = A P */
+/* P = A P, *cx: P complex; acx: A complex.  Written out in real arithmetic: while
+ * no TIR, coating or retarder has been met every factor is real (a third of the
+ * work), and C's complex product would test every result for NaN. */
+static void mul(cplx A[3][3], int acx, cplx P[3][3], int *cx)
 {
-    cplx T[3][3];
+    double ar[3][3], ai[3][3], pr[3][3], pi[3][3];
     for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            T[i][j] = A[i][0] * P[0][j] + A[i][1] * P[1][j] + A[i][2] * P[2][j];
-    memcpy(P, T, sizeof T);
+        for (int j = 0; j < 3; j++) { ar[i][j] = creal(A[i][j]); pr[i][j] = creal(P[i][j]); }
+    if (!acx && !*cx) {
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                P[i][j] = ar[i][0] * pr[0][j] + ar[i][1] * pr[1][j] + ar[i][2] * pr[2][j];
+        return;
+    }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) { ai[i][j] = cimag(A[i][j]); pi[i][j] = cimag(P[i][j]); }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double re = 0, im = 0;
+            for (int k = 0; k < 3; k++) {
+                re += ar[i][k] * pr[k][j] - ai[i][k] * pi[k][j];
+                im += ar[i][k] * pi[k][j] + ai[i][k] * pr[k][j];
+            }
+            P[i][j] = CMPLX(re, im);
+        }
+    *cx = 1;
 }
 
 /* s unit vector of the plane of incidence (d x n), or e at normal incidence. */
@@ -256,7 +283,7 @@ int tr_prt_interface(const double kin[3], const double nrm[3], double n1, double
     tr_fresnel(n1, n2, ci, &fc);
     any_perp(kin, e);
     s_vector(kin, nrm, e, s);
-    amplitudes(ps, dn > 0, n1, n2, ci, lambda, &fc, a);
+    (void)amplitudes(ps, dn > 0, n1, n2, ci, lambda, &fc, a);
     int tir = 0;
     if (reflect || fc.tir) {
         for (int i = 0; i < 3; i++) kout[i] = kin[i] + 2 * ci * m[i];
@@ -274,7 +301,8 @@ int tr_prt_interface(const double kin[3], const double nrm[3], double n1, double
             trace_polar_surface q = *ps;
             v_unit(q.axis);
             element_of(&q, kout, J);
-            mul(J, M);
+            int cx = 1;
+            mul(J, 1, M, &cx);
         }
     }
     for (int i = 0; i < 3; i++)
@@ -289,24 +317,28 @@ static void sync(pray *q, const ptree *t, const double s[3])
 {
     double f[3];
     v_cross(q->r.d, s, f);
-    double ss = 0, pp = 0;
-    cplx sp = 0;
-    for (int j = 0; j < 2; j++) {
-        cplx es = 0, ep = 0;
+    double ss = 0, pp = 0, spr = 0, spi = 0;
+    for (int j = 0; j < t->na; j++) {
+        double sr = 0, si = 0, qr = 0, qi = 0;
         for (int i = 0; i < 3; i++) {
-            cplx E = q->P[i][0] * t->a[j][0] + q->P[i][1] * t->a[j][1] + q->P[i][2] * t->a[j][2];
-            es += s[i] * E;
-            ep += f[i] * E;
+            double er = 0, ei = 0;
+            for (int k = 0; k < 3; k++) {
+                er += creal(q->P[i][k]) * t->a[j][k];
+                ei += cimag(q->P[i][k]) * t->a[j][k];
+            }
+            sr += s[i] * er; si += s[i] * ei;
+            qr += f[i] * er; qi += f[i] * ei;
         }
-        ss += creal(es * conj(es));
-        pp += creal(ep * conj(ep));
-        sp += es * conj(ep);
+        ss += sr * sr + si * si;
+        pp += qr * qr + qi * qi;
+        spr += sr * qr + si * qi;      /* Es conj(Ep) */
+        spi += si * qr - sr * qi;
     }
     v_set(q->r.pol.e, s);
     q->r.pol.jss = q->g * ss;
     q->r.pol.jpp = q->g * pp;
-    q->r.pol.jre = q->g * creal(sp);
-    q->r.pol.jim = q->g * cimag(sp);
+    q->r.pol.jre = q->g * spr;
+    q->r.pol.jim = q->g * spi;
 }
 
 static double power(const pray *q) { return q->r.pol.jss + q->r.pol.jpp; }
@@ -343,7 +375,7 @@ static void emit_polar(tr_worker *w, const pray *q, const ptree *t, uint64_t ray
             h->prt[i][j][1] = cimag(q->P[i][j]);
         }
     h->gain = q->g;
-    for (int j = 0; j < 2; j++) {
+    for (int j = 0; j < t->na; j++) {
         cplx ex = 0, ey = 0;
         for (int i = 0; i < 3; i++) {
             cplx E = q->P[i][0] * t->a[j][0] + q->P[i][1] * t->a[j][1] + q->P[i][2] * t->a[j][2];
@@ -427,7 +459,7 @@ static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
         for (int i = 0; i < 3; i++) r->d[i] += 2 * ci * m[i];
         v_unit(r->d);
         prt_of(kin, r->d, s, -1, 1, M);
-        mul(M, q->P);
+        mul(M, 0, q->P, &q->cx);
         sync(q, t, s);
         return tr_strong(w, ty, power(q), p0);
     }
@@ -435,13 +467,13 @@ static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
     trace_fresnel_coef fc;
     cplx a[4];
     tr_fresnel(n1, n2, ci, &fc);
-    amplitudes(ps, dn > 0, n1, n2, ci, r->lambda, &fc, a);
+    int acx = amplitudes(ps, dn > 0, n1, n2, ci, r->lambda, &fc, a);
     if (fc.tir) {
         if (r->depth <= 32) r->hist |= 1u << (r->depth - 1);
         for (int i = 0; i < 3; i++) r->d[i] += 2 * ci * m[i];
         v_unit(r->d);
         prt_of(kin, r->d, s, a[0], a[1], M);
-        mul(M, q->P);
+        mul(M, acx, q->P, &q->cx);
         sync(q, t, s);
         ty->tir++;
         return tr_strong(w, ty, power(q), p0);
@@ -455,7 +487,7 @@ static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
         v_unit(c->r.d);
         c->r.n = n1;
         prt_of(kin, c->r.d, s, a[0], a[1], M);
-        mul(M, c->P);
+        mul(M, acx, c->P, &c->cx);
         sync(c, t, s);
         if (w->o->reflections) {
             tr_keep(w, ty, sp, &c->r, p0);
@@ -474,13 +506,14 @@ static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
         q->g *= ci > 0 ? n2 * fc.cos_t / (n1 * ci) : 0;
     } else {
         prt_of(kin, r->d, s, 1, 1, M);
+        acx = 0;
     }
-    mul(M, q->P);
+    mul(M, acx, q->P, &q->cx);
     if (ps && ps->element != TRACE_POL_NONE) {
         sync(q, t, s);
         double before = power(q);
         element_of(ps, r->d, M);
-        mul(M, q->P);
+        mul(M, ps->element == TRACE_POL_RETARDER, q->P, &q->cx);
         sync(q, t, s);
         double lost = before - power(q);
         if (lost > 0) ty->absorbed += lost;
@@ -562,6 +595,8 @@ static void trace_tree(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *
     memset(q.P, 0, sizeof q.P);
     for (int i = 0; i < 3; i++) q.P[i][i] = 1;
     q.g = 1;
+    q.cx = 0;
+    t.na = r0->pol.jpp > 0 ? 2 : 1;
     v_cross(r0->d, r0->pol.e, f);
     for (int i = 0; i < 3; i++) {
         t.a[0][i] = sqrt(r0->pol.jss) * r0->pol.e[i];
