@@ -82,6 +82,8 @@ build/asan/trace_tests/%: tests/trace/%.c build/asan/lib/lensmat-trace.so src/tr
 all: build/lib/lensmat-trace.so
 MODULE_TEST_BINS  += build/lib/lensmat-trace.so build/asan/lib/lensmat-trace.so $(TRACE_TBIN)
 MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
+# (t_polar's checks are also scripts/bench_wave.sh's polarization figures)
+MODULE_BENCH_BINS += build/obj/trace_tests/t_polar
 -include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d) \
     $(patsubst src/paraxial/%.c,build/obj/trace/px/%.d,$(TRACE_PX))
 

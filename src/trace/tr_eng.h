@@ -240,6 +240,7 @@ typedef struct tr_worker {
     tr_wray *stack;
     tr_lane lane[TR_LANES];
     int nomem;
+    struct tr_polw *pol;         /* polarization runs: P per ray (tr_polar.c), else NULL */
 } tr_worker;
 
 /* ---- the scene (tr_scene.c) ---- */
@@ -282,6 +283,13 @@ void tr_scene_ray(const trace_scene *sc, int *k, uint64_t g, tr_ray0 *r);
 
 /* ---- polarization ray tracing (tr_polar.c) ---- */
 void tr_polar_batch(tr_worker *w);      /* a batch ray by ray, P per ray */
+/* tr_trace_rest's steps when w->pol is set: a hit (instead of its on_hit), and the
+ * waiting ray taken off stack slot sp.  Never inlined: the unpolarized loop keeps the
+ * code (and the inlining of tr_find_hit) it had. */
+__attribute__((noinline))
+int tr_polar_on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int *sp,
+                    tr_wray *r, const tr_hitrec *h, uint64_t ray, double p0);
+__attribute__((noinline)) void tr_polar_pop(tr_worker *w, int sp);
 void tr_polar_free(struct tr_polar *p);
 int tr_polarization(trace_scene *sc, int on, const double xref[3],
                     int (*cb)(void *ctx, const trace_polar_hit *ph), void *ctx);

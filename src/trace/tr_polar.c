@@ -21,13 +21,13 @@ struct tr_polar {
     double xref[3], xalt[3];   /* Stokes frame reference, and the one near it */
     int (*cb)(void *ctx, const trace_polar_hit *ph);   /* the records' sink */
     void *ctx;
+
     int n;                     /* entries in el */
     trace_polar_surface *el;   /* per surface id (element NONE, no layers: bare) */
 };
 
-/* The polarization state of one ray: the engine's ray, P, the radiometric gain. */
+/* The polarization state of one ray beside its tr_wray: P, the radiometric gain. */
 typedef struct pray {
-    tr_wray r;
     cplx P[3][3];
     double g;
     int cx;                    /* P has imaginary parts (else they are all 0) */
@@ -41,6 +41,13 @@ typedef struct ptree {
     int na;                    /* 1: linearly polarized (a[1] = 0), else 2 */
     double xin[3], yin[3];
 } ptree;
+
+/* A worker's polarization state while it traces a batch (tr_worker.pol): the live
+ * ray's, and one per slot of its stack of waiting rays (the same index). */
+struct tr_polw {
+    pray cur, *stack;
+    ptree t;
+};
 
 /* ---- set-up ------------------------------------------------------------------------ */
 
@@ -170,25 +177,45 @@ static void film(const trace_polar_surface *ps, int rev, double n1, double n2, d
     }
 }
 
-/* The interface's amplitudes: a coating's, else the bare Fresnel ones (fc). */
-static int amplitudes(const trace_polar_surface *ps, int rev, double n1, double n2,
-                      double ci, double lambda, const trace_fresnel_coef *fc, cplx a[4])
+/* Fresnel at an interface, as tr_optics.c's tr_fresnel decides it (the same cos t and
+ * TIR test, so the same refracted direction), with the amplitudes complex: Hecht's
+ * forms, under TIR cos t = i kappa.  Computed here rather than by calling tr_fresnel:
+ * a further caller makes link-time optimisation stop inlining it (and tr_find_hit)
+ * into the unpolarized loop, which then ran 8 % slower ray by ray. */
+typedef struct pfres { int tir; double cos_t; } pfres;
+static void fresnel_of(double n1, double n2, double ci, pfres *f, cplx a[4])
 {
+    double eta = n1 / n2, c2 = (1.0 - eta * eta) + eta * eta * ci * ci;
+    if (c2 <= 0) {
+        double kap = sqrt(-c2);
+        f->tir = 1;
+        f->cos_t = 0;
+        a[0] = cexp(-2 * I * atan2(n2 * kap, n1 * ci));
+        a[1] = cexp(-2 * I * atan2(n1 * kap, n2 * ci));
+        a[2] = a[3] = 0;
+        return;
+    }
+    double ct = sqrt(c2), ds = n1 * ci + n2 * ct, dp = n2 * ci + n1 * ct;
+    f->tir = 0;
+    f->cos_t = ct;
+    if (ds == 0 || dp == 0) { a[0] = -1; a[1] = 1; a[2] = a[3] = 0; return; }
+    a[0] = (n1 * ci - n2 * ct) / ds;
+    a[1] = (n2 * ci - n1 * ct) / dp;
+    a[2] = 2 * n1 * ci / ds;
+    a[3] = 2 * n1 * ci / dp;
+}
+
+/* The interface's amplitudes: a coating's, else the bare Fresnel ones; 1 if complex. */
+static int amplitudes(const trace_polar_surface *ps, int rev, double n1, double n2,
+                      double ci, double lambda, pfres *fc, cplx a[4])
+{
+    fresnel_of(n1, n2, ci, fc, a);
     if (ps && ps->nlayer > 0 && ci > 0) {
         film(ps, rev, n1, n2, ci, lambda > 0 ? lambda : 0.5875618, &a[0], &a[1], &a[2], &a[3]);
         if (fc->tir) a[2] = a[3] = 0;
         return 1;
     }
-    a[2] = fc->ts;
-    a[3] = fc->tp;
-    if (!fc->tir) {                   /* phases 0 or pi: real */
-        a[0] = fc->rs_phase == 0 ? fc->rs : -fc->rs;
-        a[1] = fc->rp_phase == 0 ? fc->rp : -fc->rp;
-        return 0;
-    }
-    a[0] = fc->rs * cexp(I * fc->rs_phase);
-    a[1] = fc->rp * cexp(I * fc->rp_phase);
-    return 1;
+    return fc->tir;
 }
 
 /* M = O_out diag(as, ap, 1) O_in^T, O = [s, k x s, k]. */
@@ -278,9 +305,8 @@ int tr_prt_interface(const double kin[3], const double nrm[3], double n1, double
     double dn = v_dot(kin, nrm), m[3], s[3], e[3];
     for (int i = 0; i < 3; i++) m[i] = dn > 0 ? -nrm[i] : nrm[i];
     double ci = fabs(dn) < 1.0 ? fabs(dn) : 1.0;
-    trace_fresnel_coef fc;
+    pfres fc;
     cplx a[4], M[3][3];
-    tr_fresnel(n1, n2, ci, &fc);
     any_perp(kin, e);
     s_vector(kin, nrm, e, s);
     (void)amplitudes(ps, dn > 0, n1, n2, ci, lambda, &fc, a);
@@ -312,11 +338,12 @@ int tr_prt_interface(const double kin[3], const double nrm[3], double n1, double
 
 /* ---- the ray's state from P -------------------------------------------------------- */
 
-/* The coherency in the basis (s, d x s) from P and the tree's source coherency. */
-static void sync(pray *q, const ptree *t, const double s[3])
+/* The coherency of ray r in the basis (s, d x s) from P and the tree's source
+ * coherency. */
+static void sync(tr_wray *r, const pray *q, const ptree *t, const double s[3])
 {
     double f[3];
-    v_cross(q->r.d, s, f);
+    v_cross(r->d, s, f);
     double ss = 0, pp = 0, spr = 0, spi = 0;
     for (int j = 0; j < t->na; j++) {
         double sr = 0, si = 0, qr = 0, qi = 0;
@@ -334,14 +361,14 @@ static void sync(pray *q, const ptree *t, const double s[3])
         spr += sr * qr + si * qi;      /* Es conj(Ep) */
         spi += si * qr - sr * qi;
     }
-    v_set(q->r.pol.e, s);
-    q->r.pol.jss = q->g * ss;
-    q->r.pol.jpp = q->g * pp;
-    q->r.pol.jre = q->g * spr;
-    q->r.pol.jim = q->g * spi;
+    v_set(r->pol.e, s);
+    r->pol.jss = q->g * ss;
+    r->pol.jpp = q->g * pp;
+    r->pol.jre = q->g * spr;
+    r->pol.jim = q->g * spi;
 }
 
-static double power(const pray *q) { return q->r.pol.jss + q->r.pol.jpp; }
+static double power(const tr_wray *r) { return r->pol.jss + r->pol.jpp; }
 
 /* The Stokes frame's x' for a ray along k. */
 static void frame_x(const struct tr_polar *pl, const double k[3], double x[3])
@@ -353,21 +380,21 @@ static void frame_x(const struct tr_polar *pl, const double k[3], double x[3])
 }
 
 /* The hit's record: P, gain, Stokes, the Jones matrix's retardance and diattenuation. */
-static void emit_polar(tr_worker *w, const pray *q, const ptree *t, uint64_t ray,
-                       int surf, const double pos[3])
+static void emit_polar(tr_worker *w, tr_out *out, const tr_wray *r, const pray *q,
+                       const ptree *t, uint64_t ray, int surf, const double pos[3])
 {
     if (!w->want_hit) return;
-    trace_polar_hit *h = buf_slot(&w->out.pol);
+    trace_polar_hit *h = buf_slot(&out->pol);
     if (!h) { w->nomem = 1; return; }
     memset(h, 0, sizeof *h);
     h->ray = ray;
-    h->depth = q->r.depth;
+    h->depth = r->depth;
     h->surface = surf;
     v_set(h->pos, pos);
     const struct tr_polar *pl = w->sc->polar;
     double x[3], y[3];
-    frame_x(pl, q->r.d, x);
-    v_cross(q->r.d, x, y);
+    frame_x(pl, r->d, x);
+    v_cross(r->d, x, y);
     v_set(h->xref, x);
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
@@ -421,7 +448,10 @@ static void emit_polar(tr_worker *w, const pray *q, const ptree *t, uint64_t ray
     }
 }
 
-/* ---- the trace loop (tr_trace.c's, with P) ----------------------------------------- */
+/* ---- the interaction (tr_trace.c's on_hit and interact, with P) ---------------------
+ * tr_trace_rest (tr_trace.c) runs the loop for both kinds of run: with w->pol set it
+ * calls tr_polar_on_hit instead of its own on_hit, and tr_polar_pop as it takes a
+ * waiting ray off the stack; the next hit is found by the one call there. */
 
 static const trace_polar_surface *el_of(const trace_scene *sc, int id)
 {
@@ -429,10 +459,12 @@ static const trace_polar_surface *el_of(const trace_scene *sc, int id)
     return id < p->n ? &p->el[id] : NULL;
 }
 
-static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
-                    const tr_hitrec *h, const tr_surf *f, double p0, const ptree *t)
+static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray *r,
+                    const tr_hitrec *h, const tr_surf *f, double p0)
 {
-    tr_wray *r = &q->r;
+    struct tr_polw *pw = w->pol;
+    pray *q = &pw->cur;
+    const ptree *t = &pw->t;
     double n1 = f->mat.n_front, n2 = f->mat.n_back, s[3], m[3], kin[3];
     double a2 = f->alpha_back;
     if (f->media && h->prim >= 0) {
@@ -460,13 +492,12 @@ static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
         v_unit(r->d);
         prt_of(kin, r->d, s, -1, 1, M);
         mul(M, 0, q->P, &q->cx);
-        sync(q, t, s);
-        return tr_strong(w, ty, power(q), p0);
+        sync(r, q, t, s);
+        return tr_strong(w, ty, power(r), p0);
     }
     const trace_polar_surface *ps = el_of(w->sc, h->surf);
-    trace_fresnel_coef fc;
+    pfres fc;
     cplx a[4];
-    tr_fresnel(n1, n2, ci, &fc);
     int acx = amplitudes(ps, dn > 0, n1, n2, ci, r->lambda, &fc, a);
     if (fc.tir) {
         if (r->depth <= 32) r->hist |= 1u << (r->depth - 1);
@@ -474,23 +505,25 @@ static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
         v_unit(r->d);
         prt_of(kin, r->d, s, a[0], a[1], M);
         mul(M, acx, q->P, &q->cx);
-        sync(q, t, s);
+        sync(r, q, t, s);
         ty->tir++;
-        return tr_strong(w, ty, power(q), p0);
+        return tr_strong(w, ty, power(r), p0);
     }
     if (w->o->fresnel) {
-        pray *c = &stack[*sp], tmp;
-        if (!w->o->reflections) c = &tmp;
-        *c = *q;
-        if (r->depth <= 32) c->r.hist |= 1u << (r->depth - 1);
-        for (int i = 0; i < 3; i++) c->r.d[i] = kin[i] + 2 * ci * m[i];
-        v_unit(c->r.d);
-        c->r.n = n1;
-        prt_of(kin, c->r.d, s, a[0], a[1], M);
-        mul(M, acx, c->P, &c->cx);
-        sync(c, t, s);
+        /* the reflected ray waits on the stack (its P in the same slot of pw->stack) */
+        tr_wray tmp, *c = w->o->reflections ? &stack[*sp] : &tmp;
+        pray tq, *cq = w->o->reflections ? &pw->stack[*sp] : &tq;
+        *c = *r;
+        *cq = *q;
+        if (r->depth <= 32) c->hist |= 1u << (r->depth - 1);
+        for (int i = 0; i < 3; i++) c->d[i] = kin[i] + 2 * ci * m[i];
+        v_unit(c->d);
+        c->n = n1;
+        prt_of(kin, c->d, s, a[0], a[1], M);
+        mul(M, acx, cq->P, &cq->cx);
+        sync(c, cq, t, s);
         if (w->o->reflections) {
-            tr_keep(w, ty, sp, &c->r, p0);
+            tr_keep(w, ty, sp, c, p0);
         } else {
             double p = power(c);
             if (p > 0) { ty->cutoff += p; ty->cut_reflection++; }
@@ -510,48 +543,43 @@ static int interact(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
     }
     mul(M, acx, q->P, &q->cx);
     if (ps && ps->element != TRACE_POL_NONE) {
-        sync(q, t, s);
-        double before = power(q);
+        sync(r, q, t, s);
+        double before = power(r);
         element_of(ps, r->d, M);
         mul(M, ps->element == TRACE_POL_RETARDER, q->P, &q->cx);
-        sync(q, t, s);
-        double lost = before - power(q);
+        sync(r, q, t, s);
+        double lost = before - power(r);
         if (lost > 0) ty->absorbed += lost;
     } else {
-        sync(q, t, s);
+        sync(r, q, t, s);
     }
-    return tr_strong(w, ty, power(q), p0);
+    return tr_strong(w, ty, power(r), p0);
 }
 
-static double absorb_along(tr_tally *ty, pray *q, double len)
+static double absorb_along(tr_tally *ty, tr_wray *r, pray *q, double len)
 {
-    double k = exp(-q->r.alpha * len), p = power(q);
+    double k = exp(-r->alpha * len), p = power(r);
     q->g *= k;
-    q->r.pol.jss *= k;
-    q->r.pol.jpp *= k;
-    q->r.pol.jre *= k;
-    q->r.pol.jim *= k;
-    double lost = p - power(q);
+    r->pol.jss *= k;
+    r->pol.jpp *= k;
+    r->pol.jre *= k;
+    r->pol.jim *= k;
+    double lost = p - power(r);
     ty->absorbed += lost;
     return lost;
 }
 
-static void failed(tr_tally *ty, int cause, int surf, double p)
+int tr_polar_on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int *sp,
+                    tr_wray *r, const tr_hitrec *h, uint64_t ray, double p0)
 {
-    if (!ty->failures) { ty->fail_cause = cause; ty->fail_surf = surf; }
-    ty->failures++;
-    if (isfinite(p)) ty->cutoff += p;
-}
-
-static int on_hit(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
-                  const tr_hitrec *h, uint64_t ray, double p0, const ptree *t)
-{
-    tr_wray *r = &q->r;
-    double p = power(q), x[3];
+    pray *q = &w->pol->cur;
+    double p = power(r), x[3];
     if (h->far) v_set(x, h->q);
     else for (int i = 0; i < 3; i++) x[i] = r->o[i] + h->t * r->d[i];
     if (!(isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(h->n[0]))) {
-        failed(ty, TR_FAIL_POINT, h->surf, p);
+        if (!ty->failures) { ty->fail_cause = TR_FAIL_POINT; ty->fail_surf = h->surf; }
+        ty->failures++;
+        if (isfinite(p)) ty->cutoff += p;
         return 0;
     }
     const tr_surf *f = w->sc->surf[h->surf];
@@ -561,86 +589,71 @@ static int on_hit(tr_worker *w, tr_tally *ty, pray *stack, int *sp, pray *q,
     switch (f->mat.kind) {
     case TRACE_ABSORB:
         ty->absorbed += p;
-        tr_emit_segment(w, &w->out, r, ray, x, TRACE_END_ABSORB, h->surf);
+        tr_emit_segment(w, out, r, ray, x, TRACE_END_ABSORB, h->surf);
         return 0;
     case TRACE_DETECT: {
         double s[3];
         s_vector(r->d, h->n, r->pol.e, s);
-        sync(q, t, s);
-        tr_emit_segment(w, &w->out, r, ray, x, TRACE_END_DETECT, h->surf);
-        if (r->alpha > 0) absorb_along(ty, q, h->t);
-        ty->detected += power(q);
+        sync(r, q, &w->pol->t, s);
+        tr_emit_segment(w, out, r, ray, x, TRACE_END_DETECT, h->surf);
+        if (r->alpha > 0) absorb_along(ty, r, q, h->t);
+        ty->detected += power(r);
         ty->hits++;
-        emit_polar(w, q, t, ray, h->surf, x);
-        tr_emit_hit(w, &w->out, r, ray, h, x);
+        emit_polar(w, out, r, q, &w->pol->t, ray, h->surf, x);
+        tr_emit_hit(w, out, r, ray, h, x);
         return 0;
     }
     default:
-        tr_emit_segment(w, &w->out, r, ray, x, TRACE_END_NONE, h->surf);
-        if (r->alpha > 0) absorb_along(ty, q, h->t);
+        tr_emit_segment(w, out, r, ray, x, TRACE_END_NONE, h->surf);
+        if (r->alpha > 0) absorb_along(ty, r, q, h->t);
         v_set(r->o, x);
-        return interact(w, ty, stack, sp, q, h, f, p0, t);
+        return interact(w, ty, stack, sp, r, h, f, p0);
     }
 }
 
-static void trace_tree(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty,
-                       pray *stack)
+void tr_polar_pop(tr_worker *w, int sp)
 {
-    const trace_scene *sc = w->sc;
-    const trace_options *o = w->o;
-    pray q;
-    ptree t;
-    double p0, f[3];
-    tr_ray_start(&q.r, r0, ty, &p0);
-    memset(q.P, 0, sizeof q.P);
-    for (int i = 0; i < 3; i++) q.P[i][i] = 1;
-    q.g = 1;
-    q.cx = 0;
-    t.na = r0->pol.jpp > 0 ? 2 : 1;
+    w->pol->cur = w->pol->stack[sp];
+}
+
+/* A source ray's tree: P = I, its coherency's factors and input frame. */
+static void tree_start(tr_worker *w, const tr_ray0 *r0)
+{
+    struct tr_polw *pw = w->pol;
+    double f[3];
+    memset(pw->cur.P, 0, sizeof pw->cur.P);
+    for (int i = 0; i < 3; i++) pw->cur.P[i][i] = 1;
+    pw->cur.g = 1;
+    pw->cur.cx = 0;
+    pw->t.na = r0->pol.jpp > 0 ? 2 : 1;
     v_cross(r0->d, r0->pol.e, f);
     for (int i = 0; i < 3; i++) {
-        t.a[0][i] = sqrt(r0->pol.jss) * r0->pol.e[i];
-        t.a[1][i] = sqrt(r0->pol.jpp) * f[i];
+        pw->t.a[0][i] = sqrt(r0->pol.jss) * r0->pol.e[i];
+        pw->t.a[1][i] = sqrt(r0->pol.jpp) * f[i];
     }
-    frame_x(sc->polar, r0->d, t.xin);
-    v_cross(r0->d, t.xin, t.yin);
-    int sp = 0, live = 1;
-    for (;;) {
-        if (!live) {
-            if (sp == 0) break;
-            q = stack[--sp];
-        }
-        double p = power(&q), x[3];
-        tr_hitrec h;
-        if (q.r.depth > ty->max_depth) ty->max_depth = q.r.depth;
-        if (!(isfinite(q.r.d[0]) && isfinite(q.r.d[1]) && isfinite(q.r.d[2]) && isfinite(p))) {
-            failed(ty, isfinite(p) ? TR_FAIL_DIR : TR_FAIL_POWER, q.r.last_surf, p);
-            live = 0;
-            continue;
-        }
-        if (q.r.depth >= o->max_depth) { ty->cutoff += p; ty->cut_depth++; live = 0; continue; }
-        if (!tr_find_hit(sc, o, q.r.o, q.r.d, q.r.last_surf, q.r.last_prim, q.r.hist, &h)) {
-            for (int i = 0; i < 3; i++) x[i] = q.r.o[i] + o->escape_length * q.r.d[i];
-            ty->segments++;
-            ty->escaped += p;
-            tr_emit_segment(w, &w->out, &q.r, ray, x, TRACE_END_ESCAPE, -1);
-            live = 0;
-            continue;
-        }
-        live = on_hit(w, ty, stack, &sp, &q, &h, ray, p0, &t);
-    }
+    frame_x(w->sc->polar, r0->d, pw->t.xin);
+    v_cross(r0->d, pw->t.xin, pw->t.yin);
 }
 
 void tr_polar_batch(tr_worker *w)
 {
-    pray *stack = malloc(((size_t)w->o->max_depth + 4) * sizeof *stack);
-    if (!stack) { w->nomem = 1; return; }
+    struct tr_polw pw;
+    if (!(pw.stack = malloc(((size_t)w->o->max_depth + 4) * sizeof *pw.stack))) {
+        w->nomem = 1;
+        return;
+    }
+    w->pol = &pw;
     int k = 0;
     for (uint64_t i = 0; i < w->count; i++) {
-        tr_ray0 r;
-        tr_scene_ray(w->sc, &k, w->first + i, &r);
-        trace_tree(w, &r, w->first + i, &w->tally[0], stack);
+        tr_ray0 r0;
+        tr_wray r;
+        double p0;
+        tr_scene_ray(w->sc, &k, w->first + i, &r0);
+        tr_ray_start(&r, &r0, &w->tally[0], &p0);
+        tree_start(w, &r0);
+        tr_trace_rest(w, &w->out, &w->tally[0], w->stack, 0, &r, 1, w->first + i, p0);
         tr_fold(w, i, &w->tally[0]);
     }
-    free(stack);
+    w->pol = NULL;
+    free(pw.stack);
 }

@@ -252,6 +252,7 @@ void tr_trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int 
         if (!live) {
             if (sp == 0) break;
             r = stack[--sp];
+            if (w->pol) tr_polar_pop(w, sp);   /* its P (tr_polar.c) */
         }
         double p = r.pol.jss + r.pol.jpp, q[3];
         tr_hitrec h;
@@ -270,7 +271,8 @@ void tr_trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int 
             live = 0;
             continue;
         }
-        live = on_hit(w, out, ty, stack, &sp, &r, &h, ray, p0);
+        live = w->pol ? tr_polar_on_hit(w, out, ty, stack, &sp, &r, &h, ray, p0)
+                      : on_hit(w, out, ty, stack, &sp, &r, &h, ray, p0);
     }
 }
 
