@@ -68,6 +68,20 @@ EOF
 )
 check "Malus's law through two traced polarizers (scene file): 0.375 detected, 0.625 absorbed, light along the second's axis" polar_malus
 
+# the table does not depend on the thread count (a cone through the rhomb's glass with
+# reflections followed: many small batches)
+polar_threads() (
+    d=$PW/thr; rm -rf "$d"; mkdir -p "$d" && cd "$d" &&
+    printf '%s\n' 'cap refract 1 1.5 coating c vertex 0 0 0 radius 20 aperture 8' \
+        'coating c layer 1.38 100 layer 2.0 70' 'cap refract 1.5 1 retarder 1 1 0 30 vertex 0 0 4 radius -20 aperture 8' \
+        'sphere detect center 0 0 0 radius 50' 'source cone from 0 0 -10 dir 0 0 1 angle 20 rings 30' \
+        'threads 1' 'batch' 'output polar one.csv' | grep -v '^batch' > one.scene &&
+    sed 's/^threads 1/threads 2/; s/one.csv/two.csv/' one.scene > two.scene &&
+    trace_scene "$BIN" "$d" one.scene && trace_scene "$BIN" "$d" two.scene || return 1
+    [ "$(wc -l < one.csv)" -gt 2000 ] && cmp one.csv two.csv
+)
+check "the polar table is the same on one thread and two (coated, retarding lens, reflections followed)" polar_threads
+
 # a quarter-wave plate, fast axis x, 45-degree light: circular (V = 1, the --polar
 # calculator's "qwp 0" on its 45-degree input); a half-wave plate: -45 degrees
 polar_qwp() (
