@@ -4,10 +4,11 @@
  * kept), thin-film coatings by characteristic matrices in place of bare Fresnel,
  * polarizers and retarders on surfaces, and the detector's Stokes parameters.
  *
- * A scene with polarization on is traced here, ray by ray, by a loop that does what
- * tr_trace.c's does (the same segments, the same choice of surfaces, the same
- * cut-offs) with P beside the ray's coherency; the unpolarized trace and the packet
- * path are not touched, so they cost what they cost before.  The ray's coherency
+ * A scene with polarization on is traced ray by ray (tr_polar_batch) through
+ * tr_trace.c's loop, which hands each hit to tr_polar_on_hit here instead of its own
+ * on_hit: the same segments, the same choice of surfaces, the same cut-offs, with P
+ * beside the ray (the live ray's and one per waiting ray in the worker's tr_polw).
+ * The packet path is not taken; the unpolarized loop pays two branches.  The ray's coherency
  * (tr_pol: its s and p powers, which the hits report and the cut-offs test) is
  * recomputed from P at every interface, so powers follow P: polarizers absorb,
  * coatings set R and T.  Conventions: trace.h, "polarization ray tracing". */
