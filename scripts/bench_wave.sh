@@ -18,3 +18,15 @@ printf '%s\n128\nfringe\n37\n100\n0\n-\n' "$W/t1.rx" | ./lensmat --wave "$W/t1.r
 /usr/bin/python3 tests/wave/mtf_quad.py "$W/t1.rec" |
     awk '$1 <= 2 { for (i = 0; i < 2; i++) { d = $(3 + i) - $(5 + i); if (d < 0) d = -d; if (d > m) m = d } }
          END { printf "BENCH wave_triplet_mtf_vs_quadrature_abs_err %.3g ratio\n", m }'
+# Polarization ray tracing (issue 21; src/trace/tr_polar.c): the traced interface's PRT
+# amplitudes against Hecht's forms, a traced Fresnel rhomb's retardance against the TIR
+# closed form and Born & Wolf's 2 x 45 degrees, Malus, a traced coating against the
+# quarter-wave closed form (tests/trace/t_polar.c, whose checks these are); what
+# polarization costs on the triplet against the unpolarized paths of the same run
+# (tests/trace/bench_polar.c), and the unpolarized ray-by-ray loop it mirrors.
+T=build/obj/trace_tests/t_polar P=build/obj/trace_tests/bench_polar
+if [ -x "$T" ] && [ -x "$P" ]; then
+    "$T" | grep '^BENCH'
+    "$P"
+    LENSMAT_ISA=scalar "$P" unpolarized
+else echo "bench_wave: $T or $P not built (make bench builds them)" >&2; exit 1; fi

@@ -12,6 +12,7 @@
 #include "../src/trace/scene_mesh.c"
 #include "../src/trace/scene_read.c"
 #include "../src/trace/scene_axial.c"
+#include "../src/trace/scene_polar.c"
 #include "../src/trace/scene_geom.c"
 
 static int parse_scene(const char *text, char *err)

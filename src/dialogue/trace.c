@@ -81,8 +81,9 @@ static int check_scene(void *ctx, const char *word, char *msg, size_t cap)
     }
     /* its outputs (and the .part files written first) must not be the answers or
      * the record (the scene's own inputs the loader checked) */
-    const char *out[3] = {t->scene.out_segments, t->scene.out_hits, t->scene.out_summary};
-    for (int i = 0; i < 3; i++) {
+    const char *out[4] = {t->scene.out_segments, t->scene.out_hits, t->scene.out_summary,
+                          t->scene.out_polar};
+    for (int i = 0; i < 4; i++) {
         char part[WORD + 8], why[512];
         if (!out[i]) continue;
         snprintf(part, sizeof part, "%s.part", out[i]);
@@ -115,6 +116,8 @@ static void report_outputs(tdlg *t)
                   f[1] == SC_OUT_H5 ? P(WRITTEN_HITS_H5) : P(WRITTEN_HITS));
     report_output(t, sc->out_summary, f[2] == SC_OUT_H5 ? P(WRITTEN_SUMMARY_H5) :
                   P(WRITTEN_SUMMARY));
+    report_output(t, sc->out_polar, sc->out_polar_format == SC_OUT_NPY ?
+                  P(WRITTEN_POLAR_NPY) : P(WRITTEN_POLAR));
 }
 
 static void report_summary(tdlg *t, const trace_summary *s)

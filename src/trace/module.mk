@@ -96,6 +96,8 @@ build/asan/trace_tests/dtoa_check: tests/trace/dtoa_check.c build/asan/trace/sce
 	$(CC) $(BASE) $(SAN) -o $@ $^ -ldouble-conversion -lstdc++ -lm
 MODULE_TEST_BINS  += build/obj/trace_tests/dtoa_check build/asan/trace_tests/dtoa_check
 MODULE_BENCH_BINS += build/lib/lensmat-trace.so $(TRACE_BBIN)
+# (t_polar's checks are also scripts/bench_wave.sh's polarization figures)
+MODULE_BENCH_BINS += build/obj/trace_tests/t_polar
 -include $(TRACE_OBJ:.o=.d) $(TRACE_SOBJ:.o=.d) \
     $(patsubst src/paraxial/%.c,build/obj/trace/px/%.d,$(TRACE_PX))
 

@@ -60,7 +60,24 @@ typedef struct sc_surface {
     char *mesh_file, *media_file;
     const char *src;      /* defined at src:line (for messages) */
     long line;
+    /* polarization (scene_polar.c): refract only.  pol_el: enum trace_polel, on the
+     * light it transmits (polarizer AX AY AZ, retarder FX FY FZ DEG, qwp/hwp F...) */
+    int pol_el;
+    double pol_axis[3], pol_ret;   /* unit axis; retardance, radians */
+    int coat;                 /* 1 + its coating in sc_scene.coating (0: bare) */
+    char coat_name[SC_GLASSMAX];
 } sc_surface;
+
+/* A thin-film coating: `coating NAME layer N D [layer N D ...]` (D in nm; the layers
+ * from the side of the first index of the surface that names it). */
+#define SC_MAXLAYER 32
+typedef struct sc_coating {
+    char name[SC_GLASSMAX];
+    int nlayer;
+    double n[SC_MAXLAYER], d_nm[SC_MAXLAYER];
+    const char *src;
+    long line;
+} sc_coating;
 
 typedef struct sc_source {
     int type;                 /* enum sc_source_type */
@@ -112,6 +129,14 @@ typedef struct sc_scene {
     int out_format[3];        /* segments, hits, summary: sc_out_format (never
                                  SC_OUT_AUTO once read); HDF5 outputs that name one
                                  file are tables of that one file */
+    /* polarization ray tracing (scene_polar.c): `polarization on [ref X Y Z]`, or any
+     * element or coating; `output polar FILE [csv|npy]`, a row per hit */
+    int polar;
+    double polar_ref[3];      /* Stokes frame reference (0 0 0: the engine's, +x) */
+    sc_coating *coating;
+    int ncoating;
+    char *out_polar;
+    int out_polar_format;
 } sc_scene;
 
 /* An output's format: `output KIND FILE [csv|csv17|npy|h5]`, else from FILE's name. */

@@ -55,4 +55,11 @@ static inline void cross3(const double *a, const double *b, double *c)
  * and located in sc.  0 or -1. */
 int sc_axial_pairs(sc_scene *sc, char *err);
 
+/* Polarization lines (scene_polar.c): `coating`, `polarization`, `output polar`; after
+ * the file, coatings found by name and polarization switched on where needed (0 or -1
+ * with FILE:LINE in err); the scene's polarization data freed. */
+int sc_polar_directive(reader *r, sc_scene *sc);
+int sc_polar_resolve(sc_scene *sc, char *err);
+void sc_polar_free(sc_scene *sc);
+
 #endif

@@ -258,13 +258,13 @@ static int h5_shared(const sc_scene *sc, int i, int j)
  * the other outputs, before anything is opened for writing. */
 static int outputs_over_inputs(const sc_scene *sc, const char *path, char *err)
 {
-    const char *what[3] = {"segments", "hits", "summary"};
-    const char *out[3] = {sc->out_segments, sc->out_hits, sc->out_summary};
-    for (int i = 0; i < 3; i++) {
+    const char *what[4] = {"segments", "hits", "summary", "polar"};
+    const char *out[4] = {sc->out_segments, sc->out_hits, sc->out_summary, sc->out_polar};
+    for (int i = 0; i < 4; i++) {
         if (!out[i]) continue;
         if (clash(sc, what[i], out[i], path, "the scene file", err)) return -1;
         for (int j = 0; j < i; j++)
-            if (out[j] && !h5_shared(sc, i, j) && (clash(sc, what[i], out[i], out[j], "output", err) ||
+            if (out[j] && (i == 3 || !h5_shared(sc, i, j)) && (clash(sc, what[i], out[i], out[j], "output", err) ||
                            clash(sc, what[j], out[j], out[i], "output", err)))
                 return -1;
         for (int k = 0; k < sc->nsurf; k++) {

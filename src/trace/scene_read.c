@@ -38,7 +38,9 @@ static const keydef keys[] = {
     {"from", 3}, {"dir", 3}, {"to", 6}, {"angle", 1}, {"rays", 1}, {"rings", 1},
     {"toward", 3}, {"grid", 1}, {"waist", 1}, {"wavelength", 1}, {"trunc", 1},
     {"power", 1}, {"medium", 1}, {"pol", 3}, {"lambda", ARGS_WL},
+    {"polarizer", 3}, {"retarder", 4}, {"qwp", 3}, {"hwp", 3}, {"coating", ARGS_WORD},
 };
+#define POLKEYS " polarizer retarder qwp hwp coating"   /* refracting surfaces */
 #define NKEYS (int)(sizeof keys / sizeof keys[0])
 
 /* The values found on one directive line. */
@@ -262,6 +264,36 @@ static int surface_kind(reader *r, const fields *f, const char *dname, sc_surfac
     return 0;
 }
 
+/* A polarizing element (transmission or fast axis) or a coating's name on a
+ * refracting surface (scene_polar.c, tr_polar.c). */
+static int surface_polar(reader *r, const fields *f, const char *dname, sc_surface *s)
+{
+    static const char *const el[] = {"polarizer", "retarder", "qwp", "hwp"};
+    int n = 0;
+    for (int i = 0; i < 4; i++)
+        if (has(f, el[i])) {
+            const double *v = val(f, el[i]);
+            double m = sqrt(dot3(v, v));
+            if (n++ || m == 0)
+                return sl_fail(r, "%s: %s", dname, m == 0 ? "a polarizer's or retarder's "
+                               "axis must not be zero" : "give one of polarizer, retarder, "
+                               "qwp, hwp");
+            for (int k = 0; k < 3; k++) s->pol_axis[k] = v[k] / m;
+            s->pol_el = i ? TRACE_POL_RETARDER : TRACE_POL_POLARIZER;
+            s->pol_ret = (i == 1 ? v[3] : i == 2 ? 90 : 180) * 0.017453292519943295;
+        }
+    if (has(f, "coating")) {
+        const tok *w = &f->word[key_index(&(tok){"coating", 7})];
+        if (w->n >= SC_GLASSMAX) return sl_fail(r, "%s: coating: the name is too long", dname);
+        memcpy(s->coat_name, w->s, w->n);
+        n++;
+    }
+    if (n && s->kind != SC_REFRACT)
+        return sl_fail(r, "%s: polarizer, retarder, qwp, hwp and coating go on a refracting "
+                       "surface (refract N1 N2)", dname);
+    return 0;
+}
+
 /* Some unit vector perpendicular to the unit vector d (or `up` projected). */
 static void perpendicular(const double *d, double *u)
 {
@@ -310,14 +342,15 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
 {
     static const char *const allowed[] = {
         [SC_PLANE] = "refract mirror absorb detect at normal disc hole rect up tessellate "
-                     "refine",
-        [SC_SPHERE] = "refract mirror absorb detect center radius tessellate refine",
-        [SC_CAP] = "refract mirror absorb detect vertex axis radius aperture tessellate refine",
+                     "refine" POLKEYS,
+        [SC_SPHERE] = "refract mirror absorb detect center radius tessellate refine" POLKEYS,
+        [SC_CAP] = "refract mirror absorb detect vertex axis radius aperture tessellate refine"
+                   POLKEYS,
         [SC_CONIC] = "refract mirror absorb detect vertex axis radius conic aperture "
-                     "tessellate refine",
+                     "tessellate refine" POLKEYS,
         [SC_ASPHERE] = "refract mirror absorb detect vertex axis radius conic coef aperture "
-                       "tessellate refine",
-        [SC_MESH] = "refract mirror absorb detect media file sphere",
+                       "tessellate refine" POLKEYS,
+        [SC_MESH] = "refract mirror absorb detect media file sphere" POLKEYS,
     };
     static const char *const required[] = {
         [SC_PLANE] = "at normal", [SC_SPHERE] = "center radius",
@@ -334,7 +367,7 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
     s.line = r->line;
     s.axis[2] = 1;
     if (parse_fields(r, 1, dname, allowed[shape], &f) || need(r, &f, dname, required[shape])
-        || surface_kind(r, &f, dname, &s))
+        || surface_kind(r, &f, dname, &s) || surface_polar(r, &f, dname, &s))
         return -1;
     if (has(&f, "tessellate")) {
         long t;
@@ -677,11 +710,15 @@ static int read_directive(reader *r, sc_scene *sc)
     const tok *d = &r->t[0];
     for (int i = 0; i < 6; i++)
         if (sl_tok_is(d, shapes[i])) return read_surface(r, sc, shapes[i], i);
+    if (sl_tok_is(d, "coating") || sl_tok_is(d, "polarization") ||
+        (sl_tok_is(d, "output") && r->nt >= 2 && sl_tok_is(&r->t[1], "polar")))
+        return sc_polar_directive(r, sc);   /* scene_polar.c */
     if (sl_tok_is(d, "source")) return read_source(r, sc);
     for (int i = 0; settings[i]; i++)
         if (sl_tok_is(d, settings[i])) return read_setting(r, sc);
     return sl_fail(r, "unknown directive '%.*s' (plane, sphere, cap, conic, asphere, mesh, "
-                "source, depth, cutoff, threads, escape, fresnel, reflections, output, mismatch)",
+                "source, depth, cutoff, threads, escape, fresnel, reflections, output, mismatch, "
+                "polarization, coating)",
                 (int)(d->n < 24 ? d->n : 24), d->s);
 }
 
@@ -729,6 +766,7 @@ int sc_parse_scene(const char *text, size_t len, const char *name, sc_scene *sc,
     }
     if (sc_axial_pairs(sc, err)) goto bad;
     if (sc_check_coincident(sc, err)) goto bad;     /* with both lines */
+    if (sc_polar_resolve(sc, err)) goto bad;
     return 0;
 bad:
     sc_free(sc);
@@ -752,5 +790,6 @@ void sc_free(sc_scene *sc)
     free(sc->out_summary);
     free(sc->name);
     free(sc->dir);
+    sc_polar_free(sc);
     memset(sc, 0, sizeof *sc);
 }

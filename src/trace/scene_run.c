@@ -18,6 +18,7 @@
 #include "paraxial/paraxial.h"
 #include "scene.h"
 #include "scene_out.h"
+#include "scene_pol.h"
 
 #define DEG 0.017453292519943295
 
@@ -553,6 +554,7 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     trace_options opt;
     trace_sink sink = {0};
     out o = {0};
+    sp_out po = {0};                /* polarization: scene_polout.c */
     int rc = TRACE_OK, nwl;
     double wl[SC_MAXWLS + 1];
     trace_summary per[SC_MAXWLS + 1];
@@ -596,10 +598,15 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
             goto out;
         sink.hit = w_hit;
     }
+    if (sc->out_polar) {
+        if (sp_open(sc, &po, err)) goto out;
+        if (!sink.hit) sink.hit = sp_nohit;   /* the records come with the hits */
+    }
     /* one run per wavelength, in the order the sources name them; rays are numbered on
      * from one run to the next */
     for (int k = 0; k < nwl && rc >= 0; k++) {
         if (!ts && build_scene(tr, sc, wl[k], &ts, err)) goto out;
+        if (sc->polar && sp_engine(tr, ts, sc, wl[k], o.ray0, &po, err)) goto out;
         rc = stop_now(&o) ? TRACE_ECANCEL : tr->run(ts, &opt, &sink, &per[k]);
         add_summary(&res->sum, &per[k]);
         o.ray0 += per[k].rays;
@@ -633,6 +640,7 @@ out:
         end_table(sc, &o, 1, res, wl, per, nwl, err);
         finish(&o.hit_out, !err[0], err);
     }
+    sp_finish(&po, !err[0], err);
     so_free(o.seg_t);
     so_free(o.hit_t);
     if (ts) tr->scene_free(ts);

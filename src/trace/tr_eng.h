@@ -86,6 +86,7 @@ struct trace_scene {
     double entry_z;            /* ... if it starts at z < entry_z */
     double entry_zmin;         /* ... and z > entry_zmin (what lies left of the lens:
                                   -inf for none, tr_seqscan.c) */
+    struct tr_polar *polar;    /* polarization ray tracing (tr_polar.c); NULL: off */
 };
 
 /* tr_wt.c: adjacency and the watertight test in double (see there). */
@@ -207,6 +208,7 @@ static inline int buf_move(tr_buf *b, tr_buf *a)
 /* Where a ray's records go: the worker's buffers, or a lane's until its turn. */
 typedef struct tr_out {
     tr_buf seg, hit;
+    tr_buf pol;                  /* polarization runs: a trace_polar_hit per hit */
 } tr_out;
 
 /* Rays traced side by side on the lens shortcut (tr_packet.c): TR_PK rays' arithmetic
@@ -238,6 +240,7 @@ typedef struct tr_worker {
     tr_wray *stack;
     tr_lane lane[TR_LANES];
     int nomem;
+    struct tr_polw *pol;         /* polarization runs: P per ray (tr_polar.c), else NULL */
 } tr_worker;
 
 /* ---- the scene (tr_scene.c) ---- */
@@ -277,6 +280,25 @@ void tr_trace_one(tr_worker *w, const tr_ray0 *r0, uint64_t ray, tr_tally *ty);
 void tr_trace_batch_rays(tr_worker *w);
 void tr_fold(tr_worker *w, uint64_t i, const tr_tally *t);
 void tr_scene_ray(const trace_scene *sc, int *k, uint64_t g, tr_ray0 *r);
+
+/* ---- polarization ray tracing (tr_polar.c) ---- */
+void tr_polar_batch(tr_worker *w);      /* a batch ray by ray, P per ray */
+/* tr_trace_rest's steps when w->pol is set: a hit (instead of its on_hit), and the
+ * waiting ray taken off stack slot sp.  Never inlined: the unpolarized loop keeps the
+ * code (and the inlining of tr_find_hit) it had. */
+__attribute__((noinline))
+int tr_polar_on_hit(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int *sp,
+                    tr_wray *r, const tr_hitrec *h, uint64_t ray, double p0);
+__attribute__((noinline)) void tr_polar_pop(tr_worker *w, int sp);
+void tr_polar_free(struct tr_polar *p);
+int tr_polarization(trace_scene *sc, int on, const double xref[3],
+                    int (*cb)(void *ctx, const trace_polar_hit *ph), void *ctx);
+/* The record sink polarization() was given (NULL: none). */
+int tr_polar_deliver(const trace_scene *sc, const trace_polar_hit *ph);
+int tr_set_polar(trace_scene *sc, int id, const trace_polar_surface *ps);
+int tr_prt_interface(const double k_in[3], const double nrm[3], double n1, double n2,
+                     const trace_polar_surface *ps, double lambda, int reflect,
+                     double P[3][3][2], double k_out[3]);
 
 /* ---- the packet orchestration (tr_lanes.c) ---- */
 void tr_trace_batch(tr_worker *w);

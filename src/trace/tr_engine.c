@@ -42,6 +42,9 @@ static const trace_api api = {
     tr_rx_trace,
     tr_rx_aim,
     tr_rx_opd,
+    tr_polarization,
+    tr_set_polar,
+    tr_prt_interface,
 };
 
 const trace_api *trace_get_api(int abi)

@@ -134,14 +134,15 @@ static void fill(tr_pool *p, tr_worker *w, tr_slot *s, uint64_t b)
     memset(&s->counts, 0, sizeof s->counts);
     w->counts = &s->counts;
     w->out = s->out;                       /* the slot's buffers, emptied */
-    w->out.seg.n = w->out.hit.n = 0;
+    w->out.seg.n = w->out.hit.n = w->out.pol.n = 0;
     w->nomem = 0;
     w->fail.cause = TR_FAIL_NONE;
     /* The packet path (tr_trace_batch's lanes) does not apply Beer-Lambert: a scene
      * with an absorbing medium goes ray by ray, the general path (same physics
      * otherwise).  Every other scene takes tr_trace_batch, which picks packets when
      * its own conditions hold (a sequential lens, AVX-512). */
-    if (p->sc->absorbing) tr_trace_batch_rays(w);
+    if (p->sc->polar) tr_polar_batch(w);          /* P per ray: tr_polar.c */
+    else if (p->sc->absorbing) tr_trace_batch_rays(w);
     else tr_trace_batch(w);
     s->fail = w->fail;
     s->out = w->out;
@@ -172,13 +173,16 @@ static void *worker_main(void *arg)
 }
 
 /* Hand a batch's records to the sinks (segments, then hits: each in ray order). */
-static int deliver(const tr_slot *s, const trace_sink *k)
+static int deliver(const trace_scene *sc, const tr_slot *s, const trace_sink *k)
 {
     for (size_t i = 0; k->segment && i < s->out.seg.n; i++)
         if (k->segment(k->ctx, (const trace_segment *)s->out.seg.p + i))
             return TRACE_ECANCEL;
-    for (size_t i = 0; k->hit && i < s->out.hit.n; i++)
+    for (size_t i = 0; k->hit && i < s->out.hit.n; i++) {
+        if (i < s->out.pol.n && tr_polar_deliver(sc, (const trace_polar_hit *)s->out.pol.p + i))
+            return TRACE_ECANCEL;
         if (k->hit(k->ctx, (const trace_hit *)s->out.hit.p + i)) return TRACE_ECANCEL;
+    }
     return TRACE_OK;
 }
 
@@ -197,7 +201,7 @@ static int drive(trace_scene *sc, tr_pool *p, tr_worker *w, const trace_sink *si
             uint64_t b0 = p->delivered * (uint64_t)p->batch, left = sc->nrays - b0;
             uint64_t nb = left < (uint64_t)p->batch ? left : (uint64_t)p->batch;
             if (s->nomem) rc = tr_scene_fail(sc, TRACE_ENOMEM, "out of memory for trace output");
-            else if ((rc = deliver(s, sink)) != TRACE_OK)
+            else if ((rc = deliver(sc, s, sink)) != TRACE_OK)
                 tr_scene_fail(sc, rc, "the trace was cancelled");
             if (rc == TRACE_OK) add_batch(sum, p->power, &s->counts, s->power, nb);
             if (rc == TRACE_OK && s->fail.cause && !p->fail.cause) p->fail = s->fail;
@@ -365,6 +369,7 @@ int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
         p.slot[i].power = malloc(room * sizeof(tr_power));
         p.slot[i].out.seg.size = sizeof(trace_segment);
         p.slot[i].out.hit.size = sizeof(trace_hit);
+        p.slot[i].out.pol.size = sizeof(trace_polar_hit);
         if (!p.slot[i].power) rc = TRACE_ENOMEM;
     }
     for (int i = 0; rc == TRACE_OK && i < nthr; i++)
@@ -391,7 +396,7 @@ int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
     s.trace_ms = tr_now_ms() - t0;
     s.lens_surfaces = lens_surfaces(sc, &o);
     if (s.lens_surfaces) {
-        const char *k = sc->absorbing || !tr_pk_usable() ? "scalar" : trace_isa_active();
+        const char *k = sc->absorbing || sc->polar || !tr_pk_usable() ? "scalar" : trace_isa_active();
         snprintf(s.lens_kernel, sizeof s.lens_kernel, "%s", k);
     }
     if (rc == TRACE_OK) rc = numeric_check(sc, &s, &p.fail);
@@ -403,6 +408,7 @@ int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
         free(p.slot[i].power);
         free(p.slot[i].out.seg.p);
         free(p.slot[i].out.hit.p);
+        free(p.slot[i].out.pol.p);
     }
     free(p.slot);
     free(w);

@@ -108,6 +108,7 @@ void tr_scene_free(trace_scene *sc)
     free(sc->surf);
     for (int i = 0; i < sc->nsrc; i++) tr_source_free(&sc->src[i]);
     free(sc->src);
+    tr_polar_free(sc->polar);
     free(sc);
 }
 

@@ -252,6 +252,7 @@ void tr_trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int 
         if (!live) {
             if (sp == 0) break;
             r = stack[--sp];
+            if (__builtin_expect(w->pol != NULL, 0)) tr_polar_pop(w, sp);   /* its P */
         }
         double p = r.pol.jss + r.pol.jpp, q[3];
         tr_hitrec h;
@@ -270,7 +271,18 @@ void tr_trace_rest(tr_worker *w, tr_out *out, tr_tally *ty, tr_wray *stack, int 
             live = 0;
             continue;
         }
-        live = on_hit(w, out, ty, stack, &sp, &r, &h, ray, p0);
+        if (__builtin_expect(w->pol != NULL, 0)) {   /* polarization: tr_polar.c */
+            /* (on copies: the addresses of r, h and sp never leave this loop, so they
+             * stay in registers for the unpolarized trace) */
+            tr_wray pr = r;
+            tr_hitrec ph = h;
+            int psp = sp;
+            live = tr_polar_on_hit(w, out, ty, stack, &psp, &pr, &ph, ray, p0);
+            r = pr;
+            sp = psp;
+        } else {
+            live = on_hit(w, out, ty, stack, &sp, &r, &h, ray, p0);
+        }
     }
 }
 

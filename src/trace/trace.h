@@ -354,6 +354,45 @@ typedef struct trace_aim_ray {
     double opl;                /* optical path from o to the image plane */
 } trace_aim_ray;
 
+/* ---- polarization ray tracing (tr_polar.c) -------------------------------------
+ * With trace_api.polarization on, every ray carries Chipman's 3x3 polarization
+ * ray-tracing matrix P (Chipman, Lam & Young, "Polarized Light and Optical Systems",
+ * ch. 9-10): the field after the path is P E for the source field E (global x y z,
+ * fields as exp(i(kz - wt)), rp with Hecht's sign).  At each interface P grows by
+ * O_out J O_in^T, O = [s, k x s, k] with s = k_in x n / |k_in x n|, J = diag(rs, rp, 1)
+ * on reflection, diag(ts, tp, 1) on refraction (amplitudes; TIR gives rs, rp of unit
+ * modulus and their phases), then a surface's element (below) on what it transmits.
+ * Powers follow P: a ray's power is gain * |P E|^2 summed over the source's
+ * coherency, gain the product of n2 cos t / (n1 cos i) over its refractions (and the
+ * Beer-Lambert factors), so polarizers absorb and coatings set R and T.  Such runs go
+ * ray by ray (never on the packet path). */
+enum trace_polel { TRACE_POL_NONE, TRACE_POL_POLARIZER, TRACE_POL_RETARDER };
+#define TRACE_MAXLAYER 32
+typedef struct trace_polar_surface {
+    int element;               /* enum trace_polel: applied to the transmitted light */
+    double axis[3];            /* polarizer: transmission axis; retarder: fast axis
+                                  (projected perpendicular to each ray) */
+    double retardance;         /* retarder: radians (slow axis delayed) */
+    int nlayer;                /* coating: layers from the front side (n_front) */
+    double layer_n[TRACE_MAXLAYER];
+    double layer_d[TRACE_MAXLAYER];   /* thickness, um (as trace_source.lambda) */
+} trace_polar_surface;
+typedef struct trace_polar_hit {
+    uint64_t ray;              /* the hit's ray, depth, surface and point (trace_hit) */
+    int depth, surface;
+    double pos[3];
+    double prt[3][3][2];       /* P (re, im), row-major, global coordinates */
+    double gain;               /* the radiometric factor (above) */
+    double stokes[4];          /* S0..S3 (power units) in the frame x', y' = dir x x',
+                                  x' the reference projected perpendicular to dir;
+                                  S3 = 2 Im(Ex* Ey) > 0: E turning from x' toward y' */
+    double xref[3];            /* x' */
+    double retardance;         /* of the Jones matrix in the frames x', y' at the source
+                                  ray and here (radians, 0..pi; NaN where a polarizer
+                                  leaves it undefined) */
+    double diattenuation;      /* (smax^2 - smin^2) / (smax^2 + smin^2) of it */
+} trace_polar_hit;
+
 typedef struct trace_scene trace_scene;
 
 typedef struct trace_api {
@@ -432,6 +471,24 @@ typedef struct trace_api {
     int (*rx_opd)(const trace_rx *rx, const trace_aim_req *rq, int n, double z_xp,
                   double lambda, double *w, int *st, trace_aim_ray *chief, double *R_ref,
                   char *err, size_t errcap);
+
+    /* Polarization ray tracing (tr_polar.c; added after rx_opd).  polarization: on 1
+     * makes run() trace P per ray and hand each hit's trace_polar_hit to cb (may be
+     * NULL) with ctx, from run()'s thread just before the sink's hit() for that hit
+     * (when the sink takes hits); xref (NULL: +x) is the Stokes frame's reference
+     * (for rays within 25 degrees of it: z x xref, +y for the default).  set_polar:
+     * surface id's element and coating (refracting surfaces only; it turns
+     * polarization on).  TRACE_OK or TRACE_EINVAL. */
+    int (*polarization)(trace_scene *sc, int on, const double xref[3],
+                        int (*cb)(void *ctx, const trace_polar_hit *ph), void *ctx);
+    int (*set_polar)(trace_scene *sc, int id, const trace_polar_surface *ps);
+    /* The PRT matrix of one interface (pure function): unit k_in, unit normal nrm (either
+     * orientation), media n1 -> n2, ps (NULL: bare), lambda um (for a coating),
+     * reflect 1: the reflected ray.  P (re/im) and the direction out; returns 0, or 1 at
+     * TIR when refraction was asked (P then 0). */
+    int (*prt_interface)(const double k_in[3], const double nrm[3], double n1, double n2,
+                         const trace_polar_surface *ps, double lambda, int reflect,
+                         double P[3][3][2], double k_out[3]);
 } trace_api;
 
 typedef const trace_api *(*trace_get_api_fn)(int abi);
