@@ -89,7 +89,7 @@ struct trace_scene {
 };
 
 /* tr_wt.c: adjacency and the watertight test in double (see there). */
-int    tr_wt_adjacency(tr_surf *f, uint32_t *weld);
+int    tr_wt_adjacency(tr_surf *f);
 int    tr_wt_hit(const tr_surf *f, long prim, const double o[3], const double d[3],
                  double *t);
 double tr_wt_margin(const tr_surf *f, long prim, double pad);

@@ -342,8 +342,8 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     f->eps = 1e-9 * v_norm(diag);
     uint32_t *weld = malloc((size_t)nv * sizeof *weld);
     f->closed = weld ? mesh_closed(f, weld) : -2;
-    if (f->closed == -2 || tr_wt_adjacency(f, weld)) {
-        free(weld);
+    f->weld = weld;                 /* the adjacency follows Embree's build (tr_build) */
+    if (f->closed == -2) {
         rc = fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
         goto bad;
     }
@@ -581,12 +581,14 @@ static void start_box(trace_scene *sc)
 
 /* A mesh's margin: how far a float ray may stray from the double one where it meets
  * that mesh.  As epad (embree_box), with the distance a ray travels to it bounded by
- * the diagonal of the mesh's box and where rays start (never more than epad's): a
+ * the diagonal of the mesh's box and where rays start (never more than epad's), and
+ * the coordinates that round (a ray's float origin, the mesh's float vertices, in
+ * Embree's frame) bounded by that same box's largest, not by all Embree holds: a
  * detector plane far from a small mesh no longer widens the mesh's margin, so fewer
  * hits need the double-precision test of the triangles around them (tr_wt_ring). */
 static double mesh_pad(const trace_scene *sc, const tr_surf *f)
 {
-    double lo[3], hi[3], d[3];
+    double lo[3], hi[3], d[3], m = 0;
     if (sc->sglobal) return sc->epad;
     for (int j = 0; j < 3; j++) { lo[j] = sc->slo[j]; hi[j] = sc->shi[j]; }
     for (long v = 0; v < f->nv; v++)
@@ -594,8 +596,11 @@ static double mesh_pad(const trace_scene *sc, const tr_surf *f)
             lo[j] = fmin(lo[j], f->vtx[3 * v + j]);
             hi[j] = fmax(hi[j], f->vtx[3 * v + j]);
         }
-    for (int j = 0; j < 3; j++) d[j] = hi[j] - lo[j];
-    double p = 8 * FLT_EPSILON * (sc->emag + 3 * v_norm(d)) + 1e-300;
+    for (int j = 0; j < 3; j++) {
+        d[j] = hi[j] - lo[j];
+        m = fmax(m, fmax(fabs(lo[j] - sc->eoff[j]), fabs(hi[j] - sc->eoff[j])));
+    }
+    double p = 8 * FLT_EPSILON * (fmin(m, sc->emag) + 3 * v_norm(d)) + 1e-300;
     return p < sc->epad ? p : sc->epad;
 }
 
@@ -693,6 +698,13 @@ int tr_build(trace_scene *sc, double *ms)
         drop_embree(sc);
         return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree build failed");
     }
+    /* the meshes' adjacency for the double-precision edge test, after Embree's build
+     * and its temporaries (the peak): 14 bytes a triangle less at the peak */
+    for (int i = 0; i < sc->nsurf; i++)
+        if (sc->surf[i]->is_mesh && !sc->surf[i]->vt_tri && tr_wt_adjacency(sc->surf[i])) {
+            drop_embree(sc);
+            return fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
+        }
     sc->built = 1;
     sc->build_ms = tr_now_ms() - t0;
     if (ms) *ms = sc->build_ms;
