@@ -74,6 +74,7 @@ struct trace_scene {
                                   pass rays on (not detectors, absorbers); sglobal:
                                   anywhere in the n box (a far surface or source) */
     int sglobal;
+    int wt_all;                /* LENSMAT_TRACE_EXACT: every mesh hit by tr_wt_ring */
     double eoff[3];            /* Embree's coordinates are the world's minus this (the
                                   centre of its box): a scene far from the origin keeps
                                   single precision's digits for its own size */

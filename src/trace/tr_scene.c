@@ -679,6 +679,11 @@ int tr_build(trace_scene *sc, double *ms)
     }
     embree_box(sc);
     start_box(sc);
+    /* LENSMAT_TRACE_EXACT=1: every mesh hit decided by the double-precision test of
+     * the triangles around it, no float margin trusted -- to check the margins change
+     * no bit (tests/t_64_mesh.sh) */
+    const char *ex = getenv("LENSMAT_TRACE_EXACT");
+    sc->wt_all = ex && *ex && strcmp(ex, "0") != 0;
     group_coincident(sc);
     if (sc->seq_nsurf != sc->nsurf && !sc->ngroup) tr_seq_detect(sc);
     for (int i = 0; i < sc->nsurf; i++) {
