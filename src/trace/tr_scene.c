@@ -621,8 +621,9 @@ static int in_range(const tr_surf *f)
  * direction to half an ulp of each component, over at most three times the box's
  * diagonal D (a ray starting within D of the box starts there, see tr_hit.c).
  * Every analytic surface's box grows by eight times that (a ray that meets the surface
- * in double is always offered to it); the box itself by as much again. */
-static void embree_box(trace_scene *sc)
+ * in double is always offered to it); the box itself by as much again.  centre: the
+ * frame's origin, if not the box's centre (mesh_frame). */
+static void embree_box(trace_scene *sc, const double *centre)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int i = 0; i < sc->nsurf; i++) {
@@ -643,7 +644,7 @@ static void embree_box(trace_scene *sc)
     double m = 0, d[3];
     for (int j = 0; j < 3; j++) {
         if (!(lo[j] <= hi[j])) { lo[j] = hi[j] = 0; }
-        sc->eoff[j] = lo[j] / 2 + hi[j] / 2;
+        sc->eoff[j] = centre ? centre[j] : lo[j] / 2 + hi[j] / 2;
         m = fmax(m, fmax(fabs(lo[j] - sc->eoff[j]), fabs(hi[j] - sc->eoff[j])));
         d[j] = hi[j] - lo[j];
     }
@@ -656,6 +657,33 @@ static void embree_box(trace_scene *sc)
         sc->nlo[j] = sc->elo[j] - diag;
         sc->nhi[j] = sc->ehi[j] + diag;
     }
+}
+
+/* Embree's frame centred on the meshes and where rays start, when those are all
+ * the rays' starts (not sglobal): what rounds to float where rays meet a mesh (the
+ * ray's origin, the mesh's vertices) is then as small as the meshes' own
+ * neighbourhood allows, not half of all Embree holds (a detector plane far away),
+ * and so is each mesh's margin (mesh_pad); the analytic surfaces' boxes take the
+ * larger epad that follows (their hits are solved in double either way). */
+static void mesh_frame(trace_scene *sc)
+{
+    double lo[3], hi[3], c[3];
+    int any = 0;
+    if (sc->sglobal) return;
+    for (int j = 0; j < 3; j++) { lo[j] = sc->slo[j]; hi[j] = sc->shi[j]; }
+    for (int i = 0; i < sc->nsurf; i++) {
+        const tr_surf *f = sc->surf[i];
+        if (!f->is_mesh) continue;
+        any = 1;
+        for (long v = 0; v < f->nv; v++)
+            for (int j = 0; j < 3; j++) {
+                lo[j] = fmin(lo[j], f->vtx[3 * v + j]);
+                hi[j] = fmax(hi[j], f->vtx[3 * v + j]);
+            }
+    }
+    if (!any) return;
+    for (int j = 0; j < 3; j++) c[j] = lo[j] / 2 + hi[j] / 2;
+    embree_box(sc, c);       /* the boxes only grow: start_box's answer stands */
 }
 
 int tr_build(trace_scene *sc, double *ms)
@@ -677,8 +705,9 @@ int tr_build(trace_scene *sc, double *ms)
         drop_embree(sc);
         return fail(sc, TRACE_ENOMEM, "out of memory");
     }
-    embree_box(sc);
+    embree_box(sc, NULL);
     start_box(sc);
+    mesh_frame(sc);
     /* LENSMAT_TRACE_EXACT=1: every mesh hit decided by the double-precision test of
      * the triangles around it, no float margin trusted -- to check the margins change
      * no bit (tests/t_64_mesh.sh) */
