@@ -600,7 +600,10 @@ static double mesh_pad(const trace_scene *sc, const tr_surf *f)
         d[j] = hi[j] - lo[j];
         m = fmax(m, fmax(fabs(lo[j] - sc->eoff[j]), fabs(hi[j] - sc->eoff[j])));
     }
-    double p = 8 * FLT_EPSILON * (fmin(m, sc->emag) + 3 * v_norm(d)) + 1e-300;
+    /* a ray starts in that box (not sglobal: in the box where Embree's ray starts at
+     * its own origin, tr_hit.c) and goes at most its diagonal to the mesh: one
+     * diagonal, not epad's three */
+    double p = 8 * FLT_EPSILON * (fmin(m, sc->emag) + v_norm(d)) + 1e-300;
     return p < sc->epad ? p : sc->epad;
 }
 
