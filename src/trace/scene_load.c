@@ -98,7 +98,7 @@ static int from_scene(const sc_surface *s, char *err)
  * nothing kept) and refused if that need exceeds what the system has: MemAvailable
  * (/proc/meminfo), and the address-space limit (RLIMIT_AS) less what the process
  * already maps (VmSize, /proc/self/status) against the address space it needs. */
-#define SC_MESH_BYTES_PER_TRI 200.0    /* resident (188 measured) */
+#define SC_MESH_BYTES_PER_TRI 200.0    /* resident (174 measured) */
 #define SC_MESH_BYTES_PER_VTX 48.0     /* while parsing (with the array's growth) */
 #define SC_MESH_VBYTES_PER_TRI 320.0   /* address space */
 #define SC_MESH_VBASE (192.0 * 1048576)
