@@ -1,7 +1,7 @@
 #!/bin/sh
 # tests/mesh/scenes.sh DIR -- writes the mesh scenes tests/t_64_mesh.sh traces (and
 # golden/trace/mesh.sha256 holds the sums of what they gave before the memory and
-# margin work of issue 23): a UV sphere OBJ (2 400 triangles, poles fanned) as a
+# margin work of issue 23): a UV sphere OBJ (2 320 triangles, poles fanned) as a
 # refracting ball with a detector, as a mirror, a right-angle prism with TIR, an open
 # OBJ sheet hit on every vertex and edge, a tessellated singlet behind an analytic
 # window (a mix), two threads, and a sphere far from a large detector.
