@@ -13,7 +13,9 @@
 # - a mesh that cannot fit under the address-space limit is refused before it is
 #   read: the refusal names what it needs, and the same file without the limit is
 #   read and refused for the error it holds on its last line (so the first refusal
-#   came before the reader).
+#   came before the reader); the same against the memory available
+#   (LENSMAT_MEMAVAILABLE_KB stands for MemAvailable), its need checked against the
+#   bytes a triangle and a vertex it quotes.
 
 cd "$TOP" || return 1
 MW=$WORK/mesh64
@@ -102,3 +104,20 @@ m64_limit() {
         { echo "without the limit, not the reader's error:"; cat "$wd/free.out"; return 1; }
 }
 check "mesh: a mesh that cannot fit under ulimit -v is refused before it is read, naming its need" m64_limit
+
+# the same file against the memory available: 20 MB is too little (170 bytes a triangle
+# and 32 a vertex: 180 000 x 170 + 90 601 x 32 bytes = 32 MB), 200 MB is not
+m64_avail() {
+    wd=$MW/lim
+    [ -f "$wd/big.obj" ] || { echo "no big.obj"; return 1; }
+    (cd "$wd" && printf 'scene\nbig.scene\n' | LENSMAT_MEMAVAILABLE_KB=20000 "$BIN" --trace -i /dev/stdin r3.rec > avail.out 2>&1)
+    rc=$?
+    [ $rc -eq 2 ] || { echo "exit $rc with 20 MB available"; cat "$wd/avail.out"; return 1; }
+    grep -q "big.obj: 180000 triangles need about 32 MB to trace (170 bytes a triangle and 32 a vertex, .*more than the 20 MB of memory available (MemAvailable): not read" "$wd/avail.out" ||
+        { echo "no refusal naming the need:"; cat "$wd/avail.out"; return 1; }
+    grep -q "bogus" "$wd/avail.out" && { echo "the file was read:"; cat "$wd/avail.out"; return 1; }
+    (cd "$wd" && printf 'scene\nbig.scene\n' | LENSMAT_MEMAVAILABLE_KB=200000 "$BIN" --trace -i /dev/stdin r4.rec > avail2.out 2>&1)
+    grep -q "big.obj:270602: 'bogus'" "$wd/avail2.out" ||
+        { echo "with 200 MB available, not the reader's error:"; cat "$wd/avail2.out"; return 1; }
+}
+check "mesh: a mesh that cannot fit in the memory available is refused before it is read, naming its need" m64_avail
