@@ -27,9 +27,15 @@ m64_trace() {
     sh "$TOP/tests/mesh/scenes.sh" "$2" || return 1
     for s in $M64_SCENES; do
         mkdir -p "$2/$s"; cp "$2"/*.obj "$2/$s.scene" "$2/$s/"
-        (cd "$2/$s" && printf 'scene\n%s.scene\nn\n' "$s" |
-            env ${3:-LENSMAT_M64=1} "$1" --trace -i /dev/stdin r.rec > out 2> err) ||
-            { echo "$s:"; cat "$2/$s/out" "$2/$s/err"; return 1; }
+        for try in 1 2; do
+            (cd "$2/$s" && printf 'scene\n%s.scene\nn\n' "$s" |
+                env ${3:-LENSMAT_M64=1} "$1" --trace -i /dev/stdin r.rec > out 2> err) && break
+            # LeakSanitizer's own tracer thread can crash at exit on this loaded
+            # machine ("Tracer caught signal 11", no report of ours): once more
+            grep -q "LeakSanitizer has encountered a fatal error" "$2/$s/err" &&
+                ! grep -q "ERROR: AddressSanitizer\|runtime error" "$2/$s/err" && [ $try -eq 1 ] && continue
+            echo "$s:"; cat "$2/$s/out" "$2/$s/err"; return 1
+        done
     done
 }
 
