@@ -74,6 +74,7 @@ struct trace_scene {
                                   pass rays on (not detectors, absorbers); sglobal:
                                   anywhere in the n box (a far surface or source) */
     int sglobal;
+    int wt_all;                /* LENSMAT_TRACE_EXACT: every mesh hit by tr_wt_ring */
     double eoff[3];            /* Embree's coordinates are the world's minus this (the
                                   centre of its box): a scene far from the origin keeps
                                   single precision's digits for its own size */
@@ -90,7 +91,7 @@ struct trace_scene {
 };
 
 /* tr_wt.c: adjacency and the watertight test in double (see there). */
-int    tr_wt_adjacency(tr_surf *f, uint32_t *weld);
+int    tr_wt_adjacency(tr_surf *f);
 int    tr_wt_hit(const tr_surf *f, long prim, const double o[3], const double d[3],
                  double *t);
 double tr_wt_margin(const tr_surf *f, long prim, double pad);

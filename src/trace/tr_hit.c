@@ -109,7 +109,21 @@ void tr_mesh_filter(const struct RTCFilterFunctionNArguments *a)
             if (x->xp[i] == (uint32_t)prim) { a->valid[0] = 0; return; }
     if (x->last_surf != f->id) return;
     if (prim == x->last_prim) { a->valid[0] = 0; return; }
-    if (!x->float_hits && !(tri_plane_t(f, prim, x->o, x->d) > f->eps)) a->valid[0] = 0;
+    if (x->float_hits) return;
+    if (x->sc->wt_all) goto exact;
+    /* Embree's float distance (the ray's tfar, from o + ta d) to the grown triangle's
+     * plane lies within 1.3 pad / |cos| of the double one (the float ray strays by at
+     * most pad from the double one, the grown float plane by pad / 4 from the true one
+     * over the triangle; cos between the ray and the float normal Ng): a hit clearly
+     * beyond eps is kept without reading the triangle's double vertices.  Same
+     * decisions as the test below, which takes the rest. */
+    const float *r = (const float *)a->ray, *g = (const float *)a->hit;
+    double ng = (double)g[0] * r[4] + (double)g[1] * r[5] + (double)g[2] * r[6];
+    double nn = (double)g[0] * g[0] + (double)g[1] * g[1] + (double)g[2] * g[2];
+    double tf = x->ta + r[8] - f->eps;     /* RTCRay.tfar for N = 1: the hit's */
+    if (tf > 0 && tf * tf * ng * ng > 16 * f->pad * f->pad * nn) return;
+exact:
+    if (!(tri_plane_t(f, prim, x->o, x->d) > f->eps)) a->valid[0] = 0;
 }
 
 /* A ray that went into a closed mesh must meet it again, and one that meets a closed
@@ -175,7 +189,7 @@ static void near_edge(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         long prim = rh->hit.primID, best;
         double u = rh->hit.u, v = rh->hit.v, w = 1 - u - v, t;
         double m = fmin(u, fmin(v, w));
-        if (!tr_wt_near(f, prim, m, 2 * f->pad)) return;         /* well inside */
+        if (!sc->wt_all && !tr_wt_near(f, prim, m, 2 * f->pad)) return;   /* well inside */
         if (x->xs && x->xs != f) return;   /* one mesh's edges at a time: rare enough */
         int leaving = last_surf == f->id;
         if (tr_wt_ring(f, prim, o, d, leaving ? last_prim : -1, leaving ? f->eps : 0,

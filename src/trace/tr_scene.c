@@ -343,8 +343,8 @@ int tr_add_mesh(trace_scene *sc, const trace_mesh *mesh, const trace_material *m
     f->eps = 1e-9 * v_norm(diag);
     uint32_t *weld = malloc((size_t)nv * sizeof *weld);
     f->closed = weld ? mesh_closed(f, weld) : -2;
-    if (f->closed == -2 || tr_wt_adjacency(f, weld)) {
-        free(weld);
+    f->weld = weld;                 /* the adjacency follows Embree's build (tr_build) */
+    if (f->closed == -2) {
         rc = fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
         goto bad;
     }
@@ -582,12 +582,14 @@ static void start_box(trace_scene *sc)
 
 /* A mesh's margin: how far a float ray may stray from the double one where it meets
  * that mesh.  As epad (embree_box), with the distance a ray travels to it bounded by
- * the diagonal of the mesh's box and where rays start (never more than epad's): a
+ * the diagonal of the mesh's box and where rays start (never more than epad's), and
+ * the coordinates that round (a ray's float origin, the mesh's float vertices, in
+ * Embree's frame) bounded by that same box's largest, not by all Embree holds: a
  * detector plane far from a small mesh no longer widens the mesh's margin, so fewer
  * hits need the double-precision test of the triangles around them (tr_wt_ring). */
 static double mesh_pad(const trace_scene *sc, const tr_surf *f)
 {
-    double lo[3], hi[3], d[3];
+    double lo[3], hi[3], d[3], m = 0;
     if (sc->sglobal) return sc->epad;
     for (int j = 0; j < 3; j++) { lo[j] = sc->slo[j]; hi[j] = sc->shi[j]; }
     for (long v = 0; v < f->nv; v++)
@@ -595,8 +597,14 @@ static double mesh_pad(const trace_scene *sc, const tr_surf *f)
             lo[j] = fmin(lo[j], f->vtx[3 * v + j]);
             hi[j] = fmax(hi[j], f->vtx[3 * v + j]);
         }
-    for (int j = 0; j < 3; j++) d[j] = hi[j] - lo[j];
-    double p = 8 * FLT_EPSILON * (sc->emag + 3 * v_norm(d)) + 1e-300;
+    for (int j = 0; j < 3; j++) {
+        d[j] = hi[j] - lo[j];
+        m = fmax(m, fmax(fabs(lo[j] - sc->eoff[j]), fabs(hi[j] - sc->eoff[j])));
+    }
+    /* a ray starts in that box (not sglobal: in the box where Embree's ray starts at
+     * its own origin, tr_hit.c) and goes at most its diagonal to the mesh: one
+     * diagonal, not epad's three */
+    double p = 8 * FLT_EPSILON * (fmin(m, sc->emag) + v_norm(d)) + 1e-300;
     return p < sc->epad ? p : sc->epad;
 }
 
@@ -617,8 +625,9 @@ static int in_range(const tr_surf *f)
  * direction to half an ulp of each component, over at most three times the box's
  * diagonal D (a ray starting within D of the box starts there, see tr_hit.c).
  * Every analytic surface's box grows by eight times that (a ray that meets the surface
- * in double is always offered to it); the box itself by as much again. */
-static void embree_box(trace_scene *sc)
+ * in double is always offered to it); the box itself by as much again.  centre: the
+ * frame's origin, if not the box's centre (mesh_frame). */
+static void embree_box(trace_scene *sc, const double *centre)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int i = 0; i < sc->nsurf; i++) {
@@ -639,7 +648,7 @@ static void embree_box(trace_scene *sc)
     double m = 0, d[3];
     for (int j = 0; j < 3; j++) {
         if (!(lo[j] <= hi[j])) { lo[j] = hi[j] = 0; }
-        sc->eoff[j] = lo[j] / 2 + hi[j] / 2;
+        sc->eoff[j] = centre ? centre[j] : lo[j] / 2 + hi[j] / 2;
         m = fmax(m, fmax(fabs(lo[j] - sc->eoff[j]), fabs(hi[j] - sc->eoff[j])));
         d[j] = hi[j] - lo[j];
     }
@@ -652,6 +661,33 @@ static void embree_box(trace_scene *sc)
         sc->nlo[j] = sc->elo[j] - diag;
         sc->nhi[j] = sc->ehi[j] + diag;
     }
+}
+
+/* Embree's frame centred on the meshes and where rays start, when those are all
+ * the rays' starts (not sglobal): what rounds to float where rays meet a mesh (the
+ * ray's origin, the mesh's vertices) is then as small as the meshes' own
+ * neighbourhood allows, not half of all Embree holds (a detector plane far away),
+ * and so is each mesh's margin (mesh_pad); the analytic surfaces' boxes take the
+ * larger epad that follows (their hits are solved in double either way). */
+static void mesh_frame(trace_scene *sc)
+{
+    double lo[3], hi[3], c[3];
+    int any = 0;
+    if (sc->sglobal) return;
+    for (int j = 0; j < 3; j++) { lo[j] = sc->slo[j]; hi[j] = sc->shi[j]; }
+    for (int i = 0; i < sc->nsurf; i++) {
+        const tr_surf *f = sc->surf[i];
+        if (!f->is_mesh) continue;
+        any = 1;
+        for (long v = 0; v < f->nv; v++)
+            for (int j = 0; j < 3; j++) {
+                lo[j] = fmin(lo[j], f->vtx[3 * v + j]);
+                hi[j] = fmax(hi[j], f->vtx[3 * v + j]);
+            }
+    }
+    if (!any) return;
+    for (int j = 0; j < 3; j++) c[j] = lo[j] / 2 + hi[j] / 2;
+    embree_box(sc, c);       /* the boxes only grow: start_box's answer stands */
 }
 
 int tr_build(trace_scene *sc, double *ms)
@@ -673,8 +709,14 @@ int tr_build(trace_scene *sc, double *ms)
         drop_embree(sc);
         return fail(sc, TRACE_ENOMEM, "out of memory");
     }
-    embree_box(sc);
+    embree_box(sc, NULL);
     start_box(sc);
+    mesh_frame(sc);
+    /* LENSMAT_TRACE_EXACT=1: every mesh hit decided by the double-precision test of
+     * the triangles around it, no float margin trusted -- to check the margins change
+     * no bit (tests/t_64_mesh.sh) */
+    const char *ex = getenv("LENSMAT_TRACE_EXACT");
+    sc->wt_all = ex && *ex && strcmp(ex, "0") != 0;
     group_coincident(sc);
     if (sc->seq_nsurf != sc->nsurf && !sc->ngroup) tr_seq_detect(sc);
     for (int i = 0; i < sc->nsurf; i++) {
@@ -694,6 +736,13 @@ int tr_build(trace_scene *sc, double *ms)
         drop_embree(sc);
         return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree build failed");
     }
+    /* the meshes' adjacency for the double-precision edge test, after Embree's build
+     * and its temporaries (the peak): 14 bytes a triangle less at the peak */
+    for (int i = 0; i < sc->nsurf; i++)
+        if (sc->surf[i]->is_mesh && !sc->surf[i]->vt_tri && tr_wt_adjacency(sc->surf[i])) {
+            drop_embree(sc);
+            return fail(sc, TRACE_ENOMEM, "out of memory for the mesh");
+        }
     sc->built = 1;
     sc->build_ms = tr_now_ms() - t0;
     if (ms) *ms = sc->build_ms;

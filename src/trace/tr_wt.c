@@ -10,10 +10,12 @@
 #include "tr_eng.h"
 
 /* The triangles around each welded vertex, compressed (f->vt_start, f->vt_tri): the
- * triangles of welded vertex w are vt_tri[vt_start[w] .. vt_start[w + 1]).  weld[i] is
- * the first vertex with vertex i's coordinates; it is kept.  0, or -1: out of memory. */
-int tr_wt_adjacency(tr_surf *f, uint32_t *weld)
+ * triangles of welded vertex w are vt_tri[vt_start[w] .. vt_start[w + 1]).  f->weld[i]
+ * is the first vertex with vertex i's coordinates.  Built once Embree's BVH is (see
+ * tr_build: not at the peak of Embree's build).  0, or -1: out of memory. */
+int tr_wt_adjacency(tr_surf *f)
 {
+    const uint32_t *weld = f->weld;
     size_t nv = (size_t)f->nv, n3 = (size_t)f->ntri * 3;
     uint32_t *start = calloc(nv + 1, sizeof *start), *tri = malloc(n3 * sizeof *tri);
     if (!start || !tri) { free(start); free(tri); return -1; }
@@ -25,7 +27,6 @@ int tr_wt_adjacency(tr_surf *f, uint32_t *weld)
     }
     for (size_t i = nv; i > 0; i--) start[i] = start[i - 1];
     start[0] = 0;
-    f->weld = weld;
     f->vt_start = start;
     f->vt_tri = tri;
     return 0;
