@@ -289,8 +289,9 @@ typedef struct im_centroid_opt {
     int method;                 /* enum im_centroid_method */
     double threshold;           /* detection threshold on the matched-filter SNR (the
                                    spot's integrated SNR, below); 0: the level at which
-                                   noise alone gives 0.001 false spots per frame (5.95
-                                   for 640x480 and w = 3 px; 5 would give 0.08) */
+                                   noise alone gives 1e-4 false spots per frame (6.23
+                                   for 640x480 and w = 3 px, 5.73 for 128x128; 5 would
+                                   give 0.08 and 0.004) */
     int min_pixels;             /* fewest connected pixels whose matched-filter SNR is
                                    above the threshold for a spot (0: 1, so that "none"
                                    always means best_snr <= threshold) */

@@ -305,7 +305,7 @@ static void *run_job(void *arg)
     for (int k = 0; k < j->n; k++) {
         im_spot o[2];
         im_centroid_result r;
-        j->x[k] = fa->centroid(c, j->f[k], NULL, o, 2, &r, e, sizeof e) || r.nspots != 1 ? -1 : o[0].x;
+        j->x[k] = fa->centroid(c, j->f[k], NULL, o, 2, &r, e, sizeof e) || r.nspots < 1 ? -1 : o[0].x;
     }
     fa->centroider_free(c);
     return NULL;
