@@ -751,7 +751,7 @@ int im_centroid(im_centroider *ctx, const im_frame *f, const im_centroid_opt *op
     r.nspots = nfit;
     r.outcome = ncomp > 1 ? IM_FOUND_SEVERAL : IM_FOUND_ONE;
     if (nfit > 0) {
-        r.best_snr = spots[0].snr_mf;
+        r.best_snr = spots[0].snr;
         r.best_x = spots[0].x;
         r.best_y = spots[0].y;
     } else {

@@ -174,8 +174,7 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
     o->x = px;
     o->y = py;
     o->amp = A0;
-    o->snr = A0 / in->noise;
-    o->snr_mf = in->snr_mf;
+    o->snr = in->snr_mf;       /* the detection statistic */
     if (in->edge) o->flags |= IM_SF_EDGE;
     if (!d) { o->flags |= IM_SF_FIT_FAILED | IM_SF_MOMENTS; return; }
 
@@ -287,7 +286,6 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
     o->sx = sqrt(gsl_matrix_get(ws->covar, 0, 0));
     o->sy = sqrt(gsl_matrix_get(ws->covar, 1, 1));
     o->power = A * M_PI * Wd * Wd / 2;
-    o->snr = A / in->noise;
     o->chi2 = chi * chi / (d->n - np);
     o->iter = (int)gsl_multifit_nlinear_niter(w);
     /* Cut by the edge: the 1/e^2 disc reaches beyond the frame. */

@@ -340,14 +340,15 @@ typedef struct im_spot {
     double w;                   /* 1/e^2 radius, pixels */
     double bg;                  /* local background, counts */
     double power;               /* counts above background (fit: amp*pi*w^2/2) */
-    double snr;                 /* amp / noise sigma */
+    double snr;                 /* the detection statistic, the one the threshold is
+                                   on: the matched filter's SNR T at its maximum (the
+                                   spot's integrated SNR, below); the peak pixel's is
+                                   amp / noise */
     double chi2;                /* fit: reduced chi-square (1 when the model is right) */
     int npix;                   /* connected pixels above threshold */
     int nsat;                   /* saturated pixels left out of the fit */
     int iter;                   /* fit iterations */
     int flags;                  /* enum im_spot_flags */
-    double snr_mf;              /* the detection statistic: the matched-filter SNR T at
-                                   its maximum (above) */
 } im_spot;
 
 enum im_outcome { IM_FOUND_NONE = 0, IM_FOUND_ONE = 1, IM_FOUND_SEVERAL = 2 };
