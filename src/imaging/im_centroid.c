@@ -440,12 +440,13 @@ static void screen(im_centroider *c, const im_frame *f, const mfk *k, double noi
         rows_add(a, a + W, c->trow, 2 * bw);
         bin_row(c->trow, tb4, P + (size_t)(by + M) * pw + M, bw);
     }
+    int c0 = M - Rb, cw = bw + 2 * Rb;    /* the columns the row pass reads */
     for (int by = 0; by < bh; by++) {
-        float *o = c->bcol + (size_t)by * pw;
-        const float *mid = P + (size_t)(by + M) * pw;
-        f_scal(o, mid, k->gb[0], pw);
+        float *o = c->bcol + (size_t)by * pw + c0;
+        const float *mid = P + (size_t)(by + M) * pw + c0;
+        f_scal(o, mid, k->gb[0], cw);
         for (int j = 1; j <= Rb; j++)
-            f_axpy2(o, mid - (size_t)j * pw, mid + (size_t)j * pw, k->gb[j], pw);
+            f_axpy2(o, mid - (size_t)j * pw, mid + (size_t)j * pw, k->gb[j], cw);
     }
     float norm = (float)(1 / (2 * noise * sqrt(k->gb2)));
     for (int by = 0; by < bh; by++) {

@@ -186,7 +186,7 @@ static void saturation(void)
     CHECK(md == n && ratio_d < 1.3, "the level found: all %d flagged, the wings' fit scatter "
           "%.2f x its formal sigma (not a confident one: the spots are left out downstream)",
           md, ratio_d);
-    printf("BENCH imaging_sat_flagged %d of %d\n", md, n);
+    printf("BENCH imaging_sat_flagged %.3f fraction\n", (double)md / n);
     fa->centroider_free(cz);
 }
 
