@@ -156,7 +156,7 @@ double tp_shot_gain(const tp_shot *sh)
  * residual's variance 2 E[d^2]^2 (normal residuals; E[d^2] the fitted model, so the
  * errors of the pixels at the peak, larger, count for more), times g^2.  With 2000
  * spots of peak 1000 counts over a read noise of 50 counts it is about 0.05 at
- * 1 e-/count and 0.6 at 4 (the shot noise then a tenth of the read noise). */
+ * 1 e-/count and 0.5 at 4 (the shot noise then a tenth of the read noise). */
 double tp_shot_gain_se(const tp_shot *sh)
 {
     double det = sh->s11 * sh->s22 - sh->s12 * sh->s12;
