@@ -19,6 +19,11 @@ typedef struct im_spot_in {
     int npix, peak_i;
     double peak, bg, thr, noise, gain, sat, window;
     int method, edge, plane;
+    double w_hint, a_hint;     /* the matched filter's width and amplitude estimate:
+                                  the start for a spot too faint for its pixels above
+                                  the threshold to say (npix < 3) */
+    double x_hint, y_hint;     /* and where its response peaks */
+    double snr_mf;             /* the detection statistic */
 } im_spot_in;
 
 void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *out);

@@ -174,12 +174,19 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
     o->x = px;
     o->y = py;
     o->amp = A0;
-    o->snr = A0 / in->noise;
+    o->snr = in->snr_mf;       /* the detection statistic */
     if (in->edge) o->flags |= IM_SF_EDGE;
     if (!d) { o->flags |= IM_SF_FIT_FAILED | IM_SF_MOMENTS; return; }
 
-    /* Width from the area above threshold: pi r_T^2 = npix, r_T^2 = (w^2/2) ln(A/T). */
-    if (A0 > 1.05 * T && T > 0) w0 = sqrt(2 * in->npix / (M_PI * log(A0 / T)));
+    /* Width from the area above threshold: pi r_T^2 = npix, r_T^2 = (w^2/2) ln(A/T);
+     * a spot with fewer than 3 pixels above it (found by its integrated SNR, its
+     * peak hidden in the noise) starts from the matched filter's width and
+     * amplitude instead. */
+    int faint = in->npix < 3 && in->w_hint > 0;
+    if (faint) {
+        w0 = in->w_hint;
+        if (in->a_hint > 0) A0 = in->a_hint;
+    } else if (A0 > 1.05 * T && T > 0) w0 = sqrt(2 * in->npix / (M_PI * log(A0 / T)));
     else w0 = sqrt(in->npix / M_PI);
     if (!(w0 >= 0.7)) w0 = 0.7;
     if (w0 > 20) w0 = 20;
@@ -224,7 +231,8 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
         double v = f->px[p] - in->bg;
         s += v; sx += v * (p % W); sy += v * (p / W);
     }
-    double start[MAXPAR] = {s > 0 ? sx / s : px, s > 0 ? sy / s : py,
+    if (faint || !(s > 0)) { s = 1; sx = faint ? in->x_hint : px; sy = faint ? in->y_hint : py; }
+    double start[MAXPAR] = {sx / s, sy / s,
                             o->nsat ? 2 * A0 : A0, w0, in->bg, 0, 0};
     int np = in->plane ? MAXPAR : NPAR;
     d->np = np;
@@ -278,7 +286,6 @@ void im_spot_locate(im_fit_ws *ws, const im_spot_in *in, im_spot *o)
     o->sx = sqrt(gsl_matrix_get(ws->covar, 0, 0));
     o->sy = sqrt(gsl_matrix_get(ws->covar, 1, 1));
     o->power = A * M_PI * Wd * Wd / 2;
-    o->snr = A / in->noise;
     o->chi2 = chi * chi / (d->n - np);
     o->iter = (int)gsl_multifit_nlinear_niter(w);
     /* Cut by the edge: the 1/e^2 disc reaches beyond the frame. */

@@ -68,6 +68,7 @@ im_centroider *im_centroider_new(void);
 void im_centroider_free(im_centroider *c);
 int im_centroid(im_centroider *c, const im_frame *f, const im_centroid_opt *opt,
                 im_spot *spots, int cap, im_centroid_result *res, char *err, size_t errcap);
+double im_false_alarm_threshold(int width, int height, double w, double pfa);
 
 #ifdef __cplusplus
 }

@@ -287,24 +287,47 @@ enum im_centroid_method {
 };
 typedef struct im_centroid_opt {
     int method;                 /* enum im_centroid_method */
-    double threshold;           /* detection threshold, noise sigmas above the local
-                                   background (0: 5) */
-    int min_pixels;             /* fewest connected pixels above it for a spot (0: 3) */
+    double threshold;           /* detection threshold on the matched-filter SNR (the
+                                   spot's integrated SNR, below); 0: the level at which
+                                   noise alone gives 1e-4 false spots per frame (6.23
+                                   for 640x480 and w = 3 px, 5.73 for 128x128; 5 would
+                                   give 0.08 and 0.004) */
+    int min_pixels;             /* fewest connected pixels whose matched-filter SNR is
+                                   above the threshold for a spot (0: 1, so that "none"
+                                   always means best_snr <= threshold) */
     int max_spots;              /* detected spots beyond this are counted, not fitted
                                    (0: 16) */
-    double saturation;          /* counts at or above which a pixel is saturated
-                                   (0: 2^bits - 1) */
+    double saturation;          /* counts at or above which a pixel is saturated (the
+                                   camera's level: full well / gain + bias, or its ADC's
+                                   2^b - 1 when b < bits, e.g. 12-bit data in a 16-bit
+                                   PNG); 0: 2^bits - 1, or a lower level found in the
+                                   frame itself (a pile-up, im_centroid_result) */
     double gain;                /* electrons per count for the shot-noise part of the
                                    noise model (0: additive noise only) */
     double read_noise;          /* noise sigma in counts (0: measured from the frame) */
     double window;              /* fit window half-width in pixels (0: 2w+1, 3..25) */
     int plane;                  /* 1: fit the background as a tilted plane (a steep
                                    gradient under the spot), 0: a constant */
+    double spot_w;              /* the expected spot's 1/e^2 radius (pixels) the
+                                   matched filter is made for (0: 3; 0.5 .. 12) */
 } im_centroid_opt;
+/* Detection.  A spot is found where the matched filter for the expected spot
+ *     T(p) = sum_i (g_i - gbar) v_i / (sigma sqrt(sum_i (g_i - gbar)^2)),
+ *     g_i = exp(-2 |i - p|^2 / spot_w^2) over the square of half-width ceil(2 spot_w)
+ * about pixel p (clipped to the frame; gbar its mean, so a constant or linear
+ * background gives 0) is a local maximum above the threshold: T is the spot's
+ * integrated SNR with the background unknown, N(0, 1) on noise alone, and for a spot
+ * of peak A centred on p its mean is (A / sigma) sqrt(sum_i (g_i - gbar)^2) (2.43 A/sigma
+ * for w = 3 px, against 1 A/sigma for its brightest pixel).  T is evaluated exactly
+ * where a cheap screen (the same filter on 2x2-binned pixels, at threshold - 2) points,
+ * and over the connected region where it stays above the threshold. */
 
 enum im_spot_flags {
     IM_SF_SEVERAL   = 1,        /* one of several spots in the frame */
-    IM_SF_SATURATED = 2,        /* saturated pixels left out: fitted from the wings */
+    IM_SF_SATURATED = 2,        /* saturated pixels left out: fitted from the wings;
+                                   its sx, sy are the wings' formal ones and hold only
+                                   as far as the spot is the Gaussian the fit assumes:
+                                   not a confident uncertainty */
     IM_SF_EDGE      = 4,        /* cut by the frame edge (window or 1/e^2 disc) */
     IM_SF_FIT_FAILED = 8,       /* the fit did not converge: moments given instead */
     IM_SF_MOMENTS   = 16        /* located by moments (method or fallback) */
@@ -317,7 +340,10 @@ typedef struct im_spot {
     double w;                   /* 1/e^2 radius, pixels */
     double bg;                  /* local background, counts */
     double power;               /* counts above background (fit: amp*pi*w^2/2) */
-    double snr;                 /* amp / noise sigma */
+    double snr;                 /* the detection statistic, the one the threshold is
+                                   on: the matched filter's SNR T at its maximum (the
+                                   spot's integrated SNR, below); the peak pixel's is
+                                   amp / noise */
     double chi2;                /* fit: reduced chi-square (1 when the model is right) */
     int npix;                   /* connected pixels above threshold */
     int nsat;                   /* saturated pixels left out of the fit */
@@ -332,10 +358,24 @@ typedef struct im_centroid_result {
     int ndetected;              /* spots detected (may exceed nspots) */
     double background;          /* median background, counts */
     double noise;               /* noise sigma used, counts */
-    double best_snr;            /* NONE: the best candidate's (peak - bg)/noise, below
+    double best_snr;            /* the detection statistic (matched-filter SNR T):
+                                   NONE: the best candidate's, at or below the
                                    threshold; otherwise the brightest spot's */
     double best_x, best_y;      /* where that candidate or spot is (pixels) */
+    double saturation;          /* the saturation level used (counts) */
+    double threshold;           /* the detection threshold used */
+    int sat_source;             /* enum im_sat_source: where that level came from */
 } im_centroid_result;
+enum im_sat_source {
+    IM_SAT_FULL_SCALE = 0,      /* 2^bits - 1 */
+    IM_SAT_GIVEN,               /* opt->saturation */
+    IM_SAT_PILEUP               /* found in the frame: its brightest value held by
+                                   several pixels with none just below (a clipped
+                                   plateau: at least 5 such pixels and more than twice
+                                   those in the band below, or 2 at an ADC's full scale
+                                   2^b - 1 or its MSB-aligned (2^b - 1) << (16 - b),
+                                   b = 8, 10, 12, 14, below the file's) */
+};
 
 /* Scratch kept between frames (about 100 kB plus a byte per pixel); one per thread:
  * calls with different centroiders may run at the same time. */

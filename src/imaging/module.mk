@@ -104,5 +104,9 @@ MODULE_TEST_BINS  += build/lib/lensmat-imaging.so build/asan/lib/lensmat-imaging
                      build/lib/lensmat-camera.so build/asan/lib/lensmat-camera.so \
                      build/fuzz_frame $(IM_TBIN) build/obj/imaging_tests/bench_load \
                      build/obj/imaging_tests/bench_centroid
-MODULE_BENCH_BINS += build/lib/lensmat-imaging.so build/lib/lensmat-camera.so $(IM_BBIN)
+MODULE_BENCH_BINS += build/lib/lensmat-imaging.so build/lib/lensmat-camera.so $(IM_BBIN) \
+                     build/obj/imaging_tests/t_front
 -include $(IM_OBJ:.o=.d) $(IM_SOBJ:.o=.d)
+# t_front compiles the topography pipeline's photon transfer (src/topo/tp_shot.c) in.
+build/obj/imaging_tests/t_front build/asan/imaging_tests/t_front: src/topo/tp_shot.c \
+    src/topo/tp_int.h src/topo/topo.h

@@ -36,8 +36,10 @@ typedef struct tp_camera {
     double read_noise;          /* counts rms (50) */
 } tp_camera;
 
-typedef struct tp_shot { double s11, s12, s22, s1y, s2y; int n; } tp_shot;   /* photon
-                                   transfer: the normal equations' sums */
+typedef struct tp_shot { double s11, s12, s22, s1y, s2y; int n;
+                         double q[5]; } tp_shot;   /* photon transfer: the normal
+                                   equations' sums and the 4th moments of the
+                                   regressors (the estimate's error) */
 
 typedef struct tp_point {
     rg_target t;

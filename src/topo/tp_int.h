@@ -13,5 +13,6 @@ struct im_frame;
 void tp_shot_add(tp_shot *sh, const struct im_frame *f, double x, double y, double amp,
                  double w, double bg, double noise);
 double tp_shot_gain(const tp_shot *sh);         /* e-/count; INFINITY: none; NaN: too few */
+double tp_shot_gain_se(const tp_shot *sh);      /* its standard error (NaN: none) */
 double tp_shot_factor(double amp, double w, double noise, double gain);
 #endif

@@ -113,6 +113,8 @@ static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double
     o.method = IM_CM_GAUSS;
     o.read_noise = read_noise;
     o.gain = gain;                      /* shot noise in each pixel's variance */
+    o.spot_w = r->cam.spot_w >= 0.5 && r->cam.spot_w <= 12 ? r->cam.spot_w : 0;
+                                        /* the matched filter's expected spot */
     q->spot.u = q->spot.v = NAN;
     int rc = F->centroid(cz, f, &o, sp, 4, &res, e, sizeof e);
     q->nspots = rc ? 0 : res.ndetected;
@@ -121,7 +123,8 @@ static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double
         q->spot.status = CN_S_NONE;
         if (rc) snprintf(q->why, sizeof q->why, "no centroid: %.70s", e);
         else if (off_sensor) snprintf(q->why, sizeof q->why, "no spot: it lands off the sensor");
-        else snprintf(q->why, sizeof q->why, "no spot (best candidate SNR %.3g)", res.best_snr);
+        else snprintf(q->why, sizeof q->why, "no spot (best candidate SNR %.3g, threshold %.3g)",
+                      res.best_snr, res.threshold);
         return;
     }
     q->x = sp[0].x;
