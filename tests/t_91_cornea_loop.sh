@@ -135,7 +135,14 @@ cl_term() {
         "$RIGGOLD" > "$CL/k.in"
     (cd "$CL" && exec "$BIN" --cornea-scan -i k.in k.rec > k.out 2> k.err) &
     p=$!
-    sleep 0.7
+    # the signal once the laser has fired (the log, still under its temporary name,
+    # shows it), not after a fixed time: on a busy machine planning can outlast any
+    # fixed wait, and on a quiet one the scan can get far
+    i=0
+    while [ $i -lt 1200 ] && kill -0 "$p" 2>/dev/null &&
+          ! grep -qs ' laser 1' "$CL"/k.log.part.*; do
+        sleep 0.1; i=$((i + 1))
+    done
     kill -TERM "$p"
     wait "$p"
     rc=$?
