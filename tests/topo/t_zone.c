@@ -227,11 +227,6 @@ int main(int argc, char **argv)
                    r->have_z ? r->zf->order : 0, r->have_z ? r->zf->chi2_dof : NAN,
                    r->have_z ? r->zf->rho : NAN, r->have_z ? "" : ": ", r->zwhy);
         }
-        if (getenv("ZDBG")) for (int k = 0; k < r->npoints; k++) if (r->pt[k].planned && r->pt[k].spot.status == CN_S_MISS) {
-            const cn_ray *ry = &r->pt[k].spot.ray; double u, v, sp3[3];
-            int fr = cn->forward(CN_BICONIC, &r->res.par, a0, &plane, ry, &u, &v, sp3, NULL);
-            printf("DBG h %.3f phi %.1f o %.2f %.2f %.2f d %.4f %.4f %.4f fwd %d hit %.3f %.3f\n", r->pt[k].t.a, r->pt[k].t.b/CT_DEG, ry->o[0], ry->o[1], ry->o[2], ry->d[0], ry->d[1], ry->d[2], fr, r->pt[k].hit_u, r->pt[k].hit_v);
-            break; }
         const tp_cover *c = &r->cover;
         printf("#   coverage 0-3 %.3f (%d spots), 3-6 %.3f (%d), 6-9 %.3f (%d), 9-10 %.3f (%d); "
                "zone %.1f mm, %d lost off the sensor\n", c->frac[0], c->nspots[0], c->frac[1],
