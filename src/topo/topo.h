@@ -208,7 +208,7 @@ typedef struct topo_api {
 
 typedef struct tp_truth { const rig_api *rg; const rg_cornea *c; const cn_bump *bump; } tp_truth;
 
-#define TOPO_ABI 1
+#define TOPO_ABI 2            /* 2: tp_run grew the zone fields, topo_api measure_zone, iso */
 #define TOPO_API_SYMBOL "topo_get_api"
 typedef const topo_api *(*topo_get_api_fn)(int abi);
 const topo_api *topo_get_api(int abi);
