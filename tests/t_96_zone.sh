@@ -40,3 +40,16 @@ tz_replay() {
     sed 's/z65b/z65/g' "$ZN/z2.rec" | cmp - "$ZN/z.rec"
 }
 check "--cornea-scan zone pattern: the record replays to the same bytes" tz_replay
+# The zone pattern on the simulated chip: every pass moved and exposed, the record's
+# dose counting the exposures of all passes (the coarse ones' planned points and the
+# scan's), checked against the MPE before the first pulse
+tz_sim() {
+    printf 'biconic\n%s\nsim\n-\n2\nzone\n60\n8\nmodel\n7.8\n0\n0\n0\n0\n0\n0\n0\n0.04\n3.45\n1\n0\n-\n' \
+        "$TOP/golden/rig/wide-zone.rig" > "$ZN/s.in"
+    (cd "$ZN" && "$BIN" --cornea-scan -i s.in s.rec > s.out 2> s.err) || { cat "$ZN/s.err"; return 1; }
+    awk '/^Zone pass/ { n += $12 + 0 }
+         /^Pattern zone/ { for (i = 1; i < NF; i++) if ($(i + 1) ~ /^exposed/) e = $i; n += e }
+         /^Dose:/ { d = $2 + 0 }
+         END { print "passes planned/exposed", n, "dose counts", d; exit !(n > 60 && d == n) }' "$ZN/s.rec"
+}
+check "--cornea-scan zone pattern on the simulated chip: the dose counts every pass's exposures" tz_sim
