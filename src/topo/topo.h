@@ -193,7 +193,7 @@ typedef struct topo_api {
      * unplanned. */
     void (*counts)(const tp_run *r, int counts[6]);
     /* --- the clinical zone and the ISO 19980 report (issue 19 items 4, 5) --- */
-    /* The measurement planned adaptively (tp_adapt.c): coarse passes (1.5 mm, then
+    /* The measurement planned adaptively (tp_adapt.c): coarse passes (1.2 mm, then
      * 3 mm from the axis, npoints / 6 each, planned on the nominal cornea, then on
      * each pass's biconic fit), then the scan of npoints out to zone_h planned on the
      * last fit, and its coverage per zone (r->cover, with r->zf).  As measure. */

@@ -1,7 +1,7 @@
 /* tp_adapt.c -- the clinical zone (issue 19 item 4): a measurement planned for the eye
  * it finds.  A plain scan solves every pose on the rig's nominal cornea (R 7.8), so on
  * a 6.5 mm sphere the outer reflections miss the sensor (102 of 300 spots lost on the
- * example rig).  Here coarse passes, out to 1.5 mm and then 3 mm from the axis, are
+ * example rig).  Here coarse passes, out to 1.2 mm and then 3 mm from the axis, are
  * fitted (a sphere, then a biconic: it carries the cylinder and the eye's pose), each
  * pass planned on the fit before it, and the scan asked for is planned on the last
  * fit: its beams then meet the eye found where the targets lie and reflect onto the
