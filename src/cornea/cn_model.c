@@ -136,13 +136,25 @@ int cn_forward_bump(int model, const cn_params *p, const cn_bump *bump,
     /* Newton on g(t) = sag(o + t d) - z(o + t d) from the apex tangent plane */
     double t = -o[2] / d[2], z = 0, zx = 0, zy = 0;
     int ok = 0;
+    if (sag(&s, o[0] + t * d[0], o[1] + t * d[1], &z, &zx, &zy)) {
+        /* a beam steep to the axis (a wide zone: up to 85 deg) crosses the apex plane
+           past the surface's edge; start where it passes closest to the axis, inside
+           the cornea if the beam meets it (Newton then walks back to the front) */
+        double dl = d[0] * d[0] + d[1] * d[1];
+        if (dl > 0) t = -(o[0] * d[0] + o[1] * d[1]) / dl;
+    }
     for (int it = 0; it < 40; it++) {
         double x = o[0] + t * d[0], y = o[1] + t * d[1];
         if (sag(&s, x, y, &z, &zx, &zy)) return CN_EFIT;
         double gv = z - (o[2] + t * d[2]);
         double gd = zx * d[0] + zy * d[1] - d[2];
         if (gd >= 0) return CN_EFIT;       /* grazing or from behind */
-        double dt = gv / gd;
+        double dt = gv / gd, z2, zx2, zy2;
+        /* a step past the surface's edge (from the closest-approach start) is
+           halved until it lands on the surface */
+        for (int h = 0; h < 40 && sag(&s, o[0] + (t - dt) * d[0], o[1] + (t - dt) * d[1],
+                                      &z2, &zx2, &zy2); h++)
+            dt *= 0.5;
         t -= dt;
         if (fabs(dt) < 1e-14 * (1 + fabs(t))) { ok = 1; break; }
     }

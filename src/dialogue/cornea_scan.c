@@ -63,6 +63,8 @@ typedef struct cs {
     char *text;                 /* the report as said, for NAME.txt */
     cn_kc kt;                   /* the true surface's indices (tk 1) */
     int tk;
+    tp_iso iso;                 /* the zone pattern on a synthetic eye (have_iso 1) */
+    int have_iso;
     size_t len, cap;
 } cs;
 
@@ -208,6 +210,8 @@ static int max_iter_env(void)
 static int run(cs *s, tp_run *r, rg_machine **m);
 static int scan_end(cs *s, const tp_run *r, int rc);
 static void say_surface(cs *s, tp_run *r);
+static void say_passes(cs *s, const tp_run *r);
+static void say_zone(cs *s, tp_run *r);
 
 /* What the report adds beside the engine's numbers: the scan's settings and, for a
  * synthetic eye, its truth and the errors. */
@@ -282,10 +286,26 @@ static int cs_files(cs *s, const tp_run *r, int maps, const cs_truth *tr)
         {"true_KISA", tk ? kt.kisa : NAN, NAN, "%"},
     };
     int nz = !r->have_z ? 0 : tk ? (int)(sizeof zrows / sizeof *zrows) : 15;
-    cs_row *all = malloc(sizeof *all * (size_t)(nrows + nz));
+    /* the zone pattern: its coverage per zone and the ISO 19980 figures */
+    const tp_cover *cv = &r->cover;
+    const tp_iso_zone *iz = s->iso.z;
+#define ISO_ROWS(k, nm) {"iso_" nm "_mean", iz[k].mean_um, NAN, "um"}, \
+        {"iso_" nm "_2sd", iz[k].sd2_um, NAN, "um"}, {"iso_" nm "_mean_D", iz[k].mean_D, NAN, "D"}, \
+        {"iso_" nm "_2sd_D", iz[k].sd2_D, NAN, "D"}
+    const cs_row crows[] = {
+        {"zone_mm", cv->zone_mm, NAN, "mm"}, {"cover_0_3", cv->frac[0], NAN, ""},
+        {"cover_3_6", cv->frac[1], NAN, ""}, {"cover_6_9", cv->frac[2], NAN, ""},
+        {"cover_9_10", cv->frac[3], NAN, ""},
+        ISO_ROWS(0, "0_3"), ISO_ROWS(1, "3_6"), ISO_ROWS(2, "6_9"), ISO_ROWS(3, "0_6"),
+    };
+#undef ISO_ROWS
+    int nc = !cv->valid ? 0 : s->have_iso ? (int)(sizeof crows / sizeof *crows) : 5;
+    cs_row *all = malloc(sizeof *all * (size_t)(nrows + nz + nc));
     if (!all) { free(sp); return calc_fail(&s->cc, CS(NO_MEMORY)); }
     memcpy(all, rows, sizeof *all * (size_t)nrows);
     memcpy(all + nrows, zrows, sizeof *all * (size_t)nz);
+    memcpy(all + nrows + nz, crows, sizeof *all * (size_t)nc);
+    nz += nc;
     if (maps && cs_write_maps(cn, r->g, s->report, &r->res, sp, n, r->have_z ? r->zf : NULL,
                               &r->kc, stop_cb, say_line, s, msg, sizeof msg)) {
         rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
@@ -310,7 +330,7 @@ int lm_cornea_scan(lm_io *io)
 {
     static const char *const models[] = {"sphere", "conic", "biconic", "asphere", NULL};
     static const char *const chips[] = {"none", "sim", "gpiod", NULL};
-    static const char *const patterns[] = {"spiral", "rings", "grid", NULL};
+    static const char *const patterns[] = {"spiral", "rings", "grid", "zone", NULL};
     static const char *const sources[] = {"frames", "model", "camera", NULL};
     cs *s = calloc(1, sizeof *s);
     tp_run *r = calloc(1, sizeof *r);
@@ -349,10 +369,21 @@ int lm_cornea_scan(lm_io *io)
             goto out;
     }
     if ((rc = calc_choice(c, CS(PATTERN), CS(PATTERN_WHAT), patterns, &pattern)) ||
-        (rc = ranged(c, CS(POINTS), CS(POINTS_WHAT), CS(POINTS_RANGE), 10, 10000, 1, &np)) ||
-        (rc = ranged(c, CS(ZONE), CS(ZONE_WHAT), CS(ZONE_RANGE), 0.5, 12, 0, &zone)) ||
-        (rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source)))
+        (rc = ranged(c, CS(POINTS), CS(POINTS_WHAT), CS(POINTS_RANGE), 10, 10000, 1, &np)))
         goto out;
+    double zone_mm = 0;                /* the zone pattern: its diameter (mm) */
+    if (pattern == 3) {
+        if ((rc = ranged(c, CS(ZONE_MM), CS(ZONE_MM_WHAT), CS(ZONE_MM_RANGE), 2, 12, 0,
+                         &zone_mm)))
+            goto out;
+        zone = 0;
+    } else if ((rc = ranged(c, CS(ZONE), CS(ZONE_WHAT), CS(ZONE_RANGE), 0.5, 12, 0, &zone)))
+        goto out;
+    if ((rc = calc_choice(c, CS(SOURCE), CS(SOURCE_WHAT), sources, &source))) goto out;
+    if (source == TP_SRC_CAMERA && pattern == 3) {
+        rc = calc_fail(c, CS(ZONE_CAMERA));
+        goto out;
+    }
     if (source == TP_SRC_CAMERA &&
         (rc = lm_ask_file(io, CS(CAMERA), CS(CAMERA), CS(CAMERA_WHAT), NULL, NULL, s->camera,
                           sizeof s->camera)))
@@ -424,9 +455,11 @@ int lm_cornea_scan(lm_io *io)
     }
     r->camera = source == TP_SRC_CAMERA ? s->camera : NULL;
     r->save = source == TP_SRC_FRAMES && s->save[0] && strcmp(s->save, "-") ? s->save : NULL;
-    r->pattern = pattern;
+    r->pattern = pattern == 3 ? TP_SPIRAL : pattern;
     r->npoints = (int)np;
     r->zone = zone * DEG;
+    r->zone_h = zone_mm / 2;           /* > 0: measure_zone */
+    r->sensor_cut = zone_mm > 0;       /* its quick model loses spots off the sensor */
     r->source = source;
     r->sigma = noise * pitch * 1e-3;
     r->cam = (tp_camera){(int)w, (int)h, pitch * 1e-3, 3, 1000, 100, 50};
@@ -599,6 +632,45 @@ static void say_surface(cs *s, tp_run *r)
         say(s, "%s", CS(TOPO_SCREEN_NORMAL));
 }
 
+/* The zone pattern's passes: each coarse one with the fit the next was planned on. */
+static void say_passes(cs *s, const tp_run *r)
+{
+    for (int p = 0; p + 1 < r->npass; p++) {
+        const tp_pass *q = &r->pass[p];
+        char fit[200] = "";
+        if (isfinite(q->R))
+            snprintf(fit, sizeof fit, CS(ZONE_PASS_FIT), q->R, q->Km, q->cyl,
+                     q->used ? "" : CS(ZONE_PASS_UNUSED));
+        say(s, CS(ZONE_PASS), p + 1, q->npoints, q->zone_h, q->nplanned, q->nok, fit);
+    }
+    int fitted = 0;
+    for (int p = 0; p + 1 < r->npass; p++) fitted |= r->pass[p].used;
+    say(s, CS(ZONE_PLANNED), r->npoints, r->zone_h, 2 * r->zone_h,
+        fitted ? "last pass's fit" : "nominal cornea", r->nplanned, r->nexposed);
+}
+
+/* The zone pattern: the coverage per zone and, on a synthetic eye, the ISO 19980
+ * statistics against its true surface (kept for the report's rows). */
+static void say_zone(cs *s, tp_run *r)
+{
+    static const char *const zn[TP_ISO_NZONE] = {"0-3", "3-6", "6-9", "0-6"};
+    const tp_cover *c = &r->cover;
+    if (!c->valid) { say(s, "%s", CS(ZONE_COVER_NONE)); return; }
+    say(s, CS(ZONE_COVER), 100 * c->frac[0], c->nspots[0], 100 * c->frac[1], c->nspots[1],
+        100 * c->frac[2], c->nspots[2], 100 * c->frac[3], c->nspots[3], c->zone_mm);
+    tp_truth tt = {r->rg, &r->truth, r->bump};
+    s->have_iso = r->have_truth && r->have_z &&
+                  !s->tp->iso(r, s->tp->truth_sag, &tt, &r->truth, &s->iso);
+    if (!s->have_iso) return;
+    say(s, "%s", CS(ISO_HEAD));
+    for (int k = 0; k < TP_ISO_NZONE; k++) {
+        const tp_iso_zone *q = &s->iso.z[k];
+        if (!q->n) say(s, CS(ISO_EMPTY), zn[k]);
+        else say(s, CS(ISO_ZONE), zn[k], 100 * q->frac, q->mean_um, q->sd2_um, q->mean_D,
+                 q->sd2_D);
+    }
+}
+
 /* The measurement and its report. */
 static int run(cs *s, tp_run *r, rg_machine **m)
 {
@@ -607,7 +679,8 @@ static int run(cs *s, tp_run *r, rg_machine **m)
     const cornea_api *cn = r->cn;
     char err[256];
     static char buf[8192];
-    int rc = s->tp->measure(r, err, sizeof err);
+    int rc = r->zone_h > 0 ? s->tp->measure_zone(r, err, sizeof err)
+                           : s->tp->measure(r, err, sizeof err);
     int counts[6];
     s->tp->counts(r, counts);
     if (rc == CN_ESTOP || lm_stop_requested()) return LM_FAIL;
@@ -617,7 +690,9 @@ static int run(cs *s, tp_run *r, rg_machine **m)
         fprintf(stderr, "lensmat: %s\n", err);
         return LM_FAIL;
     }
-    say(s, CS(PLANNED), pname[r->pattern], r->npoints, r->zone / DEG, r->nplanned, r->nexposed);
+    if (r->zone_h > 0) say_passes(s, r);
+    else say(s, CS(PLANNED), pname[r->pattern], r->npoints, r->zone / DEG, r->nplanned,
+             r->nexposed);
     double ssum = 0;
     int sn = 0;
     for (int k = 0; k < r->npoints; k++)
@@ -650,9 +725,11 @@ static int run(cs *s, tp_run *r, rg_machine **m)
     for (int k = 0; k < r->npoints; k++) {
         const tp_point *q = &r->pt[k];
         if (q->planned && q->spot.status == CN_S_OK) continue;
-        say(s, CS(REJECTED), k + 1, q->t.a / DEG, q->t.b / DEG, q->why);
+        if (r->zone_h > 0) say(s, CS(REJECTED_H), k + 1, q->t.a, q->t.b / DEG, q->why);
+        else say(s, CS(REJECTED), k + 1, q->t.a / DEG, q->t.b / DEG, q->why);
     }
     say_surface(s, r);
+    if (r->zone_h > 0) say_zone(s, r);
     if (r->tr)
         say(s, CS(CHECK), r->check_n, r->check_max * 1e3, r->check_tol * 1e3,
             r->check_max <= r->check_tol ? CS(CHECK_OK) : CS(CHECK_BAD));

@@ -32,14 +32,18 @@ TP_TESTS := $(wildcard tests/topo/t_*.c)
 TP_TBIN  := $(patsubst tests/topo/%.c,build/obj/topo_tests/%,$(TP_TESTS)) \
             $(patsubst tests/topo/%.c,build/asan/topo_tests/%,$(TP_TESTS))
 build/obj/topo_tests/%: tests/topo/%.c build/lib/lensmat-cornea.so build/lib/lensmat-rig.so \
-                        build/lib/lensmat-trace.so src/cornea/cornea.h src/rig/rig.h tests/cornea/ct.h
+                        build/lib/lensmat-trace.so build/lib/lensmat-topo.so src/cornea/cornea.h \
+                        src/rig/rig.h src/topo/topo.h tests/cornea/ct.h
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(OPT) -Itests -o $@ $< build/lib/lensmat-cornea.so \
-	    build/lib/lensmat-rig.so build/lib/lensmat-trace.so -Wl,-rpath,$(abspath build/lib) -lm
+	    build/lib/lensmat-rig.so build/lib/lensmat-trace.so build/lib/lensmat-topo.so \
+	    -Wl,-rpath,$(abspath build/lib) -lm
 build/asan/topo_tests/%: tests/topo/%.c build/asan/lib/lensmat-cornea.so build/asan/lib/lensmat-rig.so \
-                         build/asan/lib/lensmat-trace.so src/cornea/cornea.h src/rig/rig.h tests/cornea/ct.h
+                         build/asan/lib/lensmat-trace.so build/asan/lib/lensmat-topo.so \
+                         src/cornea/cornea.h src/rig/rig.h src/topo/topo.h tests/cornea/ct.h
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(SAN) -Itests -o $@ $< build/asan/lib/lensmat-cornea.so \
-	    build/asan/lib/lensmat-rig.so build/asan/lib/lensmat-trace.so -Wl,-rpath,$(abspath build/asan/lib) -lm
+	    build/asan/lib/lensmat-rig.so build/asan/lib/lensmat-trace.so build/asan/lib/lensmat-topo.so \
+	    -Wl,-rpath,$(abspath build/asan/lib) -lm
 MODULE_TEST_BINS  += $(TP_TBIN)
-MODULE_BENCH_BINS += build/obj/topo_tests/t_topo
+MODULE_BENCH_BINS += build/obj/topo_tests/t_topo build/obj/topo_tests/t_zone

@@ -59,6 +59,43 @@ typedef struct tp_point {
     int saved;                  /* 1: its frame was written (r->save) */
 } tp_point;
 
+/* The clinical zone (issue 19 item 4): the adaptive passes and the coverage of the
+ * final one by zone, diameters 0-3, 3-6, 6-9 and 9-10 mm about the reference's axis. */
+#define TP_MAXPASS 4
+#define TP_NZONE 4
+typedef struct tp_pass {
+    double zone_h;              /* mm, the targets' largest height */
+    int npoints, nplanned, nok; /* targets; planned; spots located */
+    double R, Km, cyl;          /* its fit (mm, D; NaN: none; the final pass: NaN) */
+    int used;                   /* 1: the next pass was planned on that fit (else on
+                                   the plan before) */
+} tp_pass;
+typedef struct tp_cover {
+    int valid;                  /* 1: computed (a surface from the data) */
+    double frac[TP_NZONE];      /* fraction of each zone's area within the data */
+    int nspots[TP_NZONE];       /* spots fitted in each zone */
+    double zone_mm;             /* the largest diameter whose every ring (0.1 mm steps)
+                                   is >= 95 % within the data */
+} tp_cover;
+extern const double tp_zone_edges[TP_NZONE + 1];   /* 0 3 6 9 10 mm diameter */
+
+/* The ISO 19980 report of a test surface (tp_iso.c, issue 19 item 5): the measured
+ * surface against the true one on a 0.1 mm grid, the points within the data, area
+ * weighted, per zone 0-3, 3-6, 6-9 mm diameter and the central 6 mm: the mean and
+ * twice the SD of the height difference (um, measured - true, toward the observer,
+ * both from their vertex) and of the axial power difference (D, n 1.3375, both about
+ * the measured surface's axis). */
+#define TP_ISO_NZONE 4          /* 0-3, 3-6, 6-9, 0-6 */
+typedef struct tp_iso_zone {
+    int n;                      /* grid points within the data (0: none: NaN below) */
+    double frac;                /* of the zone's area */
+    double mean_um, sd2_um, mean_D, sd2_D;
+} tp_iso_zone;
+typedef struct tp_iso { tp_iso_zone z[TP_ISO_NZONE]; } tp_iso;
+/* The true surface for the report: its sag z(x, y) in its own eye frame (mm, into the
+ * eye; 0, or -1 off the surface), placed in the rig by place->rot and place->trans. */
+typedef int (*tp_sag_fn)(void *ctx, double x, double y, double *z);
+
 typedef struct tp_times {       /* seconds of wall clock, per part */
     double plan, machine, trace, frames, fit, check, total;
     double cpu;                 /* the process's CPU seconds over the whole loop */
@@ -126,6 +163,21 @@ typedef struct tp_run {
     int have_dose;
     const char *phase;          /* the part of the loop running (or where it stopped):
                                    "planning", "the scan on the machine", ... */
+    /* --- the clinical zone (tp_adapt.c, tp_cover.c; issue 19 item 4) --- */
+    double zone_h;              /* > 0: targets by height (mm from the axis) out to
+                                   zone_h on the planning cornea; zone is then unused */
+    const rg_geometry *plan_g;  /* the geometry poses are planned on (NULL: g) */
+    int (*hit)(void *ctx, const cn_ray *ray, double *u, double *v);   /* an outside
+                                   forward model of the eye (tests): the detector hit
+                                   of the beam, 0, or -1 when it misses (NULL: traced) */
+    void *hit_ctx;
+    const cn_params *fit_start; /* the fit's start (NULL: the nominal cornea, pose 0) */
+    int sensor_cut;             /* 1: the quick model loses the spots whose traced hit
+                                   lands off the camera's sensor, as frames do */
+    int npass;                  /* measure_zone: the passes made, the last the scan */
+    tp_pass pass[TP_MAXPASS];
+    rg_geometry zone_g;         /* measure_zone: the last pass's planning geometry */
+    tp_cover cover;             /* measure_zone: the data's coverage per zone */
 } tp_run;
 
 
@@ -142,9 +194,23 @@ typedef struct topo_api {
     /* Counts of the points by status (OK, NONE, SEVERAL, OUTLIER, MISS) and
      * unplanned. */
     void (*counts)(const tp_run *r, int counts[6]);
+    /* --- the clinical zone and the ISO 19980 report (issue 19 items 4, 5) --- */
+    /* The measurement planned adaptively (tp_adapt.c): coarse passes (1.2 mm, then
+     * 3 mm from the axis, npoints / 6 each, planned on the nominal cornea, then on
+     * each pass's biconic fit), then the scan of npoints out to zone_h planned on the
+     * last fit, and its coverage per zone (r->cover, with r->zf).  As measure. */
+    int (*measure_zone)(tp_run *r, char *err, size_t cap);
+    /* The ISO 19980 statistics of r's surface from the data (r->have_z) against the
+     * true surface sag (in the frame of place); 0 or -1 (no surface). */
+    int (*iso)(const tp_run *r, tp_sag_fn sag, void *ctx, const rg_cornea *place,
+               tp_iso *out);
+    /* The true sag of a rig cornea with an optional cone (ctx: a tp_truth). */
+    int (*truth_sag)(void *ctx, double x, double y, double *z);
 } topo_api;
 
-#define TOPO_ABI 1
+typedef struct tp_truth { const rig_api *rg; const rg_cornea *c; const cn_bump *bump; } tp_truth;
+
+#define TOPO_ABI 2            /* 2: tp_run grew the zone fields, topo_api measure_zone, iso */
 #define TOPO_API_SYMBOL "topo_get_api"
 typedef const topo_api *(*topo_get_api_fn)(int abi);
 const topo_api *topo_get_api(int abi);

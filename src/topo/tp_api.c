@@ -10,6 +10,9 @@ static const topo_api api = {
     .pattern = tp_pattern,
     .measure = tp_measure,
     .counts = tp_counts,
+    .measure_zone = tp_measure_zone,
+    .iso = tp_iso_report,
+    .truth_sag = tp_truth_sag,
 };
 
 __attribute__((visibility("default"))) const topo_api *topo_get_api(int abi)

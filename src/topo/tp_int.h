@@ -15,4 +15,15 @@ void tp_shot_add(tp_shot *sh, const struct im_frame *f, double x, double y, doub
 double tp_shot_gain(const tp_shot *sh);         /* e-/count; INFINITY: none; NaN: too few */
 double tp_shot_gain_se(const tp_shot *sh);      /* its standard error (NaN: none) */
 double tp_shot_factor(double amp, double w, double noise, double gain);
+
+/* tp_adapt.c: the clinical zone (issue 19 item 4) */
+int tp_measure_zone(tp_run *r, char *err, size_t cap);
+int tp_outside_hit(const tp_run *r, const cn_plane *pl, tp_point *q, double hit[3]);
+int tp_off_sensor(const tp_run *r, tp_point *q);
+/* tp_cover.c: the data's coverage per zone */
+void tp_cover_zones(const tp_run *r, tp_cover *c);
+/* tp_iso.c: the ISO 19980 report */
+int tp_iso_report(const tp_run *r, tp_sag_fn sag, void *ctx, const rg_cornea *place,
+                  tp_iso *out);
+int tp_truth_sag(void *ctx, double x, double y, double *z);
 #endif

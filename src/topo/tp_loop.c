@@ -294,8 +294,9 @@ static void measure_one(job *j, im_centroider *cz, int k)
     }
     if (r->source == TP_SRC_CAMERA) return;       /* located as each frame was read */
     q->spot.sigma = r->sigma > 0 ? r->sigma : 1e-4;
-    if (traced_hit(r, &j->gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
-                   sizeof q->why)) {
+    if (r->hit ? tp_outside_hit(r, &j->pl, q, hit)
+               : traced_hit(r, &j->gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
+                            sizeof q->why)) {
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         /* the camera still takes the frame: it shows no spot */
@@ -303,7 +304,7 @@ static void measure_one(job *j, im_centroider *cz, int k)
             fail_job(j);
         return;
     }
-    if (r->bump && cone_hit(r, &j->pl, q, hit)) {
+    if (!r->hit && r->bump && cone_hit(r, &j->pl, q, hit)) {
         if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
             fail_job(j);
         return;
@@ -312,6 +313,7 @@ static void measure_one(job *j, im_centroider *cz, int k)
         if (frame_spot(r, cz, &j->pl, k, hit, q)) fail_job(j);
         return;
     }
+    if (r->sensor_cut && tp_off_sensor(r, q)) return;      /* tp_adapt.c */
     uint64_t s = r->seed * 0x9E3779B97F4A7C15ull ^ (uint64_t)k * 0xD1B54A32D192ED03ull;
     double nu = lm_gauss(&s), nv = lm_gauss(&s);
     q->spot.u = q->hit_u + (r->sigma > 0 ? r->sigma * nu : 0);
@@ -452,7 +454,14 @@ static int surface(tp_run *r, int m, const int *of, char *err, size_t cap)
     } else {
         cn_fit_opts fo = {.model = CN_SPHERE, .stop = r->stop, .stop_ctx = r->stop_ctx,
                           .threads = r->threads, .max_iter = r->max_iter};
-        frc = r->cn->fit(r->g, sp, m, NULL, &fo, ref, e, sizeof e);
+        cn_params st, *stp = NULL;
+        if (r->fit_start) {             /* tp_adapt.c: the last pass's eye as a sphere */
+            st = *r->fit_start;
+            for (int i = CN_C0; i < CN_NPARAM; i++)
+                if (i < CN_DX || i > CN_DZ) st.p[i] = 0;
+            stp = &st;
+        }
+        frc = r->cn->fit(r->g, sp, m, stp, &fo, ref, e, sizeof e);
     }
     if (frc == CN_ESTOP) { snprintf(err, cap, "stopped"); rc = CN_ESTOP; goto out; }
     if (frc || !ref->converged) {
@@ -501,7 +510,9 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         snprintf(err, cap, "out of memory");
         return CN_ENOMEM;
     }
-    int n = tp_pattern(r->pattern, r->npoints, r->zone, tg);
+    int n = tp_pattern(r->pattern, r->npoints, r->zone_h > 0 ? r->zone_h : r->zone, tg);
+    for (int k = 0; r->zone_h > 0 && k < n; k++) tg[k].kind = RG_T_HEIGHT;   /* mm */
+    const rg_geometry *pg = r->plan_g ? r->plan_g : r->g;    /* tp_adapt.c: the fit's */
     memset(r->pt, 0, sizeof *r->pt * (size_t)r->npoints);
     r->npoints = n;
     /* plan: solve and quantise each target on the nominal cornea */
@@ -513,8 +524,8 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         q->t = tg[k];
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = q->hit_u = q->hit_v = NAN;
-        if (rg->solve(r->g, &q->t, NULL, &s, e, sizeof e) ||
-            rg->quantise(r->g, &q->t, &s, &qu, e, sizeof e)) {
+        if (rg->solve(pg, &q->t, NULL, &s, e, sizeof e) ||
+            rg->quantise(pg, &q->t, &s, &qu, e, sizeof e)) {
             snprintf(q->why, sizeof q->why, "not planned: %.80s", e);
             continue;
         }
@@ -628,7 +639,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         if (r->pt[k].planned) { sp[m] = r->pt[k].spot; of[m++] = k; }
     cn_fit_opts fo = {.model = r->model, .stop = r->stop, .stop_ctx = r->stop_ctx,
                       .threads = r->threads, .max_iter = r->max_iter};
-    int rc = r->cn->fit(r->g, sp, m, NULL, &fo, &r->res, err, cap);
+    int rc = r->cn->fit(r->g, sp, m, r->fit_start, &fo, &r->res, err, cap);
     if (!rc && r->zf) rc = surface(r, m, of, err, cap);
     for (int i = 0; i < m; i++) {
         tp_point *q = &r->pt[of[i]];
