@@ -175,6 +175,15 @@ static int scan(const eye *e, int npoints, double theta, double sigma, unsigned 
     return m;
 }
 
+/* the fit's own CPU time (one thread): the wall clock of a machine shared by eight
+   builds measured the load, 0.2 to 1.0 s for the same fit */
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
 /* Reference sphere fit, Zernike slope fit, indices; truth's indices on the same zone. */
 static int measure(const eye *e, cn_spot *sp, int n, cn_zfit *z, cn_kc *k, cn_kc *kt,
                    int *iters)
@@ -187,7 +196,9 @@ static int measure(const eye *e, cn_spot *sp, int n, cn_zfit *z, cn_kc *k, cn_kc
     int rc = cn->fit(&g, cp, n, NULL, &fo, res, err, sizeof err);
     if (iters) *iters = res->iterations;
     printf("# reference sphere R %.4f dx %.4f dy %.4f dz %.4f\n", res->par.p[CN_R], res->par.p[CN_DX], res->par.p[CN_DY], res->par.p[CN_DZ]);
+    double t0 = now();
     if (!rc) rc = cn->zfit(&g, sp, n, &res->par, CN_SPHERE, 0, z, err, sizeof err);
+    printf("# reconstruction: %.2f s of CPU, %d fit steps\n", now() - t0, z->iterations);
     if (!rc) rc = cn->kc(z, k);
     if (rc) printf("# measure: %s\n", err);
     cn_params tp = {{0}};
@@ -200,15 +211,6 @@ static int measure(const eye *e, cn_spot *sp, int n, cn_zfit *z, cn_kc *k, cn_kc
     free(res);
     free(cp);
     return rc;
-}
-
-/* the fit's own CPU time (one thread): the wall clock of a machine shared by eight
-   builds measured the load, 0.2 to 1.0 s for the same fit */
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
 int main(int argc, char **argv)
