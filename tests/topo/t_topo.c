@@ -313,6 +313,63 @@ int main(int argc, char **argv)
     printf("BENCH topo_is_err_D %.3f D\n", fabs(eis));
 
 fits:
+    /* 3a. item 3 of the issue, for every model: a fit that fails its goodness-of-fit
+       test prints no confident +- (rejected: none at all; residuals like noise: the
+       sd inflated by sqrt(chi2/dof)), and a fit stopped at its iteration cap says
+       NOT CONVERGED and gives no finite +-.  Eyes: a 0.25 D toric (Q -0.26), the
+       cone, a conic (Q -0.26); spots from the engine's analytic forward model. */
+    {
+        static char buf[16384];
+        const char *mn[] = {"sphere", "conic", "biconic", "asphere"};
+        cn_scan_opts so = {.npoints = 600, .theta_max = 12 * CT_DEG, .sigma = 0, .seed = 1,
+                           .quantise = 1};
+        char err[256];
+        int ns = cn->simulate(rg, &g, &g.cornea, &so, sp, 600, err, sizeof err);
+        cn_spot *cp = malloc(sizeof *cp * (size_t)(ns > 0 ? ns : 1));
+        cn_result *r = calloc(1, sizeof *r);
+        int bad = 0, rejected = 0, good = 0, capped = 0;
+        for (int eye = 0; eye < 3 && ns > 0; eye++) {
+            cn_params tp = {{0}};
+            cn_bump b = {0};
+            int model = CN_SPHERE;
+            tp.p[CN_R] = 7.8;
+            if (eye == 0) { model = CN_BICONIC; tp.p[CN_C0] = -0.25 / 337.5 / 2; tp.p[CN_QF] = tp.p[CN_QS] = -0.26; }
+            if (eye == 1) { b.w = 0.8; b.h = 5.0 / 337.5 * b.w * b.w; b.y0 = -1.5; }
+            if (eye == 2) { model = CN_CONIC; tp.p[CN_QF] = tp.p[CN_QS] = -0.26; }
+            cn->reimage(&g, model, &tp, eye == 1 ? &b : NULL, sigma, 11 + eye, sp, ns);
+            for (int m = 0; m < 4; m++)
+                for (int cap = 0; cap < 2; cap++) {
+                    memcpy(cp, sp, sizeof *cp * (size_t)ns);
+                    cn_fit_opts fo = {.model = m, .max_iter = cap ? 2 : 0};
+                    int rc2 = cn->fit(&g, cp, ns, NULL, &fo, r, err, sizeof err);
+                    cn->report(r, buf, sizeof buf);
+                    int finite_pm = 0;   /* "+- x" with x a finite number */
+                    for (const char *q = buf; (q = strstr(q, "+-")) != NULL; q += 2) {
+                        char *end;
+                        double x = strtod(q + 2, &end);
+                        if (end != q + 2 && isfinite(x)) finite_pm++;
+                    }
+                    int ok;
+                    if (rc2) ok = 0;
+                    else if (!r->converged) { ok = strstr(buf, "NOT CONVERGED") && finite_pm == 0; capped++; }
+                    else if (r->rejected_model) { ok = finite_pm == 0; rejected++; }
+                    else if (r->poor) ok = r->inflation > 1 && strstr(buf, "INFLATED");
+                    else { ok = 1; good++; }
+                    if (!ok) {
+                        bad++;
+                        printf("# eye %d, %s%s: converged %d poor %d rejected %d, %d finite +-\n%s",
+                               eye, mn[m], cap ? " (cap 2)" : "", r->converged, r->poor,
+                               r->rejected_model, finite_pm, buf);
+                    }
+                }
+        }
+        ct_check(ns > 0 && bad == 0 && capped >= 10 && rejected >= 5 && good >= 3,
+                 "every model on a toric, a coned and a conic eye: %d fits that hold, %d "
+                 "rejected with no +-, %d stopped at a cap of 2 iterations saying NOT "
+                 "CONVERGED with no finite +-; %d otherwise", good, rejected, capped, bad);
+        free(cp);
+        free(r);
+    }
     /* 3. the biconic fit's iterations on the test eyes (engine's analytic truth plus
        noise) and its time on 1000 points */
     int worst = 0;
