@@ -311,11 +311,33 @@ int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_
     return CN_OK;
 }
 
+/* The radius of the largest circle about the frame's origin that the data fill: the
+ * least, over 36 sectors of 10 deg, of the farthest spot in the sector.  The frame
+ * is the instrument's axis (cn_recon.c), so a decentred eye's data are a disc off
+ * it: there its far side sets the zone (the data's own radius put I-S's points
+ * beyond the data on an eye 0.2 mm off the axis). */
+static double filled_radius(const cn_zfit *z)
+{
+    double far[36] = {0}, r = INFINITY;
+    for (int i = 0; i < z->npts; i++) {
+        double x = z->xy[2 * i], y = z->xy[2 * i + 1], a = atan2(y, x) + M_PI;
+        int sct = (int)(a / (2 * M_PI) * 36);
+        if (sct < 0) sct = 0;
+        if (sct > 35) sct = 35;
+        far[sct] = fmax(far[sct], hypot(x, y));
+    }
+    for (int j = 0; j < 36; j++) r = fmin(r, far[j]);
+    return fmin(r, z->rho);
+}
+
 int cn_kc_of(const cn_zfit *z, cn_kc *k)
 {
     kc_surf s = {.z = z, .ox = z->ref.p[CN_DX], .oy = z->ref.p[CN_DY]};
     memset(k, 0, sizeof *k);
-    if (indices(&s, z->rho, k)) return CN_EINVAL;
+    /* the data's radius, or where a ring or I-S's points fall off the data there
+       (an eye off the instrument's axis: its data a disc off the frame's origin) the
+       radius the data fill all round */
+    if (indices(&s, z->rho, k) && indices(&s, filled_radius(z), k)) return CN_EINVAL;
     screen(k);
     /* sd from the local fits' covariances: Kmax's at its point; the mean of N
        powers (rings, I-S's five points) as independent points (the kernels of the
@@ -342,7 +364,7 @@ int cn_kc_of(const cn_zfit *z, cn_kc *k)
     k->sd_is = nv ? sqrt(v) / 5 : INFINITY;
     v = 0;
     nv = 0;
-    double hr = fmin(1.5, 0.9 * z->rho);
+    double hr = fmin(1.5, 0.9 * k->zone_r);
     for (int j = 0; j < 72; j++) {
         double a = 2 * M_PI * j / 72;
         if (!power_sd(&s, hr * cos(a), hr * sin(a), &pe, &sdd)) { v += sdd * sdd; nv++; }

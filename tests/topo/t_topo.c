@@ -207,7 +207,7 @@ static int measure(const eye *e, cn_spot *sp, int n, cn_zfit *z, cn_kc *k, cn_kc
     tp.p[CN_DY] = e->apex[1] - g.cornea.trans[1];
     tp.p[CN_DZ] = e->apex[2] - g.cornea.trans[2];
     cn_bump b = {e->h, e->w, e->x0, e->y0};
-    if (!rc) rc = cn->kc_model(CN_SPHERE, &tp, e->h > 0 ? &b : NULL, z->rho, kt);
+    if (!rc) rc = cn->kc_model(CN_SPHERE, &tp, e->h > 0 ? &b : NULL, k->zone_r, kt);
     free(res);
     free(cp);
     return rc;
