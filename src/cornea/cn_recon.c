@@ -490,11 +490,31 @@ int cn_zfit_run(const rg_geometry *g, const cn_spot *spots, int n, const cn_para
         snprintf(err, errcap, "bad reference model %d", ref_model);
         return CN_EINVAL;
     }
+    int mo = max_order > 0 && max_order <= CN_ZORDER ? max_order : CN_ZORDER;
     cn_params p = *ref;
     int model = ref_model, iters = 0, rc = CN_OK;
     const double *apex0 = g->cornea.trans;
+    {   /* a reference that fits its spots (chi^2 within 4 sd of its dof, the fit's own
+           test) is the eye's frame: one converged pass in it, curvatures about its
+           apex (a tilted toric eye's maps and I-S read about the instrument's axis
+           came out -37..75 um and -0.45 D against 0) */
+        cn_plane pl;
+        cn_plane_of(g, &pl);
+        double chi2 = 0;
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            const cn_spot *s = &spots[i];
+            double u, v;
+            if (s->status != CN_S_OK || !(s->sigma > 0)) continue;
+            if (cn_forward(ref_model, ref, apex0, &pl, &s->ray, &u, &v, NULL, NULL)) { chi2 = INFINITY; break; }
+            chi2 += ((u - s->u) * (u - s->u) + (v - s->v) * (v - s->v)) / (s->sigma * s->sigma);
+            m++;
+        }
+        int dof = 2 * m - 10;
+        if (dof > 0 && (chi2 - dof) / sqrt(2.0 * dof) <= 4)
+            return recon_once(g, spots, n, ref, ref_model, mo, 40, z, err, errcap);
+    }
     double C[3] = {0, 0, 0}, R = ref->p[CN_R];   /* the sphere's centre, rig frame */
-    int mo = max_order > 0 && max_order <= CN_ZORDER ? max_order : CN_ZORDER;
     int cap = mo < 8 ? mo : 8;
     for (int pass = 0; pass < 10; pass++) {
         /* the frame needs the sphere through the surface, not its fine shape: order
