@@ -25,6 +25,7 @@ typedef struct fctx {
     int tie_q;                      /* Q steep follows Q flat (its column left out) */
     double sd[CN_NPARAM];           /* after a solve: each free parameter's sd */
     int max_it;                     /* most iterations of one solve */
+    int fwd_diff;                   /* the solver's Jacobian: one-sided differences */
 } fctx;
 
 static double cn_norm2(const gsl_vector *f)
@@ -43,12 +44,43 @@ static void unpack(const fctx *c, const gsl_vector *x, cn_params *p)
 
 /* Rows [i0, i1) of the residuals (J NULL) or of the Jacobian (f NULL) at p: every
  * spot's rows depend on that spot alone, so the split over threads changes no bit. */
+/* The solver's Jacobian row of spot s: one-sided differences (1 + nfree forward
+ * models a spot against central differences' 2 nfree; the forward model is most of
+ * a fit's time).  Only the trust region's steps use it: a step's accuracy needs no
+ * more, each step is checked against the exact residuals, and the covariance and
+ * the analysis take central differences at the solution.  Q steep tied to Q flat:
+ * Q flat's column moves both.  0 or -1 (a miss). */
+static int jac_fwd(const fctx *c, const cn_params *p, const cn_spot *s, double *ru, double *rv)
+{
+    double u0, v0;
+    if (cn_forward(c->model, p, c->apex0, c->pl, &s->ray, &u0, &v0, NULL, NULL)) return -1;
+    for (int k = 0; k < c->nf; k++) {
+        int q = c->idx[k];
+        cn_params a = *p;
+        double h = cn_step[q], ua, va;
+        a.p[q] += h;
+        if (c->tie_q && q == CN_QF) a.p[CN_QS] += h;
+        if (cn_forward(c->model, &a, c->apex0, c->pl, &s->ray, &ua, &va, NULL, NULL)) return -1;
+        ru[k] = (ua - u0) / h / s->sigma;
+        rv[k] = (va - v0) / h / s->sigma;
+    }
+    return 0;
+}
+
 static void rows(const fctx *c, const cn_params *p, int i0, int i1, gsl_vector *f,
                  gsl_matrix *J)
 {
     double ru[CN_NPARAM], rv[CN_NPARAM];
     for (int i = i0; i < i1; i++) {
         const cn_spot *s = &c->s[c->use[i]];
+        if (J && c->fwd_diff) {
+            if (jac_fwd(c, p, s, ru, rv)) memset(ru, 0, sizeof ru), memset(rv, 0, sizeof rv);
+            for (int k = 0; k < c->nf; k++) {
+                gsl_matrix_set(J, 2 * i, k, ru[k]);
+                gsl_matrix_set(J, 2 * i + 1, k, rv[k]);
+            }
+            continue;
+        }
         if (J) {
             if (c->tie_q) {     /* Q flat's column carries Q steep's, which follows it */
                 int id2[CN_NPARAM + 1], qf = -1;
@@ -236,6 +268,7 @@ static int solve(fctx *c, cn_params *p, int max_iter, int (*stop)(void *), void 
     gsl_vector *x = gsl_vector_alloc(c->nf);
     if (!w || !x) { if (w) gsl_multifit_nlinear_free(w); gsl_vector_free(x); return CN_ENOMEM; }
     for (int k = 0; k < c->nf; k++) gsl_vector_set(x, k, p->p[c->idx[k]]);
+    c->fwd_diff = 1;
     gsl_multifit_nlinear_init(x, &fdf, w);
     int it, rc = 0, small = 0;
     double chi2 = cn_norm2(gsl_multifit_nlinear_residual(w));
@@ -266,6 +299,7 @@ static int solve(fctx *c, cn_params *p, int max_iter, int (*stop)(void *), void 
             break;
         }
     }
+    c->fwd_diff = 0;
     unpack(c, w->x, p);
     if (it > c->max_it) c->max_it = it;
     gsl_matrix *cv = gsl_matrix_alloc(c->nf, c->nf);

@@ -57,6 +57,7 @@ size_t cn_report_json(const cn_result *r, const cn_spot *spots, int n, char *buf
 
 /* cn_zern.c / cn_kc.c: the surface from the slopes, its maps and indices */
 int cn_zterms(int order);
+void cn_zbasis(int nt, double rho, double x, double y, double *v, double *gx, double *gy);
 int cn_zfit_run(const rg_geometry *g, const cn_spot *spots, int n, const cn_params *ref,
                 int ref_model, int max_order, cn_zfit *z, char *err, size_t errcap);
 int cn_zsag(const cn_zfit *z, double x, double y, double *f, double *fx, double *fy);

@@ -188,18 +188,32 @@ static int indices(const kc_surf *k, double zone, cn_kc *o)
 {
     double p;
     o->zone_r = zone;
-    /* Kmax: a 0.05 mm grid within 0.95 of the zone, then 0.005 mm about its best */
+    /* Kmax: a 0.05 mm grid within 0.9 of the zone and its edge (the axial map of
+       a cone off the centre peaks beyond the cone, often at the zone's edge), then
+       polar steps about the best (0.0025 mm radially, 0.0025 mm along the arc) */
     double lim = 0.9 * zone, best = -INFINITY, bx = 0, by = 0;
     for (double y = -lim; y <= lim; y += 0.05)
         for (double x = -lim; x <= lim; x += 0.05) {
             if (hypot(x, y) > lim || (k->z && !cn_zcovered(k->z, x, y))) continue;
             if (!power(k, x, y, &p) && p > best) { best = p; bx = x; by = y; }
         }
+    for (int j = 0; j < 720; j++) {
+        double x = lim * cos(j * M_PI / 360), y = lim * sin(j * M_PI / 360);
+        if ((!k->z || cn_zcovered(k->z, x, y)) && !power(k, x, y, &p) && p > best) { best = p; bx = x; by = y; }
+    }
     if (!isfinite(best)) return -1;
-    double cx = bx, cy = by;
-    for (double y = cy - 0.05; y <= cy + 0.05; y += 0.005)
-        for (double x = cx - 0.05; x <= cx + 0.05; x += 0.005)
-            if (hypot(x, y) <= lim && !power(k, x, y, &p) && p > best) { best = p; bx = x; by = y; }
+    double r0 = hypot(bx, by), t0 = atan2(by, bx);
+    for (int pass = 0; pass < 2; pass++) {
+        double span = pass ? 0.005 : 0.05;
+        double rc = r0, tc = t0;
+        for (int i = -20; i <= 20; i++)
+            for (int j = -20; j <= 20; j++) {
+                double r = fmin(rc + i * span / 20, lim), t = tc + j * span / 20 / fmax(rc, 0.05);
+                if (r < 0) continue;
+                double x = r * cos(t), y = r * sin(t);
+                if (!power(k, x, y, &p) && p > best) { best = p; bx = x; by = y; r0 = r; t0 = t; }
+            }
+    }
     o->kmax = best;
     o->kmax_x = bx + k->ox;
     o->kmax_y = by + k->oy;
@@ -230,18 +244,28 @@ static int indices(const kc_surf *k, double zone, cn_kc *o)
     /* SRAX: the steepest semi-meridian above and below the horizontal (mean axial
        power from 0.5 mm to the zone's edge, 1 deg steps); the angle between them
        less 180 */
-    double bu = -INFINITY, bl = -INFINITY, au = 0, al = 0;
+    double sm[360], bu = -INFINITY, bl = -INFINITY;
+    int au = 0, al = 180;
     for (int dg = 0; dg < 360; dg++) {
         double a = dg * DEG, sum = 0;
         int nn = 0;
         for (double r = 0.5; r <= lim; r += 0.1)
             if (!power(k, r * cos(a), r * sin(a), &p)) { sum += p; nn++; }
-        if (!nn) continue;
-        sum /= nn;
-        if (dg < 180) { if (sum > bu) { bu = sum; au = dg; } }
-        else if (sum > bl) { bl = sum; al = dg; }
+        sm[dg] = nn ? sum / nn : -INFINITY;
+        if (dg < 180) { if (sm[dg] > bu) { bu = sm[dg]; au = dg; } }
+        else if (sm[dg] > bl) { bl = sm[dg]; al = dg; }
     }
-    o->srax = fabs(180 - fabs(al - au));
+    /* each half's steepest semi-meridian must be one: a cone straight below steepens
+       the two semi-meridians either side of it alike, and the upper half's flanks
+       alike, and which of two equals wins is noise (the bench's cone read 35 deg
+       against the truth's 145 with the same surface): no other semi-meridian of the
+       half, 20 deg or more away, within 0.05 D of it; else SRAX (and KISA) is not
+       defined on these data */
+    o->srax = fabs(180 - fabs((double)(al - au)));
+    for (int dg = 0; dg < 360; dg++) {
+        int half = dg < 180, far = half ? abs(dg - au) >= 20 : abs(dg - al) >= 20;
+        if (far && sm[dg] > (half ? bu : bl) - 0.05) { o->srax = NAN; break; }
+    }
     /* KISA% (Rabinowitz & Rasheed 1999) */
     o->kisa = o->ck * o->is * o->ast * o->srax * 100 / 300;
     return 0;
@@ -265,6 +289,9 @@ static void screen(cn_kc *o)
        (a sphere's came out 133 deg); it enters through KISA, times AST */
     if (o->kisa > 100) FLAG(CN_KC_KERATOCONUS, "KISA %.0f %% > 100; ", o->kisa);
     else if (o->kisa > 60) FLAG(CN_KC_SUSPECT, "KISA %.0f %% in 60-100; ", o->kisa);
+    else if (isnan(o->kisa) && l < sizeof o->why)
+        l += snprintf(o->why + l, sizeof o->why - l, "no KISA: SRAX not defined (two "
+                      "steepest semi-meridians alike within 0.05 D); ");
 #undef FLAG
     if (l >= 2 && l < sizeof o->why) o->why[l - 2] = 0;
 }
@@ -284,11 +311,33 @@ int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_
     return CN_OK;
 }
 
+/* The radius of the largest circle about the frame's origin that the data fill: the
+ * least, over 36 sectors of 10 deg, of the farthest spot in the sector.  The frame
+ * is the instrument's axis (cn_recon.c), so a decentred eye's data are a disc off
+ * it: there its far side sets the zone (the data's own radius put I-S's points
+ * beyond the data on an eye 0.2 mm off the axis). */
+static double filled_radius(const cn_zfit *z)
+{
+    double far[36] = {0}, r = INFINITY;
+    for (int i = 0; i < z->npts; i++) {
+        double x = z->xy[2 * i], y = z->xy[2 * i + 1], a = atan2(y, x) + M_PI;
+        int sct = (int)(a / (2 * M_PI) * 36);
+        if (sct < 0) sct = 0;
+        if (sct > 35) sct = 35;
+        far[sct] = fmax(far[sct], hypot(x, y));
+    }
+    for (int j = 0; j < 36; j++) r = fmin(r, far[j]);
+    return fmin(r, z->rho);
+}
+
 int cn_kc_of(const cn_zfit *z, cn_kc *k)
 {
     kc_surf s = {.z = z, .ox = z->ref.p[CN_DX], .oy = z->ref.p[CN_DY]};
     memset(k, 0, sizeof *k);
-    if (indices(&s, z->rho, k)) return CN_EINVAL;
+    /* the data's radius, or where a ring or I-S's points fall off the data there
+       (an eye off the instrument's axis: its data a disc off the frame's origin) the
+       radius the data fill all round */
+    if (indices(&s, z->rho, k) && indices(&s, filled_radius(z), k)) return CN_EINVAL;
     screen(k);
     /* sd from the local fits' covariances: Kmax's at its point; the mean of N
        powers (rings, I-S's five points) as independent points (the kernels of the
@@ -315,7 +364,7 @@ int cn_kc_of(const cn_zfit *z, cn_kc *k)
     k->sd_is = nv ? sqrt(v) / 5 : INFINITY;
     v = 0;
     nv = 0;
-    double hr = fmin(1.5, 0.9 * z->rho);
+    double hr = fmin(1.5, 0.9 * k->zone_r);
     for (int j = 0; j < 72; j++) {
         double a = 2 * M_PI * j / 72;
         if (!power_sd(&s, hr * cos(a), hr * sin(a), &pe, &sdd)) { v += sdd * sdd; nv++; }

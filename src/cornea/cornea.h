@@ -217,6 +217,8 @@ typedef struct cn_zfit {
                                       R0 - sqrt(R0^2 - r^2) + sum c_j Z_j */
     double g0x, g0y;               /* the slope at the frame's origin: curvatures are
                                       taken about the normal there (the vertex) */
+    int iterations;                /* Levenberg-Marquardt steps of the joint fit of
+                                      heights and slopes to the detector (cn_recon.c) */
 } cn_zfit;
 
 /* Keratoconus indices from the reconstructed surface (cn_kc.c), each with its sd
