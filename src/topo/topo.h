@@ -55,7 +55,50 @@ typedef struct tp_point {
     char why[96];               /* why the point gave no spot */
     int measured;               /* 1: its spot was made (traced, framed, located) */
     int saved;                  /* 1: its frame was written (r->save) */
+    /* the scan on the machine (tp_order.c): when it was exposed and how it moved */
+    double t_s;                 /* the exposure's middle on the machine's clock, s from
+                                   the scan's first move (NaN: not exposed) */
+    rg_pose path[8];            /* the poses the motors held at evenly spaced control
+                                   steps of the exposure (on the fly: the smear) */
+    int npath;                  /* poses in path (1 at rest, 0: not exposed) */
+    double blur_det, blur_cornea;   /* the smear's extent on the detector plane and on
+                                   the cornea, nominal eye (mm) */
 } tp_point;
+
+/* The scan on the machine (tp_order.c, doc/scan-time.md). */
+typedef struct tp_scan {
+    int on_fly;                 /* 1: exposed on the fly (rig_api.sweep); 0: stop and go */
+    int reordered;              /* 1: the planner's order; 0: the pattern's own */
+    double sim_s;               /* the machine's clock from the first move to the last
+                                   exposure's end (s) */
+    double pred_s, pred_own_s;  /* predicted: the order run; the pattern's own order */
+    char limit[320];            /* what limits the time, in words */
+    double blur_det_max, blur_cornea_max;   /* the largest smear of an exposure (mm) */
+    double blur_tol;            /* the smear the centroid tolerates (mm, detector) */
+    int blur_over;              /* exposures over it (their spots rejected) */
+} tp_scan;
+
+/* Fixation drift (tp_drift.c): the true eye moved during the scan (simulation), and
+ * its detection from the fitted spots: the eye's translation per time segment that
+ * explains each segment's residuals, tested against one fixed pose. */
+enum { TP_DRIFT_NONE, TP_DRIFT_LINEAR, TP_DRIFT_SACCADE };
+#define TP_DRIFT_SEGMENTS 8
+typedef struct tp_drift {
+    int kind;                   /* TP_DRIFT_*: slow (linear over the scan) or a saccade
+                                   (a jump at the scan's middle) */
+    double amp;                 /* the apex's total lateral displacement (mm) */
+    double dir;                 /* its direction in the rig's x-y plane (rad from x) */
+    /* detection (after the fit) */
+    int segments;               /* time segments used (0: not tested) */
+    double d[TP_DRIFT_SEGMENTS][3];     /* each segment's eye translation (mm) */
+    double sd[TP_DRIFT_SEGMENTS][3];    /* and its standard deviation */
+    double t0[TP_DRIFT_SEGMENTS], t1[TP_DRIFT_SEGMENTS];  /* the segment's times (s) */
+    double chi2;                /* of the segments against one pose */
+    int dof;
+    double p;                   /* its probability */
+    double range;               /* the largest lateral distance between segments (mm) */
+    int flagged;                /* 1: the eye moved (p < 0.001 and range over 2 um) */
+} tp_drift;
 
 typedef struct tp_times {       /* seconds of wall clock, per part */
     double plan, machine, trace, frames, fit, check, total;
@@ -124,6 +167,8 @@ typedef struct tp_run {
     int have_dose;
     const char *phase;          /* the part of the loop running (or where it stopped):
                                    "planning", "the scan on the machine", ... */
+    tp_scan sc;                 /* the scan's order, machine time and smear (tp_order.c) */
+    tp_drift drift;             /* fixation drift: simulated and detected (tp_drift.c) */
 } tp_run;
 
 

@@ -153,13 +153,13 @@ static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double
  * as the camera's Gaussian spot into a full sensor frame at the detector point, saved
  * when asked, then located.  Returns 0, or -1 when a frame could not be saved (why). */
 static int frame_spot(const tp_run *r, im_centroider *cz, const cn_plane *pl, int k,
-                      const double *hit, tp_point *q)
+                      const double *hit, int nh, tp_point *q)
 {
     const im_frame_api *F = r->im->frame;
     const tp_camera *c = &r->cam;
     im_sensor s;
     im_spot_src src;
-    im_hit h;
+    im_hit h[8];
     im_frame *f = NULL;
     char e[256];
     memset(&s, 0, sizeof s);
@@ -180,16 +180,21 @@ static int frame_spot(const tp_run *r, im_centroider *cz, const cn_plane *pl, in
     /* the electrons that give `peak` counts at the centre of a Gaussian of 1/e^2
        radius w pixels: peak * pi w^2 / 2 */
     double electrons = c->peak * s.gain * PI * c->spot_w * c->spot_w / 2;
-    memset(&h, 0, sizeof h);
-    if (hit) memcpy(h.p, hit, sizeof h.p);
-    h.power = electrons / s.exposure * PLANCK_HC / LAMBDA_M;
+    /* on the fly: the beam's hits at the poses the motors held during the exposure,
+       the light shared between them (the smeared spot) */
+    if (nh < 1 || nh > 8) nh = 1;
+    memset(h, 0, sizeof h);
+    for (int i = 0; hit && i < nh; i++) {
+        memcpy(h[i].p, hit + 3 * i, sizeof h[i].p);
+        h[i].power = electrons / s.exposure * PLANCK_HC / LAMBDA_M / nh;
+    }
     memset(&src, 0, sizeof src);
     src.kind = IM_SPOT_HITS_GAUSS;
-    src.hits = &h;
-    src.nhits = 1;
+    src.hits = h;
+    src.nhits = nh;
     src.waist = c->spot_w * c->pitch;   /* path 0: the waist is the spot */
     src.beam_lambda = LAMBDA_M * 1e3;
-    if (F->synth(&s, &src, hit ? 1 : 0, r->seed + (uint64_t)k, 1, &f, e, sizeof e)) {
+    if (F->synth(&s, &src, hit ? nh : 0, r->seed + (uint64_t)k, 1, &f, e, sizeof e)) {
         if (hit) {
             q->spot.status = CN_S_NONE;
             q->spot.u = q->spot.v = NAN;
@@ -261,10 +266,11 @@ static int take(job *j, int finished)
 /* With a cone: the hit of point q's beam through the true eye with the cone, by the
  * cornea engine's analytic model (equal to the tracer's on the eye without it to
  * 1e-12 mm); 0, or -1 (status NONE, why said) when the beam misses. */
-static int cone_hit(const tp_run *r, const cn_plane *pl, tp_point *q, double hit[3])
+static int cone_hit(const tp_run *r, const cn_plane *pl, const cn_params *truth, tp_point *q,
+                    double hit[3])
 {
     cn_spot b = q->spot;
-    if (r->cn->reimage(r->g, CN_BICONIC, &r->truth_p, r->bump, 0, 0, &b, 1) != 1) {
+    if (r->cn->reimage(r->g, CN_BICONIC, truth, r->bump, 0, 0, &b, 1) != 1) {
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         snprintf(q->why, sizeof q->why, "the beam misses the cornea with its cone");
@@ -274,6 +280,44 @@ static int cone_hit(const tp_run *r, const cn_plane *pl, tp_point *q, double hit
     q->hit_v = b.v;
     for (int i = 0; i < 3; i++) hit[i] = pl->at[i] + b.u * pl->e1[i] + b.v * pl->e2[i];
     return 0;
+}
+
+/* On the fly: the beam through the true eye at each pose the motors held during the
+ * exposure (q->path), for the smeared frame; var gets the hits' mean squared distance
+ * from their mean (mm^2).  At rest (or when none lands): the one hit.  Returns the
+ * count in hits. */
+static int smear_hits(const tp_run *r, const rg_geometry *gt, const cn_plane *pl,
+                      const cn_params *truth, const tp_point *q, const double hit[3],
+                      double hits[8][3], double *var)
+{
+    double uv[8][2], mu = 0, mv = 0;
+    int n = 0;
+    char why[96], e[RG_ERRMAX];
+    *var = 0;
+    for (int c = 0; q->npath > 1 && c < q->npath && c < 8; c++) {
+        tp_point t = *q;
+        if (r->bump) {
+            if (r->cn->ray_of_pose(r->rg, r->g, &q->path[c], &t.spot.ray, e, sizeof e) ||
+                cone_hit(r, pl, truth, &t, hits[n]))
+                continue;
+            uv[n][0] = t.hit_u;
+            uv[n][1] = t.hit_v;
+        } else if (traced_hit(r, gt, pl, &q->path[c], &uv[n][0], &uv[n][1], hits[n], why,
+                              sizeof why))
+            continue;
+        mu += uv[n][0];
+        mv += uv[n][1];
+        n++;
+    }
+    if (n == 0) {
+        memcpy(hits[0], hit, sizeof hits[0]);
+        return 1;
+    }
+    mu /= n;
+    mv /= n;
+    for (int c = 0; c < n; c++)
+        *var += ((uv[c][0] - mu) * (uv[c][0] - mu) + (uv[c][1] - mv) * (uv[c][1] - mv)) / (2 * n);
+    return n;
 }
 
 static void measure_one(job *j, im_centroider *cz, int k)
@@ -291,28 +335,45 @@ static void measure_one(job *j, im_centroider *cz, int k)
     }
     if (r->source == TP_SRC_CAMERA) return;       /* located as each frame was read */
     q->spot.sigma = r->sigma > 0 ? r->sigma : 1e-4;
-    if (traced_hit(r, &j->gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
-                   sizeof q->why)) {
+    const rg_geometry *gt = &j->gt;     /* the true eye, moved by a simulated drift */
+    rg_geometry *gd = NULL;
+    cn_params truth = r->truth_p;
+    if (r->drift.kind != TP_DRIFT_NONE && (gd = malloc(sizeof *gd))) {
+        *gd = j->gt;
+        tp_drift_eye(r, q, gd, &truth);
+        gt = gd;
+    }
+    int miss = traced_hit(r, gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
+                          sizeof q->why);
+    if (miss) free(gd);
+    if (miss) {
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         /* the camera still takes the frame: it shows no spot */
-        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
+        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, 1, q))
             fail_job(j);
         return;
     }
-    if (r->bump && cone_hit(r, &j->pl, q, hit)) {
-        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
+    if (r->bump && cone_hit(r, &j->pl, &truth, q, hit)) {
+        free(gd);
+        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, 1, q))
             fail_job(j);
         return;
     }
+    double hits[8][3], var = 0;
+    int nh = smear_hits(r, gt, &j->pl, &truth, q, hit, hits, &var);
+    free(gd);
     if (r->source == TP_SRC_FRAMES) {
-        if (frame_spot(r, cz, &j->pl, k, hit, q)) fail_job(j);
+        if (frame_spot(r, cz, &j->pl, k, hits[0], nh, q)) fail_job(j);
         return;
     }
+    /* the quick model: the smear widens the spot, and the centroid's sigma with it */
+    double sg = r->sigma * sqrt(1 + var / pow(0.5 * r->cam.spot_w * r->cam.pitch, 2));
     uint64_t s = r->seed * 0x9E3779B97F4A7C15ull ^ (uint64_t)k * 0xD1B54A32D192ED03ull;
     double nu = lm_gauss(&s), nv = lm_gauss(&s);
-    q->spot.u = q->hit_u + (r->sigma > 0 ? r->sigma * nu : 0);
-    q->spot.v = q->hit_v + (r->sigma > 0 ? r->sigma * nv : 0);
+    q->spot.u = q->hit_u + (r->sigma > 0 ? sg * nu : 0);
+    q->spot.v = q->hit_v + (r->sigma > 0 ? sg * nv : 0);
+    if (r->sigma > 0) q->spot.sigma = sg;
     q->spot.status = CN_S_OK;
 }
 
@@ -425,6 +486,14 @@ static void shot_widen(tp_run *r)
 
 static int stopped(const tp_run *r);
 
+/* Camera frames on a machine: one read after each exposure, in scan order. */
+typedef struct cam_ctx { im_source *src; im_centroider *cz; int got; } cam_ctx;
+static int cam_after(tp_run *r, int k, void *ctx, char *err, size_t cap)
+{
+    cam_ctx *c = ctx;
+    return camera_read(r, c->src, c->cz, &r->pt[k], c->got++, err, cap) ? CN_EINVAL : 0;
+}
+
 /* The surface from the data (issue 19): a reference sphere fitted to the measured
  * spots (their statuses before the model's fit: a spot the model calls an outlier
  * may be the cone), the Zernike slope fit in its frame, the keratoconus indices.  A
@@ -510,6 +579,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         q->t = tg[k];
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = q->hit_u = q->hit_v = NAN;
+        q->t_s = NAN;
         if (rg->solve(r->g, &q->t, NULL, &s, e, sizeof e) ||
             rg->quantise(r->g, &q->t, &s, &qu, e, sizeof e)) {
             snprintf(q->why, sizeof q->why, "not planned: %.80s", e);
@@ -554,30 +624,13 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         r->have_dose = 1;
     }
     r->phase = "the scan on the machine";
-    if (r->m) {
-        for (int k = 0; k < n; k++) {
-            tp_point *q = &r->pt[k];
-            long steps[RG_NJOINTS];
-            if (!q->planned) continue;
-            if (rg->pose_steps(r->rig, &q->pose, steps, e, sizeof e)) {
-                q->planned = 0;
-                snprintf(q->why, sizeof q->why, "not moved: %.80s", e);
-                continue;
-            }
-            int rc = rg->move_steps(r->m, steps, r->stop, r->stop_ctx, e, sizeof e);
-            if (!rc) rc = rg->expose(r->m, r->expose_ms, r->stop, r->stop_ctx, e, sizeof e);
-            if (rc) {
-                CAMERA_DONE();
-                if (rc == RG_ESTOP || stopped(r)) { snprintf(err, cap, "stopped"); return CN_ESTOP; }
-                snprintf(err, cap, "point %d: %s", k + 1, e);
-                return CN_EINVAL;
-            }
-            if (rg->motors(r->m, steps))        /* where the motors really stood */
-                for (int jn = 0; jn < RG_NJOINTS; jn++)
-                    q->pose.j[jn] = steps[jn] / r->rig->axis[jn].steps_per *
-                                    (jn == RG_J_U || jn == RG_J_V ? 1 : PI / 180);
-            r->nexposed++;
-            if (src && camera_read(r, src, ccz, q, got++, err, cap)) { CAMERA_DONE(); return CN_EINVAL; }
+    if (r->m) {                 /* in the planner's order, stop and go or on the fly */
+        cam_ctx cc = {src, ccz, 0};
+        int rc = tp_scan_machine(r, src ? cam_after : NULL, &cc, err, cap);
+        if (rc) {
+            CAMERA_DONE();
+            if (rc == CN_ESTOP || stopped(r)) { snprintf(err, cap, "stopped"); return CN_ESTOP; }
+            return rc == CN_ENOMEM ? CN_ENOMEM : CN_EINVAL;
         }
     }
     for (int k = 0; src && !r->m && k < n; k++) {
@@ -589,7 +642,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
     r->gain = NAN;
     r->shot_factor = 1;
     if (r->source == TP_SRC_CAMERA) shot_widen(r);
-    for (int k = 0, seq = 0; k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
+    for (int k = 0, seq = 0; !r->m && k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
     r->tm.machine = now() - t;
     /* detect: the traced spot of each exposure, its frame and centroid */
     r->phase = r->source == TP_SRC_FRAMES ? "the frames and their centroids"
@@ -647,6 +700,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         goto fail;
     }
     r->fitted = 1;
+    if (r->m && tp_drift_test(r)) { snprintf(err, cap, "out of memory"); goto fail; }
     /* check: the fitted cornea through the tracer for every fitted pose */
     if (r->tr) {
         r->phase = "the check against the tracer";
