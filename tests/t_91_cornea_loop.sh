@@ -135,7 +135,13 @@ cl_term() {
         "$RIGGOLD" > "$CL/k.in"
     (cd "$CL" && exec "$BIN" --cornea-scan -i k.in k.rec > k.out 2> k.err) &
     p=$!
-    sleep 0.7
+    # (mid-scan: once the simulator's log, still LOG.part.XXXXXX, shows a pulse; the
+    # scan first plans its order, doc/scan-time.md)
+    i=0
+    while [ $i -lt 300 ] && ! cat "$CL"/k.log.part.* 2> /dev/null | grep -q ' laser 1'; do
+        sleep 0.1; i=$((i + 1))
+    done
+    sleep 0.1
     kill -TERM "$p"
     wait "$p"
     rc=$?

@@ -63,6 +63,7 @@ typedef struct cs {
     char *text;                 /* the report as said, for NAME.txt */
     cn_kc kt;                   /* the true surface's indices (tk 1) */
     int tk;
+    int real_clock;             /* the scan runs on a chip: its machine time varies */
     size_t len, cap;
 } cs;
 
@@ -340,6 +341,7 @@ int lm_cornea_scan(lm_io *io)
         goto out;
     if (s->have_rig) {
         if ((rc = calc_choice(c, CS(CHIP), CS(CHIP_WHAT), chips, &chip))) goto out;
+        s->real_clock = chip == 2;
         if ((chip == 1 &&
              (rc = lm_ask_file(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
                                s->log, sizeof s->log))) ||
@@ -603,11 +605,18 @@ static void say_surface(cs *s, tp_run *r)
 static void say_machine(cs *s, const tp_run *r)
 {
     const tp_scan *c = &r->sc;
+    if (s->real_clock) {        /* the real clock's times: stdout only (replays) */
+        lm_say(s->cc.io, LM_OUT, CS(MACHINE_SCAN), r->nexposed,
+               c->on_fly ? "on the fly" : "stop and go",
+               c->reordered ? "the planner's" : "the pattern's", c->sim_s, c->pred_s,
+               c->pred_own_s, c->limit);
+        return;
+    }
     say(s, CS(MACHINE_SCAN), r->nexposed, c->on_fly ? "on the fly" : "stop and go",
         c->reordered ? "the planner's" : "the pattern's", c->sim_s, c->pred_s, c->pred_own_s,
         c->limit);
     say(s, CS(MACHINE_SMEAR), c->blur_det_max * 1e3, c->blur_tol * 1e3, c->blur_over,
-        c->blur_cornea_max * 1e3);
+        c->blur_cornea_max * 1e3, c->step_det_max * 1e3);
 }
 
 /* The fixation test (tp_drift.c): the eye's pose per time segment. */
@@ -615,11 +624,18 @@ static void say_fixation(cs *s, const tp_run *r)
 {
     const tp_drift *d = &r->drift;
     if (!d->segments) return;
+    if (!d->flagged && d->p < 1e-3 && d->range > 2e-3) {
+        say(s, CS(FIXATION_MISFIT), d->segments, d->chi2, d->dof, d->joint_chi2_dof);
+        return;
+    }
     say(s, d->flagged ? CS(FIXATION_BAD) : CS(FIXATION_OK), d->segments, d->chi2, d->dof, d->p,
         d->range * 1e3);
     for (int i = 0; d->flagged && i < d->segments; i++)
         say(s, CS(FIXATION_SEG), i + 1, d->t0[i], d->t1[i], d->d[i][0] * 1e3, d->d[i][1] * 1e3,
             d->d[i][2] * 1e3, d->sd[i][0] * 1e3, d->sd[i][1] * 1e3, d->sd[i][2] * 1e3);
+    if (d->flagged && d->joint_fitted)
+        say(s, CS(FIXATION_JOINT), d->joint.par.p[CN_R], d->joint.k.Km, d->joint.k.cyl,
+            d->joint.k.K2_axis, d->joint.chi2_dof);
 }
 
 /* The measurement and its report. */

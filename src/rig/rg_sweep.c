@@ -46,6 +46,26 @@ static double leg_u(const leg *l, double t)
     return fmin(1, d + l->vp * l->tc + l->vp * x - 0.5 * l->a * x * x);
 }
 
+/* The smooth commanded path at sweep time tau: fractional steps. */
+static void path_at(const leg *L, const long *steps, long n, double T, double tau, double x[RG_NJOINTS])
+{
+    long c = 0;
+    if (n < 2 || tau <= 0 || tau >= T) {
+        const long *p = steps + (n < 2 || tau <= 0 ? 0 : n - 1) * RG_NJOINTS;
+        for (int j = 0; j < RG_NJOINTS; j++) x[j] = (double)p[j];
+        return;
+    }
+    long lo = 0, hi = n - 2;                    /* the leg holding tau */
+    while (lo < hi) {
+        long mid = (lo + hi + 1) / 2;
+        if (L[mid].t0 <= tau) lo = mid; else hi = mid - 1;
+    }
+    c = lo;
+    double f = leg_u(&L[c], tau - L[c].t0);
+    const long *a = steps + c * RG_NJOINTS, *b = a + RG_NJOINTS;
+    for (int j = 0; j < RG_NJOINTS; j++) x[j] = a[j] + f * (double)(b[j] - a[j]);
+}
+
 static int check_all(const rg_rig *rig, const long *steps, long n, char *err, size_t cap)
 {
     static const char *const jn[RG_NJOINTS] = {"m1a", "m1b", "u", "v", "m2a", "m2b"};
@@ -158,6 +178,45 @@ static void laser(rg_machine *m, int on)
     o->set(m->chip, RG_G_SHUTTER, 1, on);
 }
 
+/* A short pulse between two control steps' STEP edges: from `from` (or now, when the
+ * last fall came later) for ms_ns, the heartbeat charged first, the guard read at
+ * both ends (the key switch included), no step while the light is on. */
+static int pulse_between(rg_machine *m, int64_t from, int64_t ms_ns, unsigned *heart,
+                         int64_t *beat, rg_sweep_shot *shot, char *err, size_t cap)
+{
+    const rg_chip_ops *o = m->chip->ops;
+    int64_t hold_ns = (int64_t)llround(m->rig.heartbeat_timeout_ms * 1e6), t_on, now;
+    int rc;
+    if (o->now(m->chip) < from) rg_wait(m, from);
+    if ((rc = rg_guard(m, 1, err, cap))) return rc;
+    if (m->rig.heartbeat.offset >= 0) {
+        *heart ^= 1;
+        o->set(m->chip, RG_G_HEART, 1, *heart);
+        *beat = o->now(m->chip);
+    }
+    laser(m, 1);
+    t_on = o->now(m->chip);
+    if (shot) {
+        shot->t_on = t_on / 1e9;
+        shot->nat = 1;
+        for (int j = 0; j < RG_NJOINTS; j++) {
+            shot->at[0][j] = m->pos[j];
+            shot->mean[j] = (double)m->pos[j];
+        }
+    }
+    rg_wait(m, t_on + ms_ns);
+    now = o->now(m->chip);
+    if (m->rig.heartbeat.offset >= 0 && now - *beat > hold_ns)
+        return rg_latch(m, RG_F_HEARTBEAT, RG_EFAULT, err, cap, "a pulse of the sweep ran "
+                        "%.3f ms: the heartbeat pump (hold %g ms) has cut the beam",
+                        (now - *beat) / 1e6, m->rig.heartbeat_timeout_ms);
+    if ((rc = rg_guard(m, 1, err, cap))) return rc;
+    laser(m, 0);
+    m->dose_n++;
+    m->dose_t += (o->now(m->chip) - t_on) / 1e9;
+    return 0;
+}
+
 int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn stop, void *ctx,
              rg_sweep_shot *shot, char *err, size_t cap)
 {
@@ -219,6 +278,10 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
        over ticks k_i .. k_i + kd with k_i = the tick of t_i (u = i) */
     kd = (long)ceil(ms * 1e6 / tick - 1e-9);
     if (kd < 1) kd = 1;
+    /* a pulse of at most half a control step sits in the step's low half */
+    int64_t ms_ns = (int64_t)llround(ms * 1e6);
+    int shortp = ms_ns <= tick / 2;
+    if (shortp) kd = 0;
     int64_t half = kd * tick / 2;
     K = (long)ceil((T * 1e9 + half) / tick) + kd + 2;
     for (long k = 1; k <= K; k++) {
@@ -253,6 +316,36 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
             if (kon < 1) kon = 1;
         }
         int rise = k_on < 0 && kon >= 1 && k >= kon, fall = k_on >= 0 && k == k_on + kd;
+        if (shortp) {
+            if (dmask) o->set(m->chip, RG_G_DIR, dmask, dval);
+            if (mask) {
+                if ((rc = rg_pulse(m, mask, at, tick, err, cap))) goto out;
+                for (int j = 0; j < RG_NJOINTS; j++)
+                    if (mask >> j & 1) m->pos[j] += dir[j];
+            } else {
+                rg_wait(m, at);
+                if ((rc = rg_guard(m, 0, err, cap))) goto out;
+            }
+            if (rise && (rc = pulse_between(m, at + tick / 2, ms_ns, &heart, &beat,
+                                            shot ? &shot[exp_i] : NULL, err, cap)))
+                goto out;
+            if (rise) {
+                if (shot) {
+                    double ton = (shot[exp_i].t_on * 1e9 - t0 - half) / 1e9;
+                    path_at(L, steps, n, T, ton, shot[exp_i].c_on);
+                    path_at(L, steps, n, T, ton + ms / 1e3, shot[exp_i].c_off);
+                }
+                exp_i++;
+            }
+            if (k == K && (exp_i < n || memcmp(m->pos, steps + (n - 1) * RG_NJOINTS, sizeof m->pos)))
+                K++;
+            if (K > k + 1000000) {
+                snprintf(err, cap, "sweep: the motion did not reach its last target");
+                rc = RG_EINVAL;
+                goto out;
+            }
+            continue;
+        }
         if (rise || k_on >= 0) {
             rg_wait(m, at);
             int64_t now = o->now(m->chip);
@@ -268,8 +361,11 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
                 laser(m, 0);
                 m->dose_n++;
                 m->dose_t += kd * tick / 1e9;
-                if (shot)
+                if (shot) {
                     for (int j = 0; j < RG_NJOINTS; j++) shot[exp_i].mean[j] = sum[j] / nsum;
+                    path_at(L, steps, n, T, (k_on * tick - half) / 1e9, shot[exp_i].c_on);
+                    path_at(L, steps, n, T, (k * tick - half) / 1e9, shot[exp_i].c_off);
+                }
                 k_on = -1;
                 exp_i++;
             } else {

@@ -384,6 +384,9 @@ typedef struct rg_sweep_shot {
                                    control steps of it, the first and the last included
                                    (the smear) */
     int nat;                    /* samples in at[] */
+    double c_on[RG_NJOINTS], c_off[RG_NJOINTS]; /* the smooth commanded path (fractional
+                                   steps) at the light's start and end: what shafts
+                                   moving continuously, not in steps, would follow */
     double t_on;                /* machine clock at the laser's rise (s) */
 } rg_sweep_shot;
 typedef struct rg_sweep_stats {
@@ -550,7 +553,9 @@ typedef struct rig_api {
      * before the first pulse, interlock and limits every control step, the key switch
      * and the heartbeat every step the laser is on, lateness, lost steps.  shot[k]
      * gets exposure k's mean motor position (may be NULL).  RG_OK, RG_EINVAL (not
-     * allowed: why), RG_ETRAVEL, RG_EDOSE, a fault's code, RG_ESTOP. */
+     * allowed: why), RG_ETRAVEL, RG_EDOSE, a fault's code, RG_ESTOP.  An exposure of
+     * at most half a control step is a pulse in the step's low half, after its STEP
+     * edges: no motor steps while the light is on. */
     int (*sweep)(rg_machine *m, const long *steps, long n, double expose_ms, rg_stop_fn stop,
                  void *ctx, rg_sweep_shot *shot, char *err, size_t cap);
     /* The same sweep's predicted time from start and what capped it (no machine). */

@@ -62,7 +62,8 @@ typedef struct tp_point {
                                    steps of the exposure (on the fly: the smear) */
     int npath;                  /* poses in path (1 at rest, 0: not exposed) */
     double blur_det, blur_cornea;   /* the smear's extent on the detector plane and on
-                                   the cornea, nominal eye (mm) */
+                                   the cornea, nominal eye (mm): the counted steps'
+                                   poses and the smooth path's over the exposure */
 } tp_point;
 
 /* The scan on the machine (tp_order.c, doc/scan-time.md). */
@@ -76,13 +77,17 @@ typedef struct tp_scan {
     double blur_det_max, blur_cornea_max;   /* the largest smear of an exposure (mm) */
     double blur_tol;            /* the smear the centroid tolerates (mm, detector) */
     int blur_over;              /* exposures over it (their spots rejected) */
+    double step_det_max;        /* on the fly: the largest distance on the detector
+                                   between the beam of the motors' counted steps and
+                                   of the smooth path at the pulse (mm): what a shaft
+                                   that lags its step count moves the spot */
 } tp_scan;
 
 /* Fixation drift (tp_drift.c): the true eye moved during the scan (simulation), and
- * its detection from the fitted spots: the eye's translation per time segment that
- * explains each segment's residuals, tested against one fixed pose. */
+ * its detection from the fitted spots: the model refitted with the eye's translation
+ * per time segment, the translations tested against one fixed pose. */
 enum { TP_DRIFT_NONE, TP_DRIFT_LINEAR, TP_DRIFT_SACCADE };
-#define TP_DRIFT_SEGMENTS 8
+#define TP_DRIFT_SEGMENTS 32
 typedef struct tp_drift {
     int kind;                   /* TP_DRIFT_*: slow (linear over the scan) or a saccade
                                    (a jump at the scan's middle) */
@@ -97,8 +102,17 @@ typedef struct tp_drift {
     int dof;
     double p;                   /* its probability */
     double range;               /* the largest lateral distance between segments (mm) */
-    int flagged;                /* 1: the eye moved (p < 0.001 and range over 2 um) */
+    int flagged;                /* 1: the eye moved (p < 0.001, range over 2 um, and
+                                   a pose per segment explains the misfit: the joint
+                                   fit's chi2/dof under TP_DRIFT_CHI2_MAX or under a
+                                   twentieth of the one-pose fit's) */
+    double joint_chi2_dof;      /* the joint fit's (a pose per segment) */
+    double single_chi2_dof;     /* the model's own fit's (one pose) */
+    int joint_fitted;           /* 1: joint holds the model refitted with a pose per
+                                   segment (the drift corrected) */
+    cn_result joint;
 } tp_drift;
+#define TP_DRIFT_CHI2_MAX 2.0
 
 typedef struct tp_times {       /* seconds of wall clock, per part */
     double plan, machine, trace, frames, fit, check, total;

@@ -53,22 +53,49 @@ static void sweep_limit(const rig_api *rg, const rg_sweep_stats *st, char *buf, 
 }
 
 /* The smear of point q's exposure on the nominal eye: the largest distance between
- * two of its poses' beams, on the detector plane and on the cornea. */
-static void smear(const tp_run *r, tp_point *q)
+ * the beams of its poses (the counted steps' samples, and the smooth path's at the
+ * light's start and end: shafts that move continuously), on the detector plane and
+ * on the cornea; *lag: the counted steps' mean pose against the smooth path's middle
+ * on the detector (0 at rest). */
+static void smear(const tp_run *r, tp_point *q, const rg_sweep_shot *sh, double *lag)
 {
-    rg_beam b[8];
+    rg_beam b[10];
+    rg_pose p[10];
     char e[RG_ERRMAX];
-    int nb = 0;
-    q->blur_det = q->blur_cornea = 0;
-    for (int i = 0; i < q->npath && i < 8; i++)
-        if (!r->rg->forward(r->g, &q->path[i], &b[nb], e, sizeof e)) nb++;
-    for (int a = 0; a < nb; a++)
+    int np = 0, nb = 0, ok[10];
+    q->blur_det = q->blur_cornea = *lag = 0;
+    for (int i = 0; i < q->npath && i < 8; i++) p[np++] = q->path[i];
+    if (sh) {
+        double mid[RG_NJOINTS];
+        to_pose(r->rig, sh->c_on, &p[np++]);
+        to_pose(r->rig, sh->c_off, &p[np++]);
+        for (int j = 0; j < RG_NJOINTS; j++) mid[j] = 0.5 * (sh->c_on[j] + sh->c_off[j]);
+        rg_pose pm;
+        rg_beam bm, bq;
+        to_pose(r->rig, mid, &pm);
+        if (!r->rg->forward(r->g, &pm, &bm, e, sizeof e) &&
+            !r->rg->forward(r->g, &q->pose, &bq, e, sizeof e)) {
+            double d = 0;
+            for (int i = 0; i < 3; i++) d += (bm.det[i] - bq.det[i]) * (bm.det[i] - bq.det[i]);
+            if (isfinite(d)) *lag = sqrt(d);
+        }
+    }
+    for (int i = 0; i < np; i++) {
+        ok[i] = !r->rg->forward(r->g, &p[i], &b[i], e, sizeof e);
+        nb += ok[i];
+    }
+    for (int a = 0; a < np; a++)
         for (int c = 0; c < a; c++) {
             double dd = 0, dc = 0;
+            if (!ok[a] || !ok[c]) continue;
             for (int i = 0; i < 3; i++) {
                 dd += (b[a].det[i] - b[c].det[i]) * (b[a].det[i] - b[c].det[i]);
                 dc += (b[a].spot[i] - b[c].spot[i]) * (b[a].spot[i] - b[c].spot[i]);
             }
+            /* the smear is within one sample set: the counted steps among themselves,
+               the smooth path's two ends together */
+            int same = (a < q->npath) == (c < q->npath);
+            if (!same) continue;
             if (isfinite(dd) && sqrt(dd) > q->blur_det) q->blur_det = sqrt(dd);
             if (isfinite(dc) && sqrt(dc) > q->blur_cornea) q->blur_cornea = sqrt(dc);
         }
@@ -113,7 +140,12 @@ int tp_scan_machine(tp_run *r, tp_exposed_fn after, void *ctx, char *err, size_t
         idx[m++] = k;
     }
     rg->position(r->m, start, NULL);
-    int fly = r->rig->expose_moving && !(r->rig->shutter_ms > 0) && rg->sweep && rg->sweep_time;
+    /* on the fly only for a pulse that fits between two control steps' STEP edges
+       (rig_api.sweep): a longer exposure would see the motors step during it, and one
+       mirror step moves the spot 0.2-0.4 mm on the detector, several times what the
+       centroid tolerates (doc/scan-time.md) */
+    int fly = r->rig->expose_moving && !(r->rig->shutter_ms > 0) && rg->sweep && rg->sweep_time &&
+              r->expose_ms * 1e3 <= 0.5 * r->rig->tick_us;
     if (m > 0 && rg->scan_order(r->rig, start, st, m, ord, e, sizeof e)) {
         snprintf(err, cap, "the scan order: %.400s", e);
         rc = CN_EINVAL;
@@ -188,7 +220,9 @@ int tp_scan_machine(tp_run *r, tp_exposed_fn after, void *ctx, char *err, size_t
         }
         q->seq = ++seq;
         r->nexposed++;
-        smear(r, q);
+        double lag;
+        smear(r, q, fly ? &shot[i] : NULL, &lag);
+        if (lag > r->sc.step_det_max) r->sc.step_det_max = lag;
         if (q->blur_det > r->sc.blur_det_max) r->sc.blur_det_max = q->blur_det;
         if (q->blur_cornea > r->sc.blur_cornea_max) r->sc.blur_cornea_max = q->blur_cornea;
         if (after && (rc = after(r, idx[ord[i]], ctx, err, cap))) goto out;
