@@ -32,7 +32,7 @@ sc_fly() {
                    END { d = e - h; exit !(d > 0 && t - d > 0 && t - d < 0.01) }' "$SC/f.log" &&
     grep -q '^Spots: 300 fitted, 0 rejected' "$SC/f.rec" &&
     awk '/^Errors:/ { r = $3; k = $7; exit !(r < 8 && r > -8 && k < 0.05 && k > -0.05) }' "$SC/f.rec" &&
-    grep -q '^Fixation: the eye.s pose in 8 time segments agrees with one pose' "$SC/f.rec" &&
+    grep -q '^Fixation: the eye.s pose in [0-9]* time segments agrees with one pose' "$SC/f.rec" &&
     grep -q '^Dose: 300 exposures of 0.02 ms' "$SC/f.rec"
 }
 check "scan: 300 points on the fly on the simulated chip (one 20 us pulse each, no VIOLATION, fitted)" sc_fly
@@ -55,10 +55,13 @@ sc_stopgo() {
     [ "$(grep -c ' laser 1$' "$SC/s.log")" -eq 100 ] && ! grep -q VIOLATION "$SC/s.log"
 }
 check "scan: stop and go where the rig does not allow pulses on the fly (planned order, laser at rest)" sc_stopgo
-# 4. the dose of the whole sweep is checked before its first pulse: a laser 400 times
-#    stronger is refused, and the log shows no light at all
+# 4. the dose of the whole sweep is checked before its first pulse: a laser 30 times
+#    stronger (single exposures shortened to 1 ms and the pump's hold to 0.1 ms, so the
+#    rig file itself is accepted) is refused, 1.21 times the MPE, and the log shows no
+#    light at all
 sc_dose() {
-    sed 's/^laser_power_mw .*/laser_power_mw 40/' "$RIGEX" > "$SC/d.rig"
+    sed 's/^laser_power_mw .*/laser_power_mw 3/; s/^max_on_ms .*/max_on_ms 1/; s/^heartbeat_timeout_ms .*/heartbeat_timeout_ms 0.1/' \
+        "$RIGEX" > "$SC/d.rig"
     sc_in "$SC/d.in" "$SC/d.rig" d.log rings 300 model 0.02
     ! sc_run d.in d.rec && grep -q 'refused before its first pulse' "$SC/d.rec" &&
         ! grep -q ' laser 1' "$SC/d.log" && ! grep -q ' light 1' "$SC/d.log"
