@@ -302,8 +302,7 @@ static int sim_set(rg_chip *c, int g, unsigned mask, unsigned val)
             s->sh->steps[j] += d;
             s->rise_dir[j] = d;
             s->pulses[j]++;
-            if (s->sh->laser && !s->realclock && !s->rig->expose_moving) {   /* on the
-                   fly (rig_api.sweep) only where the rig file allows it */
+            if (s->sh->laser && !s->realclock) {
                 s->violations++;
                 logs(s, "VIOLATION a step with the laser on", NULL);
             }

@@ -7,10 +7,13 @@
  * joint's speed and by one exposure per leg, each junction's speed by the joints'
  * turn there (the velocity jump u' |d_i - d_(i-1)| at most half the joint's
  * acceleration times the leg's duration 1/u'), ramps within the other half, a
- * backward then forward pass.  Every safety check of a move and an exposure stays:
- * the travel and the whole sweep's dose before the first pulse, the interlock and
- * the limit switches every control step, the key switch, the heartbeat and its
- * lateness every step the laser is on, STEP lateness, lost steps at the end. */
+ * backward then forward pass.  The pulse (at most half a control step) sits in a
+ * control step's low half, after its STEP edges: no motor steps while the light is
+ * on, and the simulator still logs a VIOLATION if one did.  Every safety check of a
+ * move and an exposure stays: the travel and the whole sweep's dose before the first
+ * pulse, the interlock and the limit switches every control step, the key switch,
+ * the heartbeat and its lateness at every pulse, STEP lateness, lost steps at the
+ * end. */
 #define _DEFAULT_SOURCE
 #include <math.h>
 #include <stdio.h>
@@ -222,14 +225,13 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
 {
     const rg_rig *rig = &m->rig;
     const rg_chip_ops *o = m->chip->ops;
-    int64_t tick = rg_tick_ns(rig), hold_ns = (int64_t)llround(rig->heartbeat_timeout_ms * 1e6);
-    int have_heart = rig->heartbeat.offset >= 0, rc;
+    int64_t tick = rg_tick_ns(rig), ms_ns = (int64_t)llround(ms * 1e6);
     unsigned heart = 0, lv = 0, ed = 0;
-    long cur = 0, kd, K, exp_i = 0, k_on = -1, nsum = 0;
-    double sum[RG_NJOINTS] = {0};
-    int dir[RG_NJOINTS] = {0};
+    long cur = 0, K, exp_i = 0;
+    int dir[RG_NJOINTS] = {0}, rc;
     leg *L = NULL;
     double T;
+    int64_t beat = 0;
     rg_dose d;
 
     if ((rc = rg_latched(m, err, cap))) return rc;
@@ -244,9 +246,11 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
                  "would smear the exposure", rig->shutter_ms);
         return RG_EINVAL;
     }
-    if (!(ms > 0) || ms > rig->max_on_ms) {
-        snprintf(err, cap, "an exposure of %g ms: it must be more than 0 and at most the "
-                 "rig's max_on_ms %g", ms, rig->max_on_ms);
+    if (!(ms > 0) || ms > rig->max_on_ms || ms_ns > tick / 2) {
+        snprintf(err, cap, "an exposure of %g ms on the fly: it must be more than 0, at most "
+                 "the rig's max_on_ms %g and fit in half a control step (%g ms at tick_us %g: "
+                 "a longer one would see the motors step during it)", ms, rig->max_on_ms,
+                 rig->tick_us / 2e3, rig->tick_us);
         return RG_EINVAL;
     }
     if (rig->heartbeat.offset < 0 && !rig->eye_safe_without_heartbeat) {
@@ -269,24 +273,17 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
     if (o->note) o->note(m->chip, "sweep (exposure on the fly)");
     /* the indicator stays on for the whole sweep, the emission delay once, at rest */
     o->set(m->chip, RG_G_INDICATOR, 1, 1);
-    int64_t t0 = o->now(m->chip) + (int64_t)llround(rig->emission_delay_ms * 1e6), beat = 0;
+    int64_t t0 = o->now(m->chip) + (int64_t)llround(rig->emission_delay_ms * 1e6);
     for (int64_t t = o->now(m->chip) + tick; t < t0 + tick; t += tick) {
         rg_wait(m, t < t0 ? t : t0);
         if ((rc = rg_guard(m, 2, err, cap))) goto out;
     }
-    /* the motion starts half an exposure (kd / 2 ticks) after t0, so exposure i runs
-       over ticks k_i .. k_i + kd with k_i = the tick of t_i (u = i) */
-    kd = (long)ceil(ms * 1e6 / tick - 1e-9);
-    if (kd < 1) kd = 1;
-    /* a pulse of at most half a control step sits in the step's low half */
-    int64_t ms_ns = (int64_t)llround(ms * 1e6);
-    int shortp = ms_ns <= tick / 2;
-    if (shortp) kd = 0;
-    int64_t half = kd * tick / 2;
-    K = (long)ceil((T * 1e9 + half) / tick) + kd + 2;
+    /* control step k: the joints to the smooth path at sweep time k tick (each at most
+       a step), then, at target i's tick (t_i / tick), the pulse in the step's low half */
+    K = (long)ceil(T * 1e9 / tick) + 2;
     for (long k = 1; k <= K; k++) {
         int64_t at = t0 + k * tick;
-        double tau = (k * tick - half) / 1e9;
+        double tau = k * tick / 1e9;
         unsigned mask = 0, dmask = 0, dval = 0;
         if (stop && stop(ctx)) {
             rg_laser_off(m);
@@ -301,115 +298,41 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
         for (int j = 0; j < RG_NJOINTS; j++) {
             const long *a = steps + (n > 1 ? cur : 0) * RG_NJOINTS, *b = a + (n > 1 ? RG_NJOINTS : 0);
             long want = tau >= T ? steps[(n - 1) * RG_NJOINTS + j] : lround(a[j] + f * (b[j] - a[j]));
-            int s = want > m->pos[j] ? 1 : want < m->pos[j] ? -1 : 0;
-            if (!s) continue;
-            if (s != dir[j]) {      /* DIR first, the step a control step later */
+            int sg = want > m->pos[j] ? 1 : want < m->pos[j] ? -1 : 0;
+            if (!sg) continue;
+            if (sg != dir[j]) {     /* DIR first, the step a control step later */
                 dmask |= 1u << j;
-                if ((s > 0) ^ rig->axis[j].dir_invert) dval |= 1u << j;
-                dir[j] = s;
+                if ((sg > 0) ^ rig->axis[j].dir_invert) dval |= 1u << j;
+                dir[j] = sg;
             } else mask |= 1u << j;
-        }
-        /* the laser's edges come at the control step, before its STEP edge */
-        long kon = -1;
-        if (exp_i < n) {
-            kon = (long)llround((exp_i ? L[exp_i - 1].t0 + L[exp_i - 1].T : 0) * 1e9 / tick);
-            if (kon < 1) kon = 1;
-        }
-        int rise = k_on < 0 && kon >= 1 && k >= kon, fall = k_on >= 0 && k == k_on + kd;
-        if (shortp) {
-            if (dmask) o->set(m->chip, RG_G_DIR, dmask, dval);
-            if (mask) {
-                if ((rc = rg_pulse(m, mask, at, tick, err, cap))) goto out;
-                for (int j = 0; j < RG_NJOINTS; j++)
-                    if (mask >> j & 1) m->pos[j] += dir[j];
-            } else {
-                rg_wait(m, at);
-                if ((rc = rg_guard(m, 0, err, cap))) goto out;
-            }
-            if (rise && (rc = pulse_between(m, at + tick / 2, ms_ns, &heart, &beat,
-                                            shot ? &shot[exp_i] : NULL, err, cap)))
-                goto out;
-            if (rise) {
-                if (shot) {
-                    double ton = (shot[exp_i].t_on * 1e9 - t0 - half) / 1e9;
-                    path_at(L, steps, n, T, ton, shot[exp_i].c_on);
-                    path_at(L, steps, n, T, ton + ms / 1e3, shot[exp_i].c_off);
-                }
-                exp_i++;
-            }
-            if (k == K && (exp_i < n || memcmp(m->pos, steps + (n - 1) * RG_NJOINTS, sizeof m->pos)))
-                K++;
-            if (K > k + 1000000) {
-                snprintf(err, cap, "sweep: the motion did not reach its last target");
-                rc = RG_EINVAL;
-                goto out;
-            }
-            continue;
-        }
-        if (rise || k_on >= 0) {
-            rg_wait(m, at);
-            int64_t now = o->now(m->chip);
-            if (k_on >= 0 && have_heart && now - beat > hold_ns) {
-                rc = rg_latch(m, RG_F_HEARTBEAT, RG_EFAULT, err, cap, "the sweep ran %.3f ms "
-                              "late with the laser on: the heartbeat pump (hold %g ms) has cut "
-                              "the beam", (now - beat) / 1e6, rig->heartbeat_timeout_ms);
-                goto out;
-            }
-            /* the interlock, the limits and (emitting) the key switch */
-            if ((rc = rg_guard(m, 1, err, cap))) goto out;
-            if (fall) {
-                laser(m, 0);
-                m->dose_n++;
-                m->dose_t += kd * tick / 1e9;
-                if (shot) {
-                    for (int j = 0; j < RG_NJOINTS; j++) shot[exp_i].mean[j] = sum[j] / nsum;
-                    path_at(L, steps, n, T, (k_on * tick - half) / 1e9, shot[exp_i].c_on);
-                    path_at(L, steps, n, T, (k * tick - half) / 1e9, shot[exp_i].c_off);
-                }
-                k_on = -1;
-                exp_i++;
-            } else {
-                if (have_heart) {   /* the pump charged first, as expose does */
-                    heart ^= 1;
-                    o->set(m->chip, RG_G_HEART, 1, heart);
-                    beat = o->now(m->chip);
-                }
-                if (rise) {
-                    k_on = k;
-                    nsum = 0;
-                    memset(sum, 0, sizeof sum);
-                    if (shot) {
-                        shot[exp_i].t_on = now / 1e9;
-                        shot[exp_i].nat = 0;
-                    }
-                    laser(m, 1);
-                }
-            }
         }
         if (dmask) o->set(m->chip, RG_G_DIR, dmask, dval);
         if (mask) {
             if ((rc = rg_pulse(m, mask, at, tick, err, cap))) goto out;
             for (int j = 0; j < RG_NJOINTS; j++)
                 if (mask >> j & 1) m->pos[j] += dir[j];
-        } else if (!(rise || fall || k_on >= 0)) {   /* (else waited and guarded above) */
+        } else {
             rg_wait(m, at);
             if ((rc = rg_guard(m, 0, err, cap))) goto out;
         }
-        if (k_on >= 0) {            /* where the motors stand during this control step */
-            nsum++;
-            for (int j = 0; j < RG_NJOINTS; j++) {
-                sum[j] += m->pos[j];
-            }
-            /* samples at control steps ceil(c (kd - 1) / 7), c = 0..7, of the exposure
-               (repeated when it has fewer steps: equal time weights) */
-            long ks = nsum - 1;
-            while (shot && shot[exp_i].nat < RG_SWEEP_SAMPLES &&
-                   ks >= (shot[exp_i].nat * (kd - 1) + RG_SWEEP_SAMPLES - 2) / (RG_SWEEP_SAMPLES - 1))
-                memcpy(shot[exp_i].at[shot[exp_i].nat++], m->pos, sizeof m->pos);
+        long kon = -1;
+        if (exp_i < n) {
+            kon = (long)llround((exp_i ? L[exp_i - 1].t0 + L[exp_i - 1].T : 0) * 1e9 / tick);
+            if (kon < 1) kon = 1;
         }
-        if (k == K && (k_on >= 0 || exp_i < n || memcmp(m->pos, steps + (n - 1) * RG_NJOINTS,
-                                                         sizeof m->pos)))
-            K++;                    /* a step or an exposure still due: one more tick */
+        if (kon >= 1 && k >= kon) {
+            if ((rc = pulse_between(m, at + tick / 2, ms_ns, &heart, &beat,
+                                    shot ? &shot[exp_i] : NULL, err, cap)))
+                goto out;
+            if (shot) {
+                double ton = (shot[exp_i].t_on * 1e9 - t0) / 1e9;
+                path_at(L, steps, n, T, ton, shot[exp_i].c_on);
+                path_at(L, steps, n, T, ton + ms / 1e3, shot[exp_i].c_off);
+            }
+            exp_i++;
+        }
+        if (k == K && (exp_i < n || memcmp(m->pos, steps + (n - 1) * RG_NJOINTS, sizeof m->pos)))
+            K++;                    /* a step or a pulse still due: one more tick */
         if (K > k + 1000000) {
             snprintf(err, cap, "sweep: the motion did not reach its last target");
             rc = RG_EINVAL;

@@ -376,14 +376,13 @@ typedef struct rg_scan_stats {
     const char *limit;          /* the largest single share, in words (static) */
 } rg_scan_stats;
 /* Exposure on the fly (rg_sweep.c, doc/scan-time.md): one continuous motion through
- * the targets, a pulse centred on the moment each is passed.  Per exposure: */
+ * the targets, a short pulse as each is passed.  Per exposure: */
 typedef struct rg_sweep_shot {
-    double mean[RG_NJOINTS];    /* the motors' mean position over the exposure (steps) */
+    double mean[RG_NJOINTS];    /* the motors' position during the pulse (steps: no
+                                   motor steps while the light is on) */
 #define RG_SWEEP_SAMPLES 8
-    long at[RG_SWEEP_SAMPLES][RG_NJOINTS];  /* where the motors stood at evenly spaced
-                                   control steps of it, the first and the last included
-                                   (the smear) */
-    int nat;                    /* samples in at[] */
+    long at[RG_SWEEP_SAMPLES][RG_NJOINTS];  /* the same, as counted steps (at[0]) */
+    int nat;                    /* entries in at[] (1) */
     double c_on[RG_NJOINTS], c_off[RG_NJOINTS]; /* the smooth commanded path (fractional
                                    steps) at the light's start and end: what shafts
                                    moving continuously, not in steps, would follow */
@@ -544,18 +543,18 @@ typedef struct rig_api {
     double (*clock_s)(const rg_machine *m);
     /* ---- exposure on the fly (rg_sweep.c, doc/scan-time.md) ---- */
     /* Visit n targets (rows of step counts) in the given order in one continuous
-     * motion, exposing expose_ms centred on each: a normal move to the first, then
+     * motion and fire a pulse of expose_ms at each: a normal move to the first, then
      * one profile through them all that slows for each turn (a joint's velocity jump
      * at a target at most half its acceleration times the leg's duration) and ramps
      * within half the acceleration, never faster than each joint's speed nor than one
-     * exposure per leg.  Needs 'expose_moving yes' and shutter_ms 0; every other
-     * check of move_steps and expose holds: travel and the session's dose for all n
-     * before the first pulse, interlock and limits every control step, the key switch
-     * and the heartbeat every step the laser is on, lateness, lost steps.  shot[k]
-     * gets exposure k's mean motor position (may be NULL).  RG_OK, RG_EINVAL (not
-     * allowed: why), RG_ETRAVEL, RG_EDOSE, a fault's code, RG_ESTOP.  An exposure of
-     * at most half a control step is a pulse in the step's low half, after its STEP
-     * edges: no motor steps while the light is on. */
+     * exposure per leg.  The pulse must fit in half a control step: it sits in the
+     * step's low half, after its STEP edges, so no motor steps while the light is on
+     * (the simulator's check stays on).  Needs 'expose_moving yes' and shutter_ms 0;
+     * every other check of move_steps and expose holds: travel and the session's
+     * dose for all n before the first pulse, interlock and limits every control step,
+     * the key switch and the heartbeat at every pulse, lateness, lost steps.
+     * shot[k] gets pulse k's motor position and time (may be NULL).  RG_OK,
+     * RG_EINVAL (not allowed: why), RG_ETRAVEL, RG_EDOSE, a fault's code, RG_ESTOP. */
     int (*sweep)(rg_machine *m, const long *steps, long n, double expose_ms, rg_stop_fn stop,
                  void *ctx, rg_sweep_shot *shot, char *err, size_t cap);
     /* The same sweep's predicted time from start and what capped it (no machine). */
