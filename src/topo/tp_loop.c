@@ -153,13 +153,13 @@ static void locate(const tp_run *r, im_centroider *cz, const im_frame *f, double
  * as the camera's Gaussian spot into a full sensor frame at the detector point, saved
  * when asked, then located.  Returns 0, or -1 when a frame could not be saved (why). */
 static int frame_spot(const tp_run *r, im_centroider *cz, const cn_plane *pl, int k,
-                      const double *hit, int nh, tp_point *q)
+                      const double *hit, tp_point *q)
 {
     const im_frame_api *F = r->im->frame;
     const tp_camera *c = &r->cam;
     im_sensor s;
     im_spot_src src;
-    im_hit h[8];
+    im_hit h;
     im_frame *f = NULL;
     char e[256];
     memset(&s, 0, sizeof s);
@@ -180,21 +180,16 @@ static int frame_spot(const tp_run *r, im_centroider *cz, const cn_plane *pl, in
     /* the electrons that give `peak` counts at the centre of a Gaussian of 1/e^2
        radius w pixels: peak * pi w^2 / 2 */
     double electrons = c->peak * s.gain * PI * c->spot_w * c->spot_w / 2;
-    /* on the fly: the beam's hits at the poses the motors held during the exposure,
-       the light shared between them (the smeared spot) */
-    if (nh < 1 || nh > 8) nh = 1;
-    memset(h, 0, sizeof h);
-    for (int i = 0; hit && i < nh; i++) {
-        memcpy(h[i].p, hit + 3 * i, sizeof h[i].p);
-        h[i].power = electrons / s.exposure * PLANCK_HC / LAMBDA_M / nh;
-    }
+    memset(&h, 0, sizeof h);
+    if (hit) memcpy(h.p, hit, sizeof h.p);
+    h.power = electrons / s.exposure * PLANCK_HC / LAMBDA_M;
     memset(&src, 0, sizeof src);
     src.kind = IM_SPOT_HITS_GAUSS;
-    src.hits = h;
-    src.nhits = nh;
+    src.hits = &h;
+    src.nhits = 1;
     src.waist = c->spot_w * c->pitch;   /* path 0: the waist is the spot */
     src.beam_lambda = LAMBDA_M * 1e3;
-    if (F->synth(&s, &src, hit ? nh : 0, r->seed + (uint64_t)k, 1, &f, e, sizeof e)) {
+    if (F->synth(&s, &src, hit ? 1 : 0, r->seed + (uint64_t)k, 1, &f, e, sizeof e)) {
         if (hit) {
             q->spot.status = CN_S_NONE;
             q->spot.u = q->spot.v = NAN;
@@ -282,44 +277,6 @@ static int cone_hit(const tp_run *r, const cn_plane *pl, const cn_params *truth,
     return 0;
 }
 
-/* On the fly: the beam through the true eye at each pose the motors held during the
- * exposure (q->path), for the smeared frame; var gets the hits' mean squared distance
- * from their mean (mm^2).  At rest (or when none lands): the one hit.  Returns the
- * count in hits. */
-static int smear_hits(const tp_run *r, const rg_geometry *gt, const cn_plane *pl,
-                      const cn_params *truth, const tp_point *q, const double hit[3],
-                      double hits[8][3], double *var)
-{
-    double uv[8][2], mu = 0, mv = 0;
-    int n = 0;
-    char why[96], e[RG_ERRMAX];
-    *var = 0;
-    for (int c = 0; q->npath > 1 && c < q->npath && c < 8; c++) {
-        tp_point t = *q;
-        if (r->bump) {
-            if (r->cn->ray_of_pose(r->rg, r->g, &q->path[c], &t.spot.ray, e, sizeof e) ||
-                cone_hit(r, pl, truth, &t, hits[n]))
-                continue;
-            uv[n][0] = t.hit_u;
-            uv[n][1] = t.hit_v;
-        } else if (traced_hit(r, gt, pl, &q->path[c], &uv[n][0], &uv[n][1], hits[n], why,
-                              sizeof why))
-            continue;
-        mu += uv[n][0];
-        mv += uv[n][1];
-        n++;
-    }
-    if (n == 0) {
-        memcpy(hits[0], hit, sizeof hits[0]);
-        return 1;
-    }
-    mu /= n;
-    mv /= n;
-    for (int c = 0; c < n; c++)
-        *var += ((uv[c][0] - mu) * (uv[c][0] - mu) + (uv[c][1] - mv) * (uv[c][1] - mv)) / (2 * n);
-    return n;
-}
-
 static void measure_one(job *j, im_centroider *cz, int k)
 {
     tp_run *r = j->r;
@@ -345,35 +302,30 @@ static void measure_one(job *j, im_centroider *cz, int k)
     }
     int miss = traced_hit(r, gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
                           sizeof q->why);
-    if (miss) free(gd);
     if (miss) {
+        free(gd);
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         /* the camera still takes the frame: it shows no spot */
-        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, 1, q))
+        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
             fail_job(j);
         return;
     }
     if (r->bump && cone_hit(r, &j->pl, &truth, q, hit)) {
         free(gd);
-        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, 1, q))
+        if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
             fail_job(j);
         return;
     }
-    double hits[8][3], var = 0;
-    int nh = smear_hits(r, gt, &j->pl, &truth, q, hit, hits, &var);
     free(gd);
     if (r->source == TP_SRC_FRAMES) {
-        if (frame_spot(r, cz, &j->pl, k, hits[0], nh, q)) fail_job(j);
+        if (frame_spot(r, cz, &j->pl, k, hit, q)) fail_job(j);
         return;
     }
-    /* the quick model: the smear widens the spot, and the centroid's sigma with it */
-    double sg = r->sigma * sqrt(1 + var / pow(0.5 * r->cam.spot_w * r->cam.pitch, 2));
     uint64_t s = r->seed * 0x9E3779B97F4A7C15ull ^ (uint64_t)k * 0xD1B54A32D192ED03ull;
     double nu = lm_gauss(&s), nv = lm_gauss(&s);
-    q->spot.u = q->hit_u + (r->sigma > 0 ? sg * nu : 0);
-    q->spot.v = q->hit_v + (r->sigma > 0 ? sg * nv : 0);
-    if (r->sigma > 0) q->spot.sigma = sg;
+    q->spot.u = q->hit_u + (r->sigma > 0 ? r->sigma * nu : 0);
+    q->spot.v = q->hit_v + (r->sigma > 0 ? r->sigma * nv : 0);
     q->spot.status = CN_S_OK;
 }
 
@@ -700,7 +652,11 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         goto fail;
     }
     r->fitted = 1;
-    if (r->m && tp_drift_test(r)) { snprintf(err, cap, "out of memory"); goto fail; }
+    if (r->m && (rc = tp_drift_test(r))) {     /* a pose per time segment (tp_drift.c) */
+        if (rc == CN_ESTOP || stopped(r)) { snprintf(err, cap, "stopped"); goto stop; }
+        snprintf(err, cap, "out of memory");
+        goto fail;
+    }
     /* check: the fitted cornea through the tracer for every fitted pose */
     if (r->tr) {
         r->phase = "the check against the tracer";
