@@ -94,8 +94,10 @@ static int segment(const tp_run *r, const cn_plane *pl, const cn_params *p, cons
             p1.p[CN_DX + c] += h;
             p2.p[CN_DX + c] -= h;
             if (cn->forward(r->model, &p1, apex0, pl, &q->ray, &u1, &v1, NULL, NULL) ||
-                cn->forward(r->model, &p2, apex0, pl, &q->ray, &u2, &v2, NULL, NULL))
+                cn->forward(r->model, &p2, apex0, pl, &q->ray, &u2, &v2, NULL, NULL)) {
                 bad = 1;
+                break;
+            }
             J[i][0][c] = (u1 - u2) / (2 * h);
             J[i][1][c] = (v1 - v2) / (2 * h);
         }

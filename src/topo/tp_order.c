@@ -62,7 +62,7 @@ static void smear(const tp_run *r, tp_point *q, const rg_sweep_shot *sh, double 
     rg_beam b[10];
     rg_pose p[10];
     char e[RG_ERRMAX];
-    int np = 0, nb = 0, ok[10];
+    int np = 0, ok[10];
     q->blur_det = q->blur_cornea = *lag = 0;
     for (int i = 0; i < q->npath && i < 8; i++) p[np++] = q->path[i];
     if (sh) {
@@ -80,10 +80,7 @@ static void smear(const tp_run *r, tp_point *q, const rg_sweep_shot *sh, double 
             if (isfinite(d)) *lag = sqrt(d);
         }
     }
-    for (int i = 0; i < np; i++) {
-        ok[i] = !r->rg->forward(r->g, &p[i], &b[i], e, sizeof e);
-        nb += ok[i];
-    }
+    for (int i = 0; i < np; i++) ok[i] = !r->rg->forward(r->g, &p[i], &b[i], e, sizeof e);
     for (int a = 0; a < np; a++)
         for (int c = 0; c < a; c++) {
             double dd = 0, dc = 0;
