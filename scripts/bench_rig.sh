@@ -12,7 +12,8 @@ S=build/obj/rig_tests/bench_safety
 [ -x "$S" ] || { echo "bench_rig: $S not built (make bench builds it)" >&2; exit 1; }
 "$S" golden/rig/example.rig || exit 1
 # the scan time (tests/rig/bench_scan.c, doc/scan-time.md): simulated time of 1000
-# spiral points, ordered and in the spiral's own order; BENCH cornea_scan1000_sim_s
+# spiral points, ordered and in the spiral's own order, stop and go (BENCH rig_scan1000_*;
+# cornea_scan1000_sim_s is scripts/bench_scan.sh's, through --cornea-scan)
 T=build/obj/rig_tests/bench_scan
 [ -x "$T" ] || { echo "bench_rig: $T not built (make bench builds it)" >&2; exit 1; }
 "$T" golden/rig/example.rig 1000 1.8 1 || exit 1

@@ -65,6 +65,7 @@ typedef struct cs {
     int tk;
     tp_iso iso;                 /* the zone pattern on a synthetic eye (have_iso 1) */
     int have_iso;
+    int real_clock;             /* the scan runs on a chip: its machine time varies */
     size_t len, cap;
 } cs;
 
@@ -360,6 +361,7 @@ int lm_cornea_scan(lm_io *io)
         goto out;
     if (s->have_rig) {
         if ((rc = calc_choice(c, CS(CHIP), CS(CHIP_WHAT), chips, &chip))) goto out;
+        s->real_clock = chip == 2;
         if ((chip == 1 &&
              (rc = lm_ask_file(io, CS(SIM_LOG), CS(SIM_LOG), CS(SIM_LOG_WHAT), check_log, s,
                                s->log, sizeof s->log))) ||
@@ -671,6 +673,43 @@ static void say_zone(cs *s, tp_run *r)
     }
 }
 
+/* The scan on the machine: its order and time, the smear of its exposures. */
+static void say_machine(cs *s, const tp_run *r)
+{
+    const tp_scan *c = &r->sc;
+    if (s->real_clock) {        /* the real clock's times: stdout only (replays) */
+        lm_say(s->cc.io, LM_OUT, CS(MACHINE_SCAN), r->nexposed,
+               c->on_fly ? "on the fly" : "stop and go",
+               c->reordered ? "the planner's" : "the pattern's", c->sim_s, c->pred_s,
+               c->pred_own_s, c->limit);
+        return;
+    }
+    say(s, CS(MACHINE_SCAN), r->nexposed, c->on_fly ? "on the fly" : "stop and go",
+        c->reordered ? "the planner's" : "the pattern's", c->sim_s, c->pred_s, c->pred_own_s,
+        c->limit);
+    say(s, CS(MACHINE_SMEAR), c->blur_det_max * 1e3, c->blur_tol * 1e3, c->blur_over,
+        c->blur_cornea_max * 1e3, c->step_det_max * 1e3);
+}
+
+/* The fixation test (tp_drift.c): the eye's pose per time segment. */
+static void say_fixation(cs *s, const tp_run *r)
+{
+    const tp_drift *d = &r->drift;
+    if (!d->segments) return;
+    if (!d->flagged && d->p < 1e-3 && d->range > 2e-3) {
+        say(s, CS(FIXATION_MISFIT), d->segments, d->chi2, d->dof, d->joint_chi2_dof);
+        return;
+    }
+    say(s, d->flagged ? CS(FIXATION_BAD) : CS(FIXATION_OK), d->segments, d->chi2, d->dof, d->p,
+        d->range * 1e3);
+    for (int i = 0; d->flagged && i < d->segments; i++)
+        say(s, CS(FIXATION_SEG), i + 1, d->t0[i], d->t1[i], d->d[i][0] * 1e3, d->d[i][1] * 1e3,
+            d->d[i][2] * 1e3, d->sd[i][0] * 1e3, d->sd[i][1] * 1e3, d->sd[i][2] * 1e3);
+    if (d->flagged && d->joint_fitted)
+        say(s, CS(FIXATION_JOINT), d->joint.par.p[CN_R], d->joint.k.Km, d->joint.k.cyl,
+            d->joint.k.K2_axis, d->joint.chi2_dof);
+}
+
 /* The measurement and its report. */
 static int run(cs *s, tp_run *r, rg_machine **m)
 {
@@ -693,6 +732,8 @@ static int run(cs *s, tp_run *r, rg_machine **m)
     if (r->zone_h > 0) say_passes(s, r);
     else say(s, CS(PLANNED), pname[r->pattern], r->npoints, r->zone / DEG, r->nplanned,
              r->nexposed);
+    if (*m)                     /* the order, the machine's time, the smear (tp_order.c) */
+        say_machine(s, r);
     double ssum = 0;
     int sn = 0;
     for (int k = 0; k < r->npoints; k++)
@@ -718,6 +759,7 @@ static int run(cs *s, tp_run *r, rg_machine **m)
         say(s, CS(DOSE), (int)r->dose.n, r->expose_ms, r->rig->laser_power_mw,
             r->rig->wavelength_nm, r->rig->beam_diameter_mm, r->dose.H_one, r->dose.H_total,
             r->dose.mpe_total, r->dose.limit, r->dose.fraction, 1 / r->dose.fraction);
+    say_fixation(s, r);
     say(s, CS(SPOTS), counts[CN_S_OK],
         counts[CN_S_NONE] + counts[CN_S_SEVERAL] + counts[CN_S_OUTLIER] + counts[CN_S_MISS],
         counts[CN_S_NONE], counts[CN_S_SEVERAL], counts[CN_S_OUTLIER], counts[CN_S_MISS],

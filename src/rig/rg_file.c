@@ -91,7 +91,7 @@ static int line_spec(reader *r, const char *key, char **w, int nw, rg_line *l)
 enum { G_CHIP, G_LASER, G_INTERLOCK, G_HEART, G_MAXON, G_TICK, G_HTIMEOUT, G_HOMETO,
        G_SETTLE, G_SIMRT, G_SIMIL, G_SIMILMS, G_CAM, G_CPITCH, G_CPIX, G_CNOISE, G_CSEED,
        G_WAIST, G_EYESAFE, G_POWER, G_WAVE, G_BEAMD, G_KEY, G_INDIC, G_SHUT, G_EDELAY,
-       G_SHUTMS, G_PULSE, G_LATE, G_DEBOUNCE, G_SIMILC, G_SIMKEY, G_STALLAT, G_STALL, NG };
+       G_SHUTMS, G_PULSE, G_LATE, G_DEBOUNCE, G_SIMILC, G_SIMKEY, G_STALLAT, G_STALL, G_MOVING, NG };
 static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "max_on_ms", "tick_us", "heartbeat_timeout_ms", "home_timeout_s", "settle_ms",
     "sim_realtime", "sim_interlock", "sim_interlock_open_ms", "camera", "camera_pitch",
@@ -99,7 +99,7 @@ static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "eye_safe_without_heartbeat", "laser_power_mw", "wavelength_nm", "beam_diameter_mm",
     "key_switch", "emission_indicator", "shutter", "emission_delay_ms", "shutter_ms",
     "step_pulse_us", "max_late_us", "home_debounce_ms", "sim_interlock_close_ms",
-    "sim_key_off_ms", "sim_stall_at_ms", "sim_stall_ms"};
+    "sim_key_off_ms", "sim_stall_at_ms", "sim_stall_ms", "expose_moving"};
 enum { A_STEP, A_DIR, A_ENABLE, A_HOME, A_STEPS, A_MIN, A_MAX, A_SPEED, A_ACCEL,
        A_HOMEAT, A_HOMEDIR, A_HOMESPEED, A_DIRINV, A_SIMHOME, A_LIMIT, A_PULLOFF,
        A_LOCATE, A_SIMLIMIT, A_SIMLOSE, NA };
@@ -205,6 +205,7 @@ static int global_key(reader *r, int k, char **w, int nw)
     case G_SIMKEY: return ranged(r, w[0], a, 0, 1e12, &g->sim_key_off_ms);
     case G_STALLAT: return ranged(r, w[0], a, 0, 1e12, &g->sim_stall_at_ms);
     case G_STALL: return ranged(r, w[0], a, 0, 1e9, &g->sim_stall_ms);
+    case G_MOVING: return yesno(r, w[0], a, "yes", "no", &g->expose_moving);
     }
     return 0;
 }

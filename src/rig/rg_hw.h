@@ -94,6 +94,14 @@ int  rg_scan_time(const rg_rig *rig, const long start[RG_NJOINTS], const long *s
                   size_t cap);
 const char *rg_scan_limit_text(const rg_scan_stats *st, char *buf, size_t cap);
 void rg_wait(rg_machine *m, int64_t deadline);  /* sleep_until + lateness record */
+int  rg_pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick, char *err, size_t cap);
+int  rg_settle(rg_machine *m, char *err, size_t cap);
+int  rg_lost_steps(rg_machine *m, char *err, size_t cap);
+/* rg_sweep.c */
+int  rg_sweep(rg_machine *m, const long *steps, long n, double expose_ms, rg_stop_fn stop,
+              void *ctx, rg_sweep_shot *shot, char *err, size_t cap);
+int  rg_sweep_time(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps, long n,
+                   double expose_ms, rg_sweep_stats *st, char *err, size_t cap);
 /* rg_safety.c */
 int  rg_open(const rg_rig *rig, const rg_open_opts *o, rg_machine **m, char *err,
              size_t cap);

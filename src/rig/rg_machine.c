@@ -137,4 +137,6 @@ void rg_machine_fill(rig_api *a)
     a->scan_time = rg_scan_time;
     a->scan_limit_text = rg_scan_limit_text;
     a->clock_s = clock_s;
+    a->sweep = rg_sweep;
+    a->sweep_time = rg_sweep_time;
 }

@@ -113,7 +113,7 @@ static int stopped(rg_stop_fn stop, void *ctx) { return stop && stop(ctx); }
  * but never sooner than step_pulse_us after the rise really happened.  First the
  * guard (interlock, limits) and the lateness: a rise later than max_late_us is not
  * sent (the motion stops, latched).  0 or the fault's code. */
-static int pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick, char *err, size_t cap)
+int rg_pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick, char *err, size_t cap)
 {
     const rg_chip_ops *o = m->chip->ops;
     int64_t rise, fall, late, maxlate = (int64_t)llround(m->rig.max_late_us * 1e3);
@@ -223,7 +223,7 @@ int rg_plan_move(const rg_rig *rig, const long from[RG_NJOINTS], const long to[R
 }
 
 /* settle_ms at rest, the guard still read every control step. */
-static int settle(rg_machine *m, char *err, size_t cap)
+int rg_settle(rg_machine *m, char *err, size_t cap)
 {
     const rg_chip_ops *o = m->chip->ops;
     int64_t tick = rg_tick_ns(&m->rig), end = o->now(m->chip) + (int64_t)llround(m->rig.settle_ms * 1e6);
@@ -238,7 +238,7 @@ static int settle(rg_machine *m, char *err, size_t cap)
 
 /* Where the chip knows the motors (the simulator; an encoder would do the same): a
  * motor that is not where it was sent lost steps. */
-static int lost_steps(rg_machine *m, char *err, size_t cap)
+int rg_lost_steps(rg_machine *m, char *err, size_t cap)
 {
     long real[RG_NJOINTS];
     if (!m->chip->ops->motors || !m->chip->ops->motors(m->chip, real)) return 0;
@@ -283,7 +283,7 @@ int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop,
             long want = k == K ? n[j] : (long)floor(n[j] * s);
             if (want > done[j]) { mask |= 1u << j; done[j]++; }
         }
-        if (mask && (rc = pulse(m, mask, t0 + k * tick, tick, err, cap))) {
+        if (mask && (rc = rg_pulse(m, mask, t0 + k * tick, tick, err, cap))) {
             for (int j = 0; j < RG_NJOINTS; j++)
                 if (mask >> j & 1) done[j]--;      /* not sent */
             for (int j = 0; j < RG_NJOINTS; j++) m->pos[j] += sign[j] * done[j];
@@ -299,7 +299,7 @@ int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop,
                     if (done[j] < n[j]) { mask |= 1u << j; done[j]++; behind = 1; }
                 if (behind) {
                     K++;
-                    if ((rc = pulse(m, mask, t0 + K * tick, tick, err, cap))) {
+                    if ((rc = rg_pulse(m, mask, t0 + K * tick, tick, err, cap))) {
                         for (int j = 0; j < RG_NJOINTS; j++) {
                             if (mask >> j & 1) done[j]--;
                             m->pos[j] += sign[j] * done[j];
@@ -312,8 +312,8 @@ int rg_move_steps(rg_machine *m, const long target[RG_NJOINTS], rg_stop_fn stop,
         }
     }
     for (int j = 0; j < RG_NJOINTS; j++) m->pos[j] = target[j];
-    if ((rc = settle(m, err, cap))) return rc;
-    if ((rc = lost_steps(m, err, cap))) return rc;
+    if ((rc = rg_settle(m, err, cap))) return rc;
+    if ((rc = rg_lost_steps(m, err, cap))) return rc;
     note(m, "moved");
     return 0;
 }
@@ -387,7 +387,7 @@ static int home_phase(rg_machine *m, unsigned axes, int toward, int slow, int di
             if (acc[j] >= 1) { acc[j] -= 1; mask |= 1u << j; }
         }
         if (mask) {
-            if ((rc = pulse(m, mask, t, tick, err, cap))) { note(m, "stopped (fault)"); return rc; }
+            if ((rc = rg_pulse(m, mask, t, tick, err, cap))) { note(m, "stopped (fault)"); return rc; }
             for (int j = 0; j < RG_NJOINTS; j++)
                 if (mask >> j & 1) { m->pos[j] += sign[j]; togo[j]--; }
         } else {
@@ -437,7 +437,7 @@ int rg_home(rg_machine *m, rg_stop_fn stop, void *ctx, char *err, size_t cap)
         if (x->home.offset >= 0) m->pos[j] -= x->home_dir * lround(x->home_pulloff * x->steps_per);
     }
     note(m, "homed");                /* then settle_ms before anything else */
-    if ((rc = settle(m, err, cap))) return rc;
+    if ((rc = rg_settle(m, err, cap))) return rc;
     m->homed = 1;
     return 0;
 }

@@ -298,6 +298,8 @@ typedef struct rg_rig {
     double sim_key_off_ms;      /* simulator: the key switch turns off at this time */
     double sim_stall_at_ms;     /* simulator: the controller is preempted at this time */
     double sim_stall_ms;        /* ... for this long (a missed deadline) */
+    int expose_moving;          /* "expose_moving yes": the laser may pulse while the axes
+                                   move (rig_api.sweep, doc/scan-time.md); 0: never */
 } rg_rig;
 
 /* Latched faults (LinuxCNC's estop_latch model): the first one is kept; laser off
@@ -373,6 +375,31 @@ typedef struct rg_scan_stats {
     double path[RG_NJOINTS];    /* each joint's summed travel (steps) */
     const char *limit;          /* the largest single share, in words (static) */
 } rg_scan_stats;
+/* Exposure on the fly (rg_sweep.c, doc/scan-time.md): one continuous motion through
+ * the targets, a short pulse as each is passed.  Per exposure: */
+typedef struct rg_sweep_shot {
+    double mean[RG_NJOINTS];    /* the motors' position during the pulse (steps: no
+                                   motor steps while the light is on) */
+#define RG_SWEEP_SAMPLES 8
+    long at[RG_SWEEP_SAMPLES][RG_NJOINTS];  /* the same, as counted steps (at[0]) */
+    int nat;                    /* entries in at[] (1) */
+    double c_on[RG_NJOINTS], c_off[RG_NJOINTS]; /* the smooth commanded path (fractional
+                                   steps) at the light's start and end: what shafts
+                                   moving continuously, not in steps, would follow */
+    double t_on;                /* machine clock at the laser's rise (s) */
+} rg_sweep_shot;
+typedef struct rg_sweep_stats {
+    long n;                     /* targets */
+    double t_total;             /* predicted: the move to the first target, its settle,
+                                   the sweep, the last exposure, the final settle (s) */
+    double t_sweep;             /* the continuous motion alone (s) */
+    int lim_speed[RG_NJOINTS];  /* segments whose cruise each joint's speed capped */
+    int lim_accel[RG_NJOINTS];  /* ... whose ramps each joint's acceleration capped */
+    int lim_turn[RG_NJOINTS];   /* junctions whose speed each joint's turn capped */
+    int lim_expose;             /* segments capped by one exposure each (no overlap) */
+    double v_max[RG_NJOINTS];   /* fastest speed of each joint during an exposure
+                                   (steps/s) */
+} rg_sweep_stats;
 /* ==== end of the machine ========================================================= */
 
 
@@ -514,6 +541,25 @@ typedef struct rig_api {
     /* The machine's clock (s): simulated time on the simulator, the real clock on
      * a chip. */
     double (*clock_s)(const rg_machine *m);
+    /* ---- exposure on the fly (rg_sweep.c, doc/scan-time.md) ---- */
+    /* Visit n targets (rows of step counts) in the given order in one continuous
+     * motion and fire a pulse of expose_ms at each: a normal move to the first, then
+     * one profile through them all that slows for each turn (a joint's velocity jump
+     * at a target at most half its acceleration times the leg's duration) and ramps
+     * within half the acceleration, never faster than each joint's speed nor than one
+     * exposure per leg.  The pulse must fit in half a control step: it sits in the
+     * step's low half, after its STEP edges, so no motor steps while the light is on
+     * (the simulator's check stays on).  Needs 'expose_moving yes' and shutter_ms 0;
+     * every other check of move_steps and expose holds: travel and the session's
+     * dose for all n before the first pulse, interlock and limits every control step,
+     * the key switch and the heartbeat at every pulse, lateness, lost steps.
+     * shot[k] gets pulse k's motor position and time (may be NULL).  RG_OK,
+     * RG_EINVAL (not allowed: why), RG_ETRAVEL, RG_EDOSE, a fault's code, RG_ESTOP. */
+    int (*sweep)(rg_machine *m, const long *steps, long n, double expose_ms, rg_stop_fn stop,
+                 void *ctx, rg_sweep_shot *shot, char *err, size_t cap);
+    /* The same sweep's predicted time from start and what capped it (no machine). */
+    int (*sweep_time)(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps,
+                      long n, double expose_ms, rg_sweep_stats *st, char *err, size_t cap);
 } rig_api;
 
 typedef const rig_api *(*rig_get_api_fn)(int abi);

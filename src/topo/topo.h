@@ -57,6 +57,15 @@ typedef struct tp_point {
     char why[96];               /* why the point gave no spot */
     int measured;               /* 1: its spot was made (traced, framed, located) */
     int saved;                  /* 1: its frame was written (r->save) */
+    /* the scan on the machine (tp_order.c): when it was exposed and how it moved */
+    double t_s;                 /* the exposure's middle on the machine's clock, s from
+                                   the scan's first move (NaN: not exposed) */
+    rg_pose path[8];            /* the poses the motors held at evenly spaced control
+                                   steps of the exposure (on the fly: the smear) */
+    int npath;                  /* poses in path (1 at rest, 0: not exposed) */
+    double blur_det, blur_cornea;   /* the smear's extent on the detector plane and on
+                                   the cornea, nominal eye (mm): the counted steps'
+                                   poses and the smooth path's over the exposure */
 } tp_point;
 
 /* The clinical zone (issue 19 item 4): the adaptive passes and the coverage of the
@@ -95,6 +104,53 @@ typedef struct tp_iso { tp_iso_zone z[TP_ISO_NZONE]; } tp_iso;
 /* The true surface for the report: its sag z(x, y) in its own eye frame (mm, into the
  * eye; 0, or -1 off the surface), placed in the rig by place->rot and place->trans. */
 typedef int (*tp_sag_fn)(void *ctx, double x, double y, double *z);
+/* The scan on the machine (tp_order.c, doc/scan-time.md). */
+typedef struct tp_scan {
+    int on_fly;                 /* 1: exposed on the fly (rig_api.sweep); 0: stop and go */
+    int reordered;              /* 1: the planner's order; 0: the pattern's own */
+    double sim_s;               /* the machine's clock from the first move to the last
+                                   exposure's end (s) */
+    double pred_s, pred_own_s;  /* predicted: the order run; the pattern's own order */
+    char limit[320];            /* what limits the time, in words */
+    double blur_det_max, blur_cornea_max;   /* the largest smear of an exposure (mm) */
+    double blur_tol;            /* the smear the centroid tolerates (mm, detector) */
+    int blur_over;              /* exposures over it (their spots rejected) */
+    double step_det_max;        /* on the fly: the largest distance on the detector
+                                   between the beam of the motors' counted steps and
+                                   of the smooth path at the pulse (mm): what a shaft
+                                   that lags its step count moves the spot */
+} tp_scan;
+
+/* Fixation drift (tp_drift.c): the true eye moved during the scan (simulation), and
+ * its detection from the fitted spots: the model refitted with the eye's translation
+ * per time segment, the translations tested against one fixed pose. */
+enum { TP_DRIFT_NONE, TP_DRIFT_LINEAR, TP_DRIFT_SACCADE };
+#define TP_DRIFT_SEGMENTS 32
+typedef struct tp_drift {
+    int kind;                   /* TP_DRIFT_*: slow (linear over the scan) or a saccade
+                                   (a jump at the scan's middle) */
+    double amp;                 /* the apex's total lateral displacement (mm) */
+    double dir;                 /* its direction in the rig's x-y plane (rad from x) */
+    /* detection (after the fit) */
+    int segments;               /* time segments used (0: not tested) */
+    double d[TP_DRIFT_SEGMENTS][3];     /* each segment's eye translation (mm) */
+    double sd[TP_DRIFT_SEGMENTS][3];    /* and its standard deviation */
+    double t0[TP_DRIFT_SEGMENTS], t1[TP_DRIFT_SEGMENTS];  /* the segment's times (s) */
+    double chi2;                /* of the segments against one pose */
+    int dof;
+    double p;                   /* its probability */
+    double range;               /* the largest lateral distance between segments (mm) */
+    int flagged;                /* 1: the eye moved (p < 0.001, range over 2 um, and
+                                   a pose per segment explains the misfit: the joint
+                                   fit's chi2/dof under TP_DRIFT_CHI2_MAX or under a
+                                   twentieth of the one-pose fit's) */
+    double joint_chi2_dof;      /* the joint fit's (a pose per segment) */
+    double single_chi2_dof;     /* the model's own fit's (one pose) */
+    int joint_fitted;           /* 1: joint holds the model refitted with a pose per
+                                   segment (the drift corrected) */
+    cn_result joint;
+} tp_drift;
+#define TP_DRIFT_CHI2_MAX 2.0
 
 typedef struct tp_times {       /* seconds of wall clock, per part */
     double plan, machine, trace, frames, fit, check, total;
@@ -178,6 +234,8 @@ typedef struct tp_run {
     tp_pass pass[TP_MAXPASS];
     rg_geometry zone_g;         /* measure_zone: the last pass's planning geometry */
     tp_cover cover;             /* measure_zone: the data's coverage per zone */
+    tp_scan sc;                 /* the scan's order, machine time and smear (tp_order.c) */
+    tp_drift drift;             /* fixation drift: simulated and detected (tp_drift.c) */
 } tp_run;
 
 

@@ -26,4 +26,14 @@ void tp_cover_zones(const tp_run *r, tp_cover *c);
 int tp_iso_report(const tp_run *r, tp_sag_fn sag, void *ctx, const rg_cornea *place,
                   tp_iso *out);
 int tp_truth_sag(void *ctx, double x, double y, double *z);
+/* tp_order.c: the scan on the machine in the planner's order, stop and go or on the
+ * fly; after(r, k, ...) once per exposure of point k, in scan order (0 or an error) */
+typedef int (*tp_exposed_fn)(tp_run *r, int k, void *ctx, char *err, size_t cap);
+int tp_scan_machine(tp_run *r, tp_exposed_fn after, void *ctx, char *err, size_t cap);
+double tp_blur_tol(const tp_run *r);
+
+/* tp_drift.c: the true eye of point q under the simulated drift (its apex moved by
+ * the drift at q->t); and the drift test on the fitted spots (r->drift) */
+void tp_drift_eye(const tp_run *r, const tp_point *q, rg_geometry *gt, cn_params *tp);
+int tp_drift_test(tp_run *r);
 #endif

@@ -264,10 +264,11 @@ static int take(job *j, int finished)
 /* With a cone: the hit of point q's beam through the true eye with the cone, by the
  * cornea engine's analytic model (equal to the tracer's on the eye without it to
  * 1e-12 mm); 0, or -1 (status NONE, why said) when the beam misses. */
-static int cone_hit(const tp_run *r, const cn_plane *pl, tp_point *q, double hit[3])
+static int cone_hit(const tp_run *r, const cn_plane *pl, const cn_params *truth, tp_point *q,
+                    double hit[3])
 {
     cn_spot b = q->spot;
-    if (r->cn->reimage(r->g, CN_BICONIC, &r->truth_p, r->bump, 0, 0, &b, 1) != 1) {
+    if (r->cn->reimage(r->g, CN_BICONIC, truth, r->bump, 0, 0, &b, 1) != 1) {
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         snprintf(q->why, sizeof q->why, "the beam misses the cornea with its cone");
@@ -294,9 +295,19 @@ static void measure_one(job *j, im_centroider *cz, int k)
     }
     if (r->source == TP_SRC_CAMERA) return;       /* located as each frame was read */
     q->spot.sigma = r->sigma > 0 ? r->sigma : 1e-4;
-    if (r->hit ? tp_outside_hit(r, &j->pl, q, hit)
-               : traced_hit(r, &j->gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
-                            sizeof q->why)) {
+    const rg_geometry *gt = &j->gt;     /* the true eye, moved by a simulated drift */
+    rg_geometry *gd = NULL;
+    cn_params truth = r->truth_p;
+    if (r->drift.kind != TP_DRIFT_NONE && (gd = malloc(sizeof *gd))) {
+        *gd = j->gt;
+        tp_drift_eye(r, q, gd, &truth);
+        gt = gd;
+    }
+    int miss = r->hit ? tp_outside_hit(r, &j->pl, q, hit)
+                      : traced_hit(r, gt, &j->pl, &q->pose, &q->hit_u, &q->hit_v, hit, q->why,
+                                   sizeof q->why);
+    if (miss) {
+        free(gd);
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = NAN;
         /* the camera still takes the frame: it shows no spot */
@@ -304,11 +315,13 @@ static void measure_one(job *j, im_centroider *cz, int k)
             fail_job(j);
         return;
     }
-    if (!r->hit && r->bump && cone_hit(r, &j->pl, q, hit)) {
+    if (!r->hit && r->bump && cone_hit(r, &j->pl, &truth, q, hit)) {
+        free(gd);
         if (r->source == TP_SRC_FRAMES && r->save && frame_spot(r, cz, &j->pl, k, NULL, q))
             fail_job(j);
         return;
     }
+    free(gd);
     if (r->source == TP_SRC_FRAMES) {
         if (frame_spot(r, cz, &j->pl, k, hit, q)) fail_job(j);
         return;
@@ -430,6 +443,14 @@ static void shot_widen(tp_run *r)
 
 static int stopped(const tp_run *r);
 
+/* Camera frames on a machine: one read after each exposure, in scan order. */
+typedef struct cam_ctx { im_source *src; im_centroider *cz; int got; } cam_ctx;
+static int cam_after(tp_run *r, int k, void *ctx, char *err, size_t cap)
+{
+    cam_ctx *c = ctx;
+    return camera_read(r, c->src, c->cz, &r->pt[k], c->got++, err, cap) ? CN_EINVAL : 0;
+}
+
 /* The surface from the data (issue 19): a reference sphere fitted to the measured
  * spots (their statuses before the model's fit: a spot the model calls an outlier
  * may be the cone), the Zernike slope fit in its frame, the keratoconus indices.  A
@@ -524,6 +545,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         q->t = tg[k];
         q->spot.status = CN_S_NONE;
         q->spot.u = q->spot.v = q->hit_u = q->hit_v = NAN;
+        q->t_s = NAN;
         if (rg->solve(pg, &q->t, NULL, &s, e, sizeof e) ||
             rg->quantise(pg, &q->t, &s, &qu, e, sizeof e)) {
             snprintf(q->why, sizeof q->why, "not planned: %.80s", e);
@@ -568,30 +590,13 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         r->have_dose = 1;
     }
     r->phase = "the scan on the machine";
-    if (r->m) {
-        for (int k = 0; k < n; k++) {
-            tp_point *q = &r->pt[k];
-            long steps[RG_NJOINTS];
-            if (!q->planned) continue;
-            if (rg->pose_steps(r->rig, &q->pose, steps, e, sizeof e)) {
-                q->planned = 0;
-                snprintf(q->why, sizeof q->why, "not moved: %.80s", e);
-                continue;
-            }
-            int rc = rg->move_steps(r->m, steps, r->stop, r->stop_ctx, e, sizeof e);
-            if (!rc) rc = rg->expose(r->m, r->expose_ms, r->stop, r->stop_ctx, e, sizeof e);
-            if (rc) {
-                CAMERA_DONE();
-                if (rc == RG_ESTOP || stopped(r)) { snprintf(err, cap, "stopped"); return CN_ESTOP; }
-                snprintf(err, cap, "point %d: %s", k + 1, e);
-                return CN_EINVAL;
-            }
-            if (rg->motors(r->m, steps))        /* where the motors really stood */
-                for (int jn = 0; jn < RG_NJOINTS; jn++)
-                    q->pose.j[jn] = steps[jn] / r->rig->axis[jn].steps_per *
-                                    (jn == RG_J_U || jn == RG_J_V ? 1 : PI / 180);
-            r->nexposed++;
-            if (src && camera_read(r, src, ccz, q, got++, err, cap)) { CAMERA_DONE(); return CN_EINVAL; }
+    if (r->m) {                 /* in the planner's order, stop and go or on the fly */
+        cam_ctx cc = {src, ccz, 0};
+        int rc = tp_scan_machine(r, src ? cam_after : NULL, &cc, err, cap);
+        if (rc) {
+            CAMERA_DONE();
+            if (rc == CN_ESTOP || stopped(r)) { snprintf(err, cap, "stopped"); return CN_ESTOP; }
+            return rc == CN_ENOMEM ? CN_ENOMEM : CN_EINVAL;
         }
     }
     for (int k = 0; src && !r->m && k < n; k++) {
@@ -603,7 +608,7 @@ int tp_measure(tp_run *r, char *err, size_t cap)
     r->gain = NAN;
     r->shot_factor = 1;
     if (r->source == TP_SRC_CAMERA) shot_widen(r);
-    for (int k = 0, seq = 0; k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
+    for (int k = 0, seq = 0; !r->m && k < n; k++) r->pt[k].seq = r->pt[k].planned ? ++seq : 0;
     r->tm.machine = now() - t;
     /* detect: the traced spot of each exposure, its frame and centroid */
     r->phase = r->source == TP_SRC_FRAMES ? "the frames and their centroids"
@@ -661,6 +666,11 @@ int tp_measure(tp_run *r, char *err, size_t cap)
         goto fail;
     }
     r->fitted = 1;
+    if (r->m && (rc = tp_drift_test(r))) {     /* a pose per time segment (tp_drift.c) */
+        if (rc == CN_ESTOP || stopped(r)) { snprintf(err, cap, "stopped"); goto stop; }
+        snprintf(err, cap, "out of memory");
+        goto fail;
+    }
     /* check: the fitted cornea through the tracer for every fitted pose */
     if (r->tr) {
         r->phase = "the check against the tracer";

@@ -1,5 +1,5 @@
 /* bench_scan.c -- the scan time (doc/scan-time.md, issue 19 item 6):
- *   BENCH cornea_scan1000_sim_s  1000 targets of the sunflower spiral (height
+ *   BENCH rig_scan1000_stopgo_sim_s  1000 targets of the sunflower spiral (height
  *       zone*sqrt((k+0.5)/n), meridian k * the golden angle), solved and quantised,
  *       ordered by rig_api.scan_order and run on the simulated machine through
  *       rig_api.move_steps and expose: simulated seconds from the first move to the
@@ -7,7 +7,7 @@
  *   baseline in the same run: the same targets in the spiral's own order.  Also the
  *   predicted times (rig_api.scan_time) and where the time goes.
  * argv: RIG [N [ZONE_MM [EXPOSE_MS [TAG]]]] (defaults 1000, 1.8, 1); with TAG the
- * BENCH names are cornea_scan1000_TAG_sim_s (a variant rig, scripts/bench_rig.sh). */
+ * BENCH names are rig_scan1000_TAG_sim_s (a variant rig, scripts/bench_rig.sh). */
 #define _GNU_SOURCE
 #include <math.h>
 #include <stdio.h>
@@ -130,11 +130,11 @@ int main(int argc, char **argv)
                ok * ms / 1e3, lb + ok * ms / 1e3);
     }
     if (argc > 5) {
-        printf("BENCH cornea_scan1000_%s_sim_s %.3f s\n", argv[5], sim1);
-        printf("BENCH cornea_scan1000_%s_unordered_sim_s %.3f s\n", argv[5], sim0);
+        printf("BENCH rig_scan1000_%s_sim_s %.3f s\n", argv[5], sim1);
+        printf("BENCH rig_scan1000_%s_unordered_sim_s %.3f s\n", argv[5], sim0);
     } else {
-        printf("BENCH cornea_scan1000_sim_s %.3f s\n", sim1);
-        printf("BENCH cornea_scan1000_unordered_sim_s %.3f s\n", sim0);
+        printf("BENCH rig_scan1000_stopgo_sim_s %.3f s\n", sim1);
+        printf("BENCH rig_scan1000_unordered_sim_s %.3f s\n", sim0);
     }
     free(steps);
     free(order);
