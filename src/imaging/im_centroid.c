@@ -291,13 +291,31 @@ static double mf_at(const im_frame *f, const mfk *k, int cx, int cy, double nois
         r0 += gx;
         r2 += gx * gx;
     }
-    double S1 = 0, S0 = 0, S2 = 0, Sv = 0;
-    for (int y = y0; y <= y1; y++) {
+    double S1 = 0, S0 = 0, S2 = 0, Sv = 0, gx[2 * MF_MAXR + 1];
+    for (int x = x0; x <= x1; x++) gx[x - x0] = k->g[abs(x - cx)];
+    /* two rows at a time: their sums are independent chains (the adds' latency, not
+       their number, bounds this loop), each summed in the same order as one at a time */
+    int y = y0;
+    for (; y + 1 <= y1; y += 2) {
+        const uint16_t *ra = f->px + (size_t)y * W, *rb = ra + W;
+        double ga = k->g[abs(y - cy)], gb = k->g[abs(y + 1 - cy)];
+        double a1 = 0, av = 0, b1 = 0, bv = 0;
+        for (int x = x0; x <= x1; x++) {
+            double va = ra[x], vb = rb[x];
+            a1 += gx[x - x0] * va;
+            av += va;
+            b1 += gx[x - x0] * vb;
+            bv += vb;
+        }
+        S1 += ga * a1; S0 += ga * r0; S2 += ga * ga * r2; Sv += av;
+        S1 += gb * b1; S0 += gb * r0; S2 += gb * gb * r2; Sv += bv;
+    }
+    for (; y <= y1; y++) {
         const uint16_t *row = f->px + (size_t)y * W;
         double gy = k->g[abs(y - cy)], r1 = 0, rv = 0;
         for (int x = x0; x <= x1; x++) {
             double v = row[x];
-            r1 += k->g[abs(x - cx)] * v;
+            r1 += gx[x - x0] * v;
             rv += v;
         }
         S1 += gy * r1;
@@ -397,6 +415,9 @@ static long region(im_centroider *c, const im_frame *f, const mfk *k, double noi
 typedef float im_v8f __attribute__((vector_size(32), aligned(4)));
 #define v8_load(p) (*(const im_v8f *)(p))
 #define v8_store(p, v) (*(im_v8f *)(p) = (v))
+typedef uint32_t im_v8u __attribute__((vector_size(32), aligned(2), may_alias));
+typedef int32_t im_v8i __attribute__((vector_size(32)));
+#define v8u_load(p) (*(const im_v8u *)(const void *)(p))
 
 /* out[x] = g[0] mid[x] + sum_j g[j] (up[j][x] + dn[j][x]), j = 1 .. R (the column
  * pass: up, dn the rows j above and below). */
@@ -454,7 +475,14 @@ __attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
 static void bin_row(const uint16_t *restrict a, const uint16_t *restrict b,
                     const float *restrict tb, float *restrict o, int n)
 {
-    for (int x = 0; x < n; x++)
+    int x = 0;
+    /* eight pixel pairs a vector: a pair read as one 32-bit word, its halves added */
+    for (; x + 8 <= n; x += 8) {
+        im_v8u pa = v8u_load(a + 2 * x), pb = v8u_load(b + 2 * x);
+        im_v8u t = ((pa & 0xffff) + (pa >> 16)) + ((pb & 0xffff) + (pb >> 16));
+        v8_store(o + x, __builtin_convertvector((im_v8i)t, im_v8f) - v8_load(tb + x));
+    }
+    for (; x < n; x++)
         o[x] = (float)((int32_t)a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1]) - tb[x];
 }
 /* The screen's binned row by (ring row by % MF_RING): four pixels summed less four
