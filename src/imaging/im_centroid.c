@@ -135,7 +135,7 @@ static double select_k(double *a, int n, int k)
 /* Column accumulators of one row: the maximum of every sample (a spot anywhere must be
  * seen), sums and sums of squares of every second row (the background statistics need
  * no more).  Written once, compiled per processor (AVX-512, AVX2, baseline). */
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 static void acc_row(const uint16_t *restrict row, int W, int stats, uint16_t *restrict cmax,
                     uint32_t *restrict csum, uint64_t *restrict csq)
 {
@@ -293,22 +293,25 @@ static double mf_at(const im_frame *f, const mfk *k, int cx, int cy, double nois
     }
     double S1 = 0, S0 = 0, S2 = 0, Sv = 0, gx[2 * MF_MAXR + 1];
     for (int x = x0; x <= x1; x++) gx[x - x0] = k->g[abs(x - cx)];
-    /* two rows at a time: their sums are independent chains (the adds' latency, not
+    /* four rows at a time: their sums are independent chains (the adds' latency, not
        their number, bounds this loop), each summed in the same order as one at a time */
     int y = y0;
-    for (; y + 1 <= y1; y += 2) {
-        const uint16_t *ra = f->px + (size_t)y * W, *rb = ra + W;
-        double ga = k->g[abs(y - cy)], gb = k->g[abs(y + 1 - cy)];
-        double a1 = 0, av = 0, b1 = 0, bv = 0;
+    for (; y + 3 <= y1; y += 4) {
+        const uint16_t *r0p = f->px + (size_t)y * W, *r1p = r0p + W, *r2p = r1p + W,
+                       *r3p = r2p + W;
+        double a1 = 0, av = 0, b1 = 0, bv = 0, c1 = 0, cv = 0, d1 = 0, dv = 0;
         for (int x = x0; x <= x1; x++) {
-            double va = ra[x], vb = rb[x];
-            a1 += gx[x - x0] * va;
-            av += va;
-            b1 += gx[x - x0] * vb;
-            bv += vb;
+            double g = gx[x - x0], va = r0p[x], vb = r1p[x], vc = r2p[x], vd = r3p[x];
+            a1 += g * va; av += va;
+            b1 += g * vb; bv += vb;
+            c1 += g * vc; cv += vc;
+            d1 += g * vd; dv += vd;
         }
-        S1 += ga * a1; S0 += ga * r0; S2 += ga * ga * r2; Sv += av;
-        S1 += gb * b1; S0 += gb * r0; S2 += gb * gb * r2; Sv += bv;
+        double q1[4] = {a1, b1, c1, d1}, qv[4] = {av, bv, cv, dv};
+        for (int l = 0; l < 4; l++) {
+            double gy = k->g[abs(y + l - cy)];
+            S1 += gy * q1[l]; S0 += gy * r0; S2 += gy * gy * r2; Sv += qv[l];
+        }
     }
     for (; y <= y1; y++) {
         const uint16_t *row = f->px + (size_t)y * W;
@@ -412,21 +415,22 @@ static long region(im_centroider *c, const im_frame *f, const mfk *k, double noi
  * with no contraction (-ffp-contract=off): the same float whatever the vector width,
  * the same as a pass per tap over whole rows gives.  Eight lanes at a time in GCC's
  * vector extension, the tail one by one. */
-typedef float im_v8f __attribute__((vector_size(32), aligned(4)));
+#define IM_VN 16                /* lanes: one AVX-512 register, two AVX2, four SSE2 */
+typedef float im_v8f __attribute__((vector_size(4 * IM_VN), aligned(4)));
 #define v8_load(p) (*(const im_v8f *)(p))
 #define v8_store(p, v) (*(im_v8f *)(p) = (v))
-typedef uint32_t im_v8u __attribute__((vector_size(32), aligned(2), may_alias));
-typedef int32_t im_v8i __attribute__((vector_size(32)));
+typedef uint32_t im_v8u __attribute__((vector_size(4 * IM_VN), aligned(2), may_alias));
+typedef int32_t im_v8i __attribute__((vector_size(4 * IM_VN)));
 #define v8u_load(p) (*(const im_v8u *)(const void *)(p))
 
 /* out[x] = g[0] mid[x] + sum_j g[j] (up[j][x] + dn[j][x]), j = 1 .. R (the column
  * pass: up, dn the rows j above and below). */
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 static void f_col(float *restrict out, const float *mid, const float *const *up,
                   const float *const *dn, const float *g, int R, int n)
 {
     int x = 0;
-    for (; x + 8 <= n; x += 8) {
+    for (; x + IM_VN <= n; x += IM_VN) {
         im_v8f a = g[0] * v8_load(mid + x);
         for (int j = 1; j <= R; j++) a = a + g[j] * (v8_load(up[j] + x) + v8_load(dn[j] + x));
         v8_store(out + x, a);
@@ -439,12 +443,12 @@ static void f_col(float *restrict out, const float *mid, const float *const *up,
 }
 /* out[x] = (g[0] in[x] + sum_j g[j] (in[x - j] + in[x + j])) norm (the row pass, in
  * read from -R to n + R). */
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 static void f_row(float *restrict out, const float *in, const float *g, int R, float norm,
                   int n)
 {
     int x = 0;
-    for (; x + 8 <= n; x += 8) {
+    for (; x + IM_VN <= n; x += IM_VN) {
         im_v8f a = g[0] * v8_load(in + x);
         for (int j = 1; j <= R; j++) a = a + g[j] * (v8_load(in + x - j) + v8_load(in + x + j));
         v8_store(out + x, a * norm);
@@ -461,7 +465,7 @@ static void f_row(float *restrict out, const float *in, const float *g, int R, f
 #else
 #define IM_FINITE
 #endif
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default"))) IM_FINITE
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) IM_FINITE
 static float row_max(const float *restrict a, int n)
 {
     float m = a[0];
@@ -471,13 +475,13 @@ static float row_max(const float *restrict a, int n)
 /* o[x] = (four pixels of rows a and b summed) - tb[x]: the sum exact in integers
  * (signed: under 2^18, and a signed conversion is one instruction), then one rounding
  * to float and one in the subtraction. */
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 static void bin_row(const uint16_t *restrict a, const uint16_t *restrict b,
                     const float *restrict tb, float *restrict o, int n)
 {
     int x = 0;
     /* eight pixel pairs a vector: a pair read as one 32-bit word, its halves added */
-    for (; x + 8 <= n; x += 8) {
+    for (; x + IM_VN <= n; x += IM_VN) {
         im_v8u pa = v8u_load(a + 2 * x), pb = v8u_load(b + 2 * x);
         im_v8u t = ((pa & 0xffff) + (pa >> 16)) + ((pb & 0xffff) + (pb >> 16));
         v8_store(o + x, __builtin_convertvector((im_v8i)t, im_v8f) - v8_load(tb + x));
