@@ -113,21 +113,36 @@ static int prepare(im_centroider *c, int w, int h)
     return 0;
 }
 
-/* k-th smallest of a[0..n) (a is reordered). */
+/* Moves the elements of a[lo..hi] for which (strict ? v < p : v <= p) to the front,
+ * without branches (a noisy frame's tile statistics are in random order, so a branch
+ * on each comparison is mispredicted half the time); their count. */
+static int part_le(double *a, int lo, int hi, double p, int strict)
+{
+    int st = lo;
+    for (int i = lo; i <= hi; i++) {
+        double v = a[i], t = a[st];
+        int in = strict ? v < p : v <= p;
+        a[i] = in ? t : v;
+        a[st] = in ? v : t;
+        st += in;
+    }
+    return st - lo;
+}
+
+/* k-th smallest of a[0..n) (a is reordered): quickselect on the median of three,
+ * each range split three ways (below, equal to, above the pivot), so that equal
+ * values - a noiseless frame's tiles - end it at once. */
 static double select_k(double *a, int n, int k)
 {
     int lo = 0, hi = n - 1;
     while (lo < hi) {
-        double piv = a[(lo + hi) / 2];
-        int i = lo, j = hi;
-        while (i <= j) {
-            while (a[i] < piv) i++;
-            while (a[j] > piv) j--;
-            if (i <= j) { double t = a[i]; a[i] = a[j]; a[j] = t; i++; j--; }
-        }
-        if (k <= j) hi = j;
-        else if (k >= i) lo = i;
-        else break;
+        double x = a[lo], y = a[(lo + hi) / 2], z = a[hi];
+        double piv = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
+        int nl = part_le(a, lo, hi, piv, 1);
+        if (k < lo + nl) { hi = lo + nl - 1; continue; }
+        int ne = part_le(a, lo + nl, hi, piv, 0);
+        if (k < lo + nl + ne) return piv;
+        lo = lo + nl + ne;
     }
     return a[k];
 }
