@@ -16,6 +16,7 @@
 #define TILE 16
 #define MF_MAXR 24             /* the matched filter's half-width: ceil(2 w), w <= 12 */
 #define MF_MAXRB 12            /* ... on the 2x2-binned screen */
+#define MF_RING (2 * MF_MAXRB + 1)  /* binned rows the screen holds at once */
 #define MF_MAXCAND 4096        /* screen candidates examined per frame at most */
 #define MF_MAXREG 20000        /* pixels of one region above threshold at most */
 
@@ -34,12 +35,12 @@ struct im_centroider {
        the exact statistic per pixel (NaN: not computed), the region mask, and the
        pixels touched (reset after each frame) */
     int bw, bh, pw;            /* bins across, down; padded row length */
-    float *bin, *bcol, *scr;
+    float *bin, *bcol, *tb4, *scr;
     float *tmap;
     uint8_t *rmask;
     int *touched, *reg;
     size_t ntouched, touched_cap, reg_cap;
-    uint32_t *trow;
+    float *rmax;               /* the screen's maximum on each of its rows */
 };
 
 im_centroider *im_centroider_new(void) { return calloc(1, sizeof(im_centroider)); }
@@ -48,12 +49,12 @@ static void release(im_centroider *c)
 {
     free(c->mask); free(c->list); free(c->tmean); free(c->tmax); free(c->cmax);
     free(c->csum); free(c->csq);
-    free(c->bin); free(c->bcol); free(c->scr); free(c->tmap); free(c->rmask);
-    free(c->touched); free(c->reg); free(c->trow);
+    free(c->bin); free(c->bcol); free(c->tb4); free(c->scr); free(c->tmap); free(c->rmask);
+    free(c->touched); free(c->reg); free(c->rmax);
     c->mask = NULL; c->list = NULL; c->tmean = NULL; c->tmax = NULL; c->cmax = NULL;
     c->csum = NULL; c->csq = NULL;
-    c->bin = c->bcol = c->scr = c->tmap = NULL; c->rmask = NULL;
-    c->touched = c->reg = NULL; c->trow = NULL;
+    c->bin = c->bcol = c->tb4 = c->scr = c->tmap = NULL; c->rmask = NULL;
+    c->touched = c->reg = NULL; c->rmax = NULL;
     c->ntouched = c->touched_cap = c->reg_cap = 0;
     c->list_cap = 0;
     c->w = c->h = 0;
@@ -85,19 +86,21 @@ static int prepare(im_centroider *c, int w, int h)
     c->bw = w / 2;
     c->bh = h / 2;
     c->pw = c->bw + 2 * MF_MAXRB;
-    size_t pb = (size_t)c->pw * (size_t)(c->bh + 2 * MF_MAXRB);
-    c->bin = calloc(pb, sizeof(float));
-    c->bcol = malloc(sizeof(float) * (size_t)c->pw * (size_t)(c->bh > 0 ? c->bh : 1));
+    /* the screen's binned rows: a ring of MF_RING rows and a row of zeros (the rows
+       beyond the frame), their padding columns zero for good; one column-pass row */
+    c->bin = calloc((size_t)c->pw * (MF_RING + 1), sizeof(float));
+    c->bcol = calloc((size_t)c->pw, sizeof(float));
+    c->tb4 = malloc(sizeof(float) * (size_t)(c->bw > 0 ? c->bw : 1));
     c->scr = malloc(sizeof(float) * (size_t)(c->bw > 0 ? c->bw : 1) * (size_t)(c->bh > 0 ? c->bh : 1));
     c->tmap = malloc(sizeof(float) * (size_t)w * h);
     c->rmask = calloc((size_t)w * h, 1);
     c->touched_cap = c->reg_cap = 1024;
     c->touched = malloc(sizeof(int) * c->touched_cap);
     c->reg = malloc(sizeof(int) * c->reg_cap);
-    c->trow = malloc(sizeof(uint32_t) * (size_t)w);
+    c->rmax = malloc(sizeof(float) * (size_t)(c->bh > 0 ? c->bh : 1));
     if (!c->mask || !c->tmean || !c->tmax || !c->list || !c->cmax || !c->csum || !c->csq ||
-        !c->bin || !c->bcol || !c->scr || !c->tmap || !c->rmask || !c->touched || !c->reg ||
-        !c->trow) {
+        !c->bin || !c->bcol || !c->tb4 || !c->scr || !c->tmap || !c->rmask || !c->touched || !c->reg ||
+        !c->rmax) {
         release(c);
         return -1;
     }
@@ -110,21 +113,36 @@ static int prepare(im_centroider *c, int w, int h)
     return 0;
 }
 
-/* k-th smallest of a[0..n) (a is reordered). */
+/* Moves the elements of a[lo..hi] for which (strict ? v < p : v <= p) to the front,
+ * without branches (a noisy frame's tile statistics are in random order, so a branch
+ * on each comparison is mispredicted half the time); their count. */
+static int part_le(double *a, int lo, int hi, double p, int strict)
+{
+    int st = lo;
+    for (int i = lo; i <= hi; i++) {
+        double v = a[i], t = a[st];
+        int in = strict ? v < p : v <= p;
+        a[i] = in ? t : v;
+        a[st] = in ? v : t;
+        st += in;
+    }
+    return st - lo;
+}
+
+/* k-th smallest of a[0..n) (a is reordered): quickselect on the median of three,
+ * each range split three ways (below, equal to, above the pivot), so that equal
+ * values - a noiseless frame's tiles - end it at once. */
 static double select_k(double *a, int n, int k)
 {
     int lo = 0, hi = n - 1;
     while (lo < hi) {
-        double piv = a[(lo + hi) / 2];
-        int i = lo, j = hi;
-        while (i <= j) {
-            while (a[i] < piv) i++;
-            while (a[j] > piv) j--;
-            if (i <= j) { double t = a[i]; a[i] = a[j]; a[j] = t; i++; j--; }
-        }
-        if (k <= j) hi = j;
-        else if (k >= i) lo = i;
-        else break;
+        double x = a[lo], y = a[(lo + hi) / 2], z = a[hi];
+        double piv = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
+        int nl = part_le(a, lo, hi, piv, 1);
+        if (k < lo + nl) { hi = lo + nl - 1; continue; }
+        int ne = part_le(a, lo + nl, hi, piv, 0);
+        if (k < lo + nl + ne) return piv;
+        lo = lo + nl + ne;
     }
     return a[k];
 }
@@ -132,7 +150,7 @@ static double select_k(double *a, int n, int k)
 /* Column accumulators of one row: the maximum of every sample (a spot anywhere must be
  * seen), sums and sums of squares of every second row (the background statistics need
  * no more).  Written once, compiled per processor (AVX-512, AVX2, baseline). */
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 static void acc_row(const uint16_t *restrict row, int W, int stats, uint16_t *restrict cmax,
                     uint32_t *restrict csum, uint64_t *restrict csq)
 {
@@ -288,13 +306,34 @@ static double mf_at(const im_frame *f, const mfk *k, int cx, int cy, double nois
         r0 += gx;
         r2 += gx * gx;
     }
-    double S1 = 0, S0 = 0, S2 = 0, Sv = 0;
-    for (int y = y0; y <= y1; y++) {
+    double S1 = 0, S0 = 0, S2 = 0, Sv = 0, gx[2 * MF_MAXR + 1];
+    for (int x = x0; x <= x1; x++) gx[x - x0] = k->g[abs(x - cx)];
+    /* four rows at a time: their sums are independent chains (the adds' latency, not
+       their number, bounds this loop), each summed in the same order as one at a time */
+    int y = y0;
+    for (; y + 3 <= y1; y += 4) {
+        const uint16_t *r0p = f->px + (size_t)y * W, *r1p = r0p + W, *r2p = r1p + W,
+                       *r3p = r2p + W;
+        double a1 = 0, av = 0, b1 = 0, bv = 0, c1 = 0, cv = 0, d1 = 0, dv = 0;
+        for (int x = x0; x <= x1; x++) {
+            double g = gx[x - x0], va = r0p[x], vb = r1p[x], vc = r2p[x], vd = r3p[x];
+            a1 += g * va; av += va;
+            b1 += g * vb; bv += vb;
+            c1 += g * vc; cv += vc;
+            d1 += g * vd; dv += vd;
+        }
+        double q1[4] = {a1, b1, c1, d1}, qv[4] = {av, bv, cv, dv};
+        for (int l = 0; l < 4; l++) {
+            double gy = k->g[abs(y + l - cy)];
+            S1 += gy * q1[l]; S0 += gy * r0; S2 += gy * gy * r2; Sv += qv[l];
+        }
+    }
+    for (; y <= y1; y++) {
         const uint16_t *row = f->px + (size_t)y * W;
         double gy = k->g[abs(y - cy)], r1 = 0, rv = 0;
         for (int x = x0; x <= x1; x++) {
             double v = row[x];
-            r1 += k->g[abs(x - cx)] * v;
+            r1 += gx[x - x0] * v;
             rv += v;
         }
         S1 += gy * r1;
@@ -386,29 +425,54 @@ static long region(im_centroider *c, const im_frame *f, const mfk *k, double noi
     return (long)tail;
 }
 
-/* Vectorisable float kernels of the screen (written once, compiled per processor). */
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
-static void f_scal(float *restrict out, const float *restrict a, float g, int n)
+/* The screen's kernels, written once and compiled per processor.  Each output value
+ * is one expression evaluated left to right, g0 a + g1 (b1 + c1) + g2 (b2 + c2) + ...,
+ * with no contraction (-ffp-contract=off): the same float whatever the vector width,
+ * the same as a pass per tap over whole rows gives.  Eight lanes at a time in GCC's
+ * vector extension, the tail one by one. */
+#define IM_VN 16                /* lanes: one AVX-512 register, two AVX2, four SSE2 */
+typedef float im_v8f __attribute__((vector_size(4 * IM_VN), aligned(4)));
+#define v8_load(p) (*(const im_v8f *)(p))
+#define v8_store(p, v) (*(im_v8f *)(p) = (v))
+typedef uint32_t im_v8u __attribute__((vector_size(4 * IM_VN), aligned(2), may_alias));
+typedef int32_t im_v8i __attribute__((vector_size(4 * IM_VN)));
+#define v8u_load(p) (*(const im_v8u *)(const void *)(p))
+
+/* out[x] = g[0] mid[x] + sum_j g[j] (up[j][x] + dn[j][x]), j = 1 .. R (the column
+ * pass: up, dn the rows j above and below). */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+static void f_col(float *restrict out, const float *mid, const float *const *up,
+                  const float *const *dn, const float *g, int R, int n)
 {
-    for (int x = 0; x < n; x++) out[x] = g * a[x];
+    int x = 0;
+    for (; x + IM_VN <= n; x += IM_VN) {
+        im_v8f a = g[0] * v8_load(mid + x);
+        for (int j = 1; j <= R; j++) a = a + g[j] * (v8_load(up[j] + x) + v8_load(dn[j] + x));
+        v8_store(out + x, a);
+    }
+    for (; x < n; x++) {
+        float a = g[0] * mid[x];
+        for (int j = 1; j <= R; j++) a = a + g[j] * (up[j][x] + dn[j][x]);
+        out[x] = a;
+    }
 }
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
-static void f_axpy2(float *restrict out, const float *restrict a, const float *restrict b,
-                    float g, int n)
+/* out[x] = (g[0] in[x] + sum_j g[j] (in[x - j] + in[x + j])) norm (the row pass, in
+ * read from -R to n + R). */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+static void f_row(float *restrict out, const float *in, const float *g, int R, float norm,
+                  int n)
 {
-    for (int x = 0; x < n; x++) out[x] += g * (a[x] + b[x]);
-}
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
-static void rows_add(const uint16_t *restrict a, const uint16_t *restrict b,
-                     uint32_t *restrict out, int n)
-{
-    for (int x = 0; x < n; x++) out[x] = (uint32_t)a[x] + b[x];
-}
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default")))
-static void bin_row(const uint32_t *restrict t, const float *restrict tb, float *restrict o,
-                    int n)
-{
-    for (int x = 0; x < n; x++) o[x] = (float)(t[2 * x] + t[2 * x + 1]) - tb[x];
+    int x = 0;
+    for (; x + IM_VN <= n; x += IM_VN) {
+        im_v8f a = g[0] * v8_load(in + x);
+        for (int j = 1; j <= R; j++) a = a + g[j] * (v8_load(in + x - j) + v8_load(in + x + j));
+        v8_store(out + x, a * norm);
+    }
+    for (; x < n; x++) {
+        float a = g[0] * in[x];
+        for (int j = 1; j <= R; j++) a = a + g[j] * (in[x - j] + in[x + j]);
+        out[x] = a * norm;
+    }
 }
 /* (finite values only: GCC vectorises the max when told so) */
 #if defined(__GNUC__) && !defined(__clang__)
@@ -416,45 +480,69 @@ static void bin_row(const uint32_t *restrict t, const float *restrict tb, float 
 #else
 #define IM_FINITE
 #endif
-__attribute__((target_clones("arch=skylake-avx512", "avx2", "default"))) IM_FINITE
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) IM_FINITE
 static float row_max(const float *restrict a, int n)
 {
     float m = a[0];
     for (int x = 1; x < n; x++) m = a[x] > m ? a[x] : m;
     return m;
 }
+/* o[x] = (four pixels of rows a and b summed) - tb[x]: the sum exact in integers
+ * (signed: under 2^18, and a signed conversion is one instruction), then one rounding
+ * to float and one in the subtraction. */
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+static void bin_row(const uint16_t *restrict a, const uint16_t *restrict b,
+                    const float *restrict tb, float *restrict o, int n)
+{
+    int x = 0;
+    /* eight pixel pairs a vector: a pair read as one 32-bit word, its halves added */
+    for (; x + IM_VN <= n; x += IM_VN) {
+        im_v8u pa = v8u_load(a + 2 * x), pb = v8u_load(b + 2 * x);
+        im_v8u t = ((pa & 0xffff) + (pa >> 16)) + ((pb & 0xffff) + (pb >> 16));
+        v8_store(o + x, __builtin_convertvector((im_v8i)t, im_v8f) - v8_load(tb + x));
+    }
+    for (; x < n; x++)
+        o[x] = (float)((int32_t)a[2 * x] + a[2 * x + 1] + b[2 * x] + b[2 * x + 1]) - tb[x];
+}
+/* The screen's binned row by (ring row by % MF_RING): four pixels summed less four
+ * times their tile's local background (c->tb4 holds it for the tile row *tbrow). */
+static void screen_bin(im_centroider *c, const im_frame *f, int by, int *tbrow)
+{
+    int W = f->width, bw = c->bw, ty = (2 * by) / TILE;
+    if (ty != *tbrow) {
+        const double *tb = c->tbg + (size_t)ty * c->ntx;
+        for (int bx = 0; bx < bw; bx++) c->tb4[bx] = (float)(4 * tb[(2 * bx) / TILE]);
+        *tbrow = ty;
+    }
+    const uint16_t *a = f->px + (size_t)(2 * by) * W;
+    bin_row(a, a + W, c->tb4, c->bin + (size_t)(by % MF_RING) * c->pw + MF_MAXRB, bw);
+}
 
 /* The screen: 2x2 bins less four times their tile's local background, filtered by
  * the kernel at the bins' spacing (columns, then rows; zero beyond the frame), in
- * SNR units of the bins' noise (2 sigma).  Only where it points is T computed. */
+ * SNR units of the bins' noise (2 sigma).  Only where it points is T computed.  One
+ * pass down the frame: the binned rows live in a ring of 2 Rb + 1 rows and the column
+ * pass in one row, so the frame is read once and only the result leaves the cache;
+ * every value is computed by the same operations in the same order as a filter over
+ * whole binned planes would (the same floats). */
 static void screen(im_centroider *c, const im_frame *f, const mfk *k, double noise)
 {
-    int W = f->width, bw = c->bw, bh = c->bh, pw = c->pw, Rb = k->Rb, M = MF_MAXRB;
-    float *P = c->bin, *tb4 = c->scr;     /* scr: scratch until the last pass */
-    for (int by = 0; by < bh; by++) {
-        const uint16_t *a = f->px + (size_t)(2 * by) * W;
-        if ((2 * by) % TILE == 0) {         /* four times the tile's background per bin */
-            const double *tb = c->tbg + (size_t)((2 * by) / TILE) * c->ntx;
-            for (int bx = 0; bx < bw; bx++) tb4[bx] = (float)(4 * tb[(2 * bx) / TILE]);
-        }
-        rows_add(a, a + W, c->trow, 2 * bw);
-        bin_row(c->trow, tb4, P + (size_t)(by + M) * pw + M, bw);
-    }
+    int bw = c->bw, bh = c->bh, pw = c->pw, Rb = k->Rb, M = MF_MAXRB, tbrow = -1;
+    const float *zero = c->bin + (size_t)MF_RING * pw;
     int c0 = M - Rb, cw = bw + 2 * Rb;    /* the columns the row pass reads */
-    for (int by = 0; by < bh; by++) {
-        float *o = c->bcol + (size_t)by * pw + c0;
-        const float *mid = P + (size_t)(by + M) * pw + c0;
-        f_scal(o, mid, k->gb[0], cw);
-        for (int j = 1; j <= Rb; j++)
-            f_axpy2(o, mid - (size_t)j * pw, mid + (size_t)j * pw, k->gb[j], cw);
-    }
     float norm = (float)(1 / (2 * noise * sqrt(k->gb2)));
-    for (int by = 0; by < bh; by++) {
-        const float *in = c->bcol + (size_t)by * pw + M;
-        float *o = c->scr + (size_t)by * bw;
-        f_scal(o, in, k->gb[0], bw);
-        for (int j = 1; j <= Rb; j++) f_axpy2(o, in - j, in + j, k->gb[j], bw);
-        for (int bx = 0; bx < bw; bx++) o[bx] *= norm;
+    /* bottom up: the frame's last rows, the ones pass 1 read last, are still cached */
+    for (int by = bh - 1; by >= bh - Rb && by >= 0; by--) screen_bin(c, f, by, &tbrow);
+    for (int by = bh - 1; by >= 0; by--) {
+        if (by - Rb >= 0) screen_bin(c, f, by - Rb, &tbrow);
+        const float *up[MF_MAXRB + 1], *dn[MF_MAXRB + 1];
+        for (int j = 1; j <= Rb; j++) {
+            up[j] = (by - j >= 0 ? c->bin + (size_t)((by - j) % MF_RING) * pw : zero) + c0;
+            dn[j] = (by + j < bh ? c->bin + (size_t)((by + j) % MF_RING) * pw : zero) + c0;
+        }
+        f_col(c->bcol + c0, c->bin + (size_t)(by % MF_RING) * pw + c0, up, dn, k->gb, Rb, cw);
+        f_row(c->scr + (size_t)by * bw, c->bcol + M, k->gb, Rb, norm, bw);
+        c->rmax[by] = row_max(c->scr + (size_t)by * bw, bw);
     }
 }
 
@@ -631,7 +719,7 @@ int im_centroid(im_centroider *ctx, const im_frame *f, const im_centroid_opt *op
         int bw = c->bw, bh = c->bh, top = 0, toprow = 0;
         float topv = -INFINITY;
         for (int by = 0; by < bh; by++) {
-            float m = row_max(c->scr + (size_t)by * bw, bw);
+            float m = c->rmax[by];
             if (m > topv) { topv = m; toprow = by; }
             if (!(m > ts)) continue;
             for (int bx = 0; bx < bw; bx++) {

@@ -344,12 +344,132 @@ static void files(const char *dir)
     fa->frame_free(f);
 }
 
+/* ---- the screen against the exact statistic everywhere ---------------------------- */
+/* T at every pixel by the closed form in imaging.h (written here: the kernel's square
+ * clipped to the frame, its mean taken out, sigma known), then the 8-connected regions
+ * where T > thr: a spot per region (a region always holds a local maximum, so it is
+ * what "a local maximum above the threshold" finds).  Each region's local maxima of T
+ * are kept for matching the engine's spots (their snr is T at the maximum reached). */
+typedef struct bregion { int nmax; double tmax[8]; int used; } bregion;
+static int brute(const im_frame *f, double w, double sigma, double thr, double *T, int *lab,
+                 bregion *reg, int maxreg)
+{
+    int W = f->width, H = f->height, R = (int)ceil(2 * w);
+    if (R > 24) R = 24;
+    for (int cy = 0; cy < H; cy++)
+        for (int cx = 0; cx < W; cx++) {
+            double s1 = 0, s0 = 0, s2 = 0, sv = 0, n = 0;
+            for (int y = cy - R; y <= cy + R; y++)
+                for (int x = cx - R; x <= cx + R; x++) {
+                    if (x < 0 || y < 0 || x >= W || y >= H) continue;
+                    double g = exp(-2.0 * ((x - cx) * (x - cx) + (y - cy) * (y - cy)) / (w * w));
+                    double v = f->px[(size_t)y * W + x];
+                    s1 += g * v; s0 += g; s2 += g * g; sv += v; n++;
+                }
+            double den = s2 - s0 * s0 / n;
+            T[(size_t)cy * W + cx] = den > 1e-12 ? (s1 - s0 * sv / n) / (sigma * sqrt(den)) : 0;
+        }
+    int nreg = 0, *stack = malloc(sizeof(int) * (size_t)W * H);
+    for (int i = 0; i < W * H; i++) lab[i] = -1;
+    for (int i = 0; i < W * H; i++) {
+        if (!(T[i] > thr) || lab[i] >= 0) continue;
+        if (nreg == maxreg) { free(stack); return -1; }
+        bregion *g = &reg[nreg];
+        g->nmax = 0; g->used = 0;
+        int sp = 0;
+        stack[sp++] = i;
+        lab[i] = nreg;
+        while (sp) {
+            int q = stack[--sp], x = q % W, y = q / W, ismax = 1;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    int xx = x + dx, yy = y + dy, r = yy * W + xx;
+                    if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+                    if (T[r] > T[q]) ismax = 0;
+                    if (T[r] > thr && lab[r] < 0) { lab[r] = nreg; stack[sp++] = r; }
+                }
+            if (ismax && g->nmax < 8) g->tmax[g->nmax++] = T[q];
+        }
+        nreg++;
+    }
+    free(stack);
+    return nreg;
+}
+
+static void screen_exhaustive(void)
+{
+    im_centroider *cz = fa->centroider_new();
+    const double sigma = 20, thr = 5, ws[3] = {1.5, 3, 4.5};
+    cam c = {96, 72, 16, 200, sigma, 0, 0, 0};
+    double *T = malloc(sizeof(double) * 96 * 72);
+    int *lab = malloc(sizeof(int) * 96 * 72), n = 360, bad = 0, nbrute = 0, nnear = 0;
+    int first_bad = -1, nmiss = 0;
+    bregion reg[64];
+    for (int k = 0; k < n; k++) {
+        double w = ws[k % 3], t = k % 4 == 3 ? 4 : thr;   /* some at 4: more noise peaks */
+        int ns = (k / 3) % 4;
+        spot s[3];
+        for (int i = 0; i < ns && i < 3; i++) {
+            double d = thr - 1.5 + 3 * u01();             /* near the threshold */
+            s[i] = (spot){4 + 88 * u01(), 4 + 64 * u01(), d / mf_d(1, w, sigma), w};
+            nnear += fabs(d - thr) < 0.5;
+        }
+        im_frame *f = render(&c, s, ns < 3 ? ns : 3, 130000 + (uint64_t)k);
+        im_spot o[64];
+        im_centroid_result r;
+        im_centroid_opt opt = {0};
+        opt.threshold = t;
+        opt.spot_w = w;
+        opt.read_noise = sigma;
+        opt.max_spots = 64;
+        int nb = brute(f, w, sigma, t, T, lab, reg, 64), ok = nb >= 0, miss = 0;
+        if (fa->centroid(cz, f, &opt, o, 64, &r, err, sizeof err)) ok = 0;
+        ok = ok && r.nspots == r.ndetected;
+        /* every spot the engine found is one region's local maximum, each region once */
+        for (int i = 0; ok && i < r.nspots; i++) {
+            int hit = 0;
+            for (int g = 0; g < nb && !hit; g++)
+                for (int m = 0; m < reg[g].nmax; m++)
+                    if (!reg[g].used &&
+                        fabs(o[i].snr - reg[g].tmax[m]) < 1e-5 * fabs(reg[g].tmax[m]) + 1e-6) {
+                        reg[g].used = hit = 1;
+                        break;
+                    }
+            ok = hit;
+        }
+        for (int g = 0; ok && g < nb; g++) miss += !reg[g].used;
+        if (!ok) { if (first_bad < 0) first_bad = k; bad++; }
+        if (ok && miss) {
+            nmiss += miss;
+            printf("  frame %d (w %.1f, threshold %.0f): %d regions, the engine found %d:", k,
+                   w, t, nb, r.ndetected);
+            for (int g = 0; g < nb; g++)
+                printf(" T %.3f%s", reg[g].tmax[0], reg[g].used ? "" : " (missed)");
+            printf("\n");
+        }
+        nbrute += nb > 0 ? nb : 0;
+        fa->frame_free(f);
+    }
+    CHECK(bad == 0, "every spot the screen leads to is a local maximum of the exact "
+          "statistic evaluated at every pixel, one per region above threshold, with its T, on "
+          "%d frames 96x72, w = 1.5/3/4.5 px, 0-3 spots of SNR 3.5-6.5 (%d within 0.5 of it), "
+          "threshold 5 or 4: %d frames not (first %d)", n, nnear, bad, first_bad);
+    /* Not asserted (a finding for issue 19: the screen at threshold - 2 is not complete):
+       the regions the exhaustive statistic has and the screen never leads to. */
+    printf("NOTE the screen missed %d of the %d regions above threshold the exhaustive "
+           "statistic finds (listed above)\n", nmiss, nbrute);
+    free(T);
+    free(lab);
+    fa->centroider_free(cz);
+}
+
 int main(int argc, char **argv)
 {
     fa = it_api();
     if (argc > 1) files(argv[1]);
     saturation();
     detection();
+    screen_exhaustive();
     camera_gain();
     return it_failed != 0;
 }
