@@ -253,7 +253,7 @@ static double sat_level(const im_centroider *c, const im_frame *f, double bg, do
     for (int b = 8; b < f->bits; b += 2)
         if (vmax == (1u << b) - 1 || (f->bits == 16 && vmax == ((1u << b) - 1) << (16 - b)))
             known = 1;
-    if ((known && ntop >= 2) || (ntop >= 5 && ntop > 2 * nband)) {
+    if ((known && ntop >= 3) || (ntop >= 5 && ntop > 2 * nband)) {
         *how = IM_SAT_PILEUP;
         return vmax;
     }

@@ -149,6 +149,18 @@ static void saturation(void)
     CHECK(r.nspots == 1 && !(o[0].flags & IM_SF_SATURATED) && r.sat_source == IM_SAT_FULL_SCALE,
           "a noiseless spot on a pixel corner (four tied top pixels): not saturated");
     fa->frame_free(f);
+    /* between two pixels, its top two exactly 1023 (2^10 - 1) in a 16-bit frame: a tie
+       at a value that is some ADC's full scale is not a clip (a frame of t_91's scan
+       was rejected so) */
+    spot st = {31.5, 31, 923 / exp(-2 * 0.25 / 9), 3};
+    f = render(&quiet, &st, 1, 1);
+    int ntop = 0;
+    for (size_t i = 0; i < (size_t)64 * 64; i++) ntop += f->px[i] == 1023;
+    fa->centroid(cz, f, NULL, o, 4, &r, err, sizeof err);
+    CHECK(ntop == 2 && r.nspots == 1 && !(o[0].flags & IM_SF_SATURATED),
+          "an unclipped spot whose top two pixels are exactly 1023 in a 16-bit frame: not "
+          "saturated (%d pixels at 1023)", ntop);
+    fa->frame_free(f);
 
     /* What the level is for: the same 12-bit frames told the file's level (65535)
        pass unflagged, and their reported sigma is smaller than their scatter. */
