@@ -63,8 +63,10 @@ void rg_geometry_default(rg_geometry *g)
     }
     g->m1.offset = 0.8;
     g->m2.offset = 1.2;
-    /* the resolution of golden/rig/example.rig: 200 steps per degree on the mirror
-     * mounts (0.005 deg), 400 steps per mm on the stage (2.5 um) */
+    /* the built-in geometry's resolution (no rig file): 200 steps per degree on the
+     * mirror mounts (0.005 deg), 400 steps per mm on the stage (2.5 um).  The machine
+     * in golden/rig/example.rig has since taken faster, coarser parts for scan time
+     * (88.9 steps/deg, 100 steps/mm: doc/scan-time.md); its file says its own. */
     for (int j = 0; j < RG_NJOINTS; j++) {
         int stage = j == RG_J_U || j == RG_J_V;
         g->joint[j].steps_per = stage ? 400 : 200 / DEG;
