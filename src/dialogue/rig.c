@@ -478,6 +478,36 @@ static int do_scan(rdlg *d)
 
 /* ---- the session ---------------------------------------------------------------- */
 
+/* The beam on the cornea and the detector (rig_api.spots): the engine computes,
+ * this prints. */
+static int do_beam(rdlg *d)
+{
+    rg_spots s;
+    char err[RG_ERRMAX];
+    int rc;
+    if (!d->api->spots) return refused(d, RG_EINVAL, P(NO_GEOMETRY));
+    if ((rc = d->api->spots(&d->rig, &s, err, sizeof err))) return refused(d, rc, err);
+    lm_say(d->io, LM_BOTH, P(BEAM_PATH), s.path[0], s.path[1], s.path[2], s.path[3], s.R);
+    if (s.waist_from_diameter)
+        lm_say(d->io, LM_BOTH, P(BEAM_LASER_DERIVED), s.w0, s.m2, s.lambda_mm * 1e6);
+    else
+        lm_say(d->io, LM_BOTH, P(BEAM_LASER_GIVEN), s.w0, s.waist_before_m1, s.m2,
+               s.lambda_mm * 1e6);
+    if (s.lens_at > 0) lm_say(d->io, LM_BOTH, P(BEAM_LENS), s.lens_f, s.lens_at);
+    else lm_say(d->io, LM_BOTH, "%s", P(BEAM_NO_LENS));
+    lm_say(d->io, LM_BOTH, P(BEAM_RADII), s.w_m1, s.w_m2, s.w_cornea, s.w_det);
+    if (s.lens_at > 0) lm_say(d->io, LM_BOTH, P(BEAM_NOLENS), s.nolens_cornea, s.nolens_det);
+    if (s.best_is_none)
+        lm_say(d->io, LM_BOTH, P(BEAM_BEST_NONE), s.scan_at, s.best_cornea, s.best_det);
+    else
+        lm_say(d->io, LM_BOTH, P(BEAM_BEST), s.scan_at, s.best_f, s.best_cornea, s.best_det);
+    if (s.have_dose)
+        lm_say(d->io, LM_BOTH, P(BEAM_CENTROID), s.expose_ms, s.reflectance, s.photons,
+               s.sigma_um, s.sigma_best_um);
+    else lm_say(d->io, LM_BOTH, "%s", P(BEAM_NO_DOSE));
+    return LM_GO;
+}
+
 static int need_engine(rdlg *d)
 {
     rig_get_api_fn get = (rig_get_api_fn)lm_engine_symbol("rig", RIG_API_SYMBOL);
@@ -525,8 +555,8 @@ static int open_machine(rdlg *d)
 
 int lm_rig(lm_io *io)
 {
-    static const char *const actions[] = {"home", "joints", "point", "expose", "scan", "quit",
-                                          NULL};
+    static const char *const actions[] = {"home", "joints", "point", "expose", "scan", "beam",
+                                          "quit", NULL};
     rdlg *d = calloc(1, sizeof *d);
     char name[WORD];
     int rc, a;
@@ -547,9 +577,10 @@ int lm_rig(lm_io *io)
     while (!rc) {
         double ms;
         if ((rc = lm_ask_choice(io, P(ACTION), P(ACTION), P(ACTION_WHAT), actions, &a))) break;
-        if (a == 5) break;
+        if (a == 6) break;
         rc = a == 0 ? do_home(d) : a == 1 ? do_joints(d) : a == 2 ? do_point(d)
-           : a == 3 ? ((rc = ask_ms(d, &ms)) ? rc : do_expose_ms(d, ms)) : do_scan(d);
+           : a == 3 ? ((rc = ask_ms(d, &ms)) ? rc : do_expose_ms(d, ms))
+           : a == 5 ? do_beam(d) : do_scan(d);
     }
     /* every way out: laser off, then drivers disabled */
     if (d->m) {

@@ -7,7 +7,8 @@
 build/fuzz_rig_file: tests/rig/fuzz_rig_file.c $(wildcard src/rig/rg_*.c src/rig/*.h) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-	    -o $@ tests/rig/fuzz_rig_file.c $(wildcard src/rig/rg_*.c) src/common/lm_out.c -lgpiod -lgsl \
+	    -o $@ tests/rig/fuzz_rig_file.c $(wildcard src/rig/rg_*.c) src/common/lm_out.c \
+	    $(wildcard src/paraxial/*.c) -lgpiod -lgsl \
 	    -lgslcblas -lm -pthread
 
 # (linked by absolute path: the module has no soname, and gpio-vm copies what ldd names)

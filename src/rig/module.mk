@@ -14,6 +14,11 @@ RIG_BENCH := $(wildcard tests/rig/bench_*.c)
 RIG_TBIN  := $(patsubst tests/rig/%.c,build/obj/rig_tests/%,$(RIG_TESTS)) \
              $(patsubst tests/rig/%.c,build/asan/rig_tests/%,$(RIG_TESTS))
 RIG_BBIN  := $(patsubst tests/rig/%.c,build/obj/rig_tests/%,$(RIG_BENCH))
+# The beam (rg_spots.c) calls the paraxial engine through paraxial.h: its objects come
+# from the trace module's archive of hidden position-independent objects (rules in
+# src/trace/module.mk; only what is called is linked, nothing of it is exported).
+RIG_PXA   := build/obj/trace/px/libpx.a
+RIG_SPXA  := build/asan/trace/px/libpx.a
 
 # Module objects: -fPIC, internal symbols hidden (only rig_get_api is exported).
 build/obj/rig/%.o: src/rig/%.c $(GEN) | $(DEPS)
@@ -23,12 +28,12 @@ build/asan/rig/%.o: src/rig/%.c $(GEN) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BASE) $(SAN) -fPIC -fvisibility=hidden -pthread -MMD -MP -c $< -o $@
 
-build/lib/lensmat-rig.so: $(RIG_OBJ) $(LM_COMMON_PIC)
+build/lib/lensmat-rig.so: $(RIG_OBJ) $(RIG_PXA) $(LM_COMMON_PIC)
 	@mkdir -p $(@D)
-	$(CC) -shared $(OPT) -o $@ $(RIG_OBJ) $(LM_COMMON_PIC) $(RIG_LIBS)
-build/asan/lib/lensmat-rig.so: $(RIG_SOBJ) $(LM_COMMON_SPIC)
+	$(CC) -shared $(OPT) -o $@ $(RIG_OBJ) $(RIG_PXA) $(LM_COMMON_PIC) $(RIG_LIBS)
+build/asan/lib/lensmat-rig.so: $(RIG_SOBJ) $(RIG_SPXA) $(LM_COMMON_SPIC)
 	@mkdir -p $(@D)
-	$(CC) -shared $(SAN) -o $@ $(RIG_SOBJ) $(LM_COMMON_SPIC) $(RIG_LIBS)
+	$(CC) -shared $(SAN) -o $@ $(RIG_SOBJ) $(RIG_SPXA) $(LM_COMMON_SPIC) $(RIG_LIBS)
 
 # Tests link both modules (the trace engine checks the geometry independently).
 build/obj/rig_tests/%: tests/rig/%.c build/lib/lensmat-rig.so build/lib/lensmat-trace.so \
@@ -54,7 +59,8 @@ MODULE_BENCH_BINS += build/lib/lensmat-rig.so $(RIG_BBIN)
 build/fuzz_rig_geom: tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c src/rig/*.h) | $(DEPS)
 	@mkdir -p $(@D)
 	$(CLANG) $(BASE) -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-	    -o $@ tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c) src/common/lm_out.c -lgpiod -lgsl \
+	    -o $@ tests/rig/fuzz_rig_geom.c $(wildcard src/rig/rg_*.c) src/common/lm_out.c \
+	    $(wildcard src/paraxial/*.c) -lgpiod -lgsl \
 	    -lgslcblas -lm -pthread
 fuzz-rig-geom: build/fuzz_rig_geom
 	@mkdir -p build/fuzz-rig-geom-corpus

@@ -91,7 +91,8 @@ static int line_spec(reader *r, const char *key, char **w, int nw, rg_line *l)
 enum { G_CHIP, G_LASER, G_INTERLOCK, G_HEART, G_MAXON, G_TICK, G_HTIMEOUT, G_HOMETO,
        G_SETTLE, G_SIMRT, G_SIMIL, G_SIMILMS, G_CAM, G_CPITCH, G_CPIX, G_CNOISE, G_CSEED,
        G_WAIST, G_EYESAFE, G_POWER, G_WAVE, G_BEAMD, G_KEY, G_INDIC, G_SHUT, G_EDELAY,
-       G_SHUTMS, G_PULSE, G_LATE, G_DEBOUNCE, G_SIMILC, G_SIMKEY, G_STALLAT, G_STALL, G_MOVING, NG };
+       G_SHUTMS, G_PULSE, G_LATE, G_DEBOUNCE, G_SIMILC, G_SIMKEY, G_STALLAT, G_STALL, G_MOVING,
+       G_WAISTAT, G_BEAMM2, G_LENS, NG };
 static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "max_on_ms", "tick_us", "heartbeat_timeout_ms", "home_timeout_s", "settle_ms",
     "sim_realtime", "sim_interlock", "sim_interlock_open_ms", "camera", "camera_pitch",
@@ -99,7 +100,8 @@ static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "eye_safe_without_heartbeat", "laser_power_mw", "wavelength_nm", "beam_diameter_mm",
     "key_switch", "emission_indicator", "shutter", "emission_delay_ms", "shutter_ms",
     "step_pulse_us", "max_late_us", "home_debounce_ms", "sim_interlock_close_ms",
-    "sim_key_off_ms", "sim_stall_at_ms", "sim_stall_ms", "expose_moving"};
+    "sim_key_off_ms", "sim_stall_at_ms", "sim_stall_ms", "expose_moving",
+    "beam_waist_at_mm", "beam_m2", "focus_lens_mm"};
 enum { A_STEP, A_DIR, A_ENABLE, A_HOME, A_STEPS, A_MIN, A_MAX, A_SPEED, A_ACCEL,
        A_HOMEAT, A_HOMEDIR, A_HOMESPEED, A_DIRINV, A_SIMHOME, A_LIMIT, A_PULLOFF,
        A_LOCATE, A_SIMLIMIT, A_SIMLOSE, NA };
@@ -126,7 +128,7 @@ static int global_key(reader *r, int k, char **w, int nw)
     rg_rig *g = r->rig;
     const char *a = nw > 1 ? w[1] : NULL;
     if (nw > (k == G_LASER || k == G_INTERLOCK || k == G_HEART || k == G_KEY ||
-              k == G_INDIC || k == G_SHUT ? 3 : 2))
+              k == G_INDIC || k == G_SHUT || k == G_LENS ? 3 : 2))
         return fail(r, "'%s' takes one value", w[0]);
     switch (k) {
     case G_CHIP:
@@ -182,7 +184,9 @@ static int global_key(reader *r, int k, char **w, int nw)
             return fail(r, "'camera_seed' must be a whole number from 0 to 4000000000");
         return rc;
     }
-    case G_WAIST: return positive(r, w[0], a, 10, &g->beam_waist);
+    case G_WAIST:
+        g->beam_waist_line = (int)r->line;
+        return positive(r, w[0], a, 10, &g->beam_waist);
     case G_EYESAFE: return yesno(r, w[0], a, "yes", "no", &g->eye_safe_without_heartbeat);
     case G_POWER: return positive(r, w[0], a, 1e4, &g->laser_power_mw);
     case G_WAVE: {
@@ -206,6 +210,23 @@ static int global_key(reader *r, int k, char **w, int nw)
     case G_STALLAT: return ranged(r, w[0], a, 0, 1e12, &g->sim_stall_at_ms);
     case G_STALL: return ranged(r, w[0], a, 0, 1e9, &g->sim_stall_ms);
     case G_MOVING: return yesno(r, w[0], a, "yes", "no", &g->expose_moving);
+    case G_WAISTAT: return ranged(r, w[0], a, -1e5, 1e5, &g->beam_waist_at);
+    case G_BEAMM2: return ranged(r, w[0], a, 1, 1000, &g->beam_m2);
+    case G_LENS: {      /* F AT: a thin lens AT mm before the apex (the leg is checked
+                           against the geometry by rig_api.spots, at this line) */
+        int rc = number(r, w[0], a, &g->lens_f);
+        if (!rc && !(fabs(g->lens_f) >= 0.1 && fabs(g->lens_f) <= 1e5))
+            return fail(r, "'focus_lens_mm': the focal length %g mm must be from 0.1 to "
+                        "100000 mm, either sign", g->lens_f);
+        if (!rc && nw < 3) return fail(r, "'focus_lens_mm' needs F and AT (mm before the "
+                                       "cornea apex)");
+        if (!rc) rc = number(r, w[0], w[2], &g->lens_at);
+        if (!rc && !(g->lens_at > 0 && g->lens_at <= 1e5))
+            return fail(r, "'focus_lens_mm': the lens must lie more than 0 and at most 100000 "
+                        "mm before the cornea apex (%g)", g->lens_at);
+        g->lens_line = (int)r->line;
+        return rc;
+    }
     }
     return 0;
 }
@@ -481,6 +502,8 @@ static void defaults(rg_rig *g, const rig_api *geo)
     g->cam_read_noise = 5;
     g->cam_seed = 1;
     g->beam_waist = 0.2;
+    g->beam_waist_at = NAN;
+    g->beam_m2 = 1;
 }
 
 int rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,

@@ -122,6 +122,8 @@ int  rg_reset(rg_machine *m, char *err, size_t cap);
 double rg_mpe(double wavelength_nm, double t, const char **limit);
 int  rg_dose_rig(const rg_rig *rig, double ms, long n, rg_dose *d, char *err, size_t cap);
 int  rg_dose_plan(const rg_machine *m, double ms, long n, rg_dose *d, char *err, size_t cap);
+/* rg_spots.c */
+int  rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap);
 /* rg_file.c */
 int  rg_rig_load(const char *path, rg_rig *rig, char *err, size_t cap);
 int  rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,

@@ -139,4 +139,5 @@ void rg_machine_fill(rig_api *a)
     a->clock_s = clock_s;
     a->sweep = rg_sweep;
     a->sweep_time = rg_sweep_time;
+    a->spots = rg_spots_run;
 }

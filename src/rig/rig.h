@@ -300,6 +300,17 @@ typedef struct rg_rig {
     double sim_stall_ms;        /* ... for this long (a missed deadline) */
     int expose_moving;          /* "expose_moving yes": the laser may pulse while the axes
                                    move (rig_api.sweep, doc/scan-time.md); 0: never */
+    /* ---- the laser's Gaussian beam (rg_spots.c, doc/rig.md "The beam on the cornea
+     * and the detector"); beam_waist above is its waist radius when given */
+    int beam_waist_line;        /* rig-file line of 'beam_waist'; 0: not given (the
+                                   waist then reproduces beam_diameter_mm, below) */
+    double beam_waist_at;       /* beam_waist_at_mm Z: the waist lies Z mm before m1
+                                   along the beam (negative: past it); NaN: at the laser */
+    double beam_m2;             /* beam_m2 M2 (>= 1; default 1) */
+    double lens_f, lens_at;     /* focus_lens_mm F AT: a thin lens of focal length F
+                                   (mm, +-) AT mm before the cornea apex on the
+                                   m2-cornea leg; lens_at 0: none */
+    int lens_line;              /* its rig-file line (0: none) */
 } rg_rig;
 
 /* Latched faults (LinuxCNC's estop_latch model): the first one is kept; laser off
@@ -400,6 +411,32 @@ typedef struct rg_sweep_stats {
     double v_max[RG_NJOINTS];   /* fastest speed of each joint during an exposure
                                    (steps/s) */
 } rg_sweep_stats;
+/* The beam on the cornea and on the detector for the apex pose (rg_spots.c): the
+ * laser's Gaussian beam (q parameter, the paraxial engine's px_beam) along the solved
+ * path laser -> m1 -> m2 -> [focus lens] -> cornea apex -> detector plane, flat
+ * mirrors, the cornea a convex mirror of its apex radius R (a thin lens of power
+ * -2/R, on-axis: the oblique incidence's astigmatism is left out).  Lengths mm. */
+#define RG_SPOTS_SCAN 2001      /* focal lengths scanned (log-spaced, each sign) */
+typedef struct rg_spots {
+    double path[4];             /* laser->m1, m1->m2, m2->cornea, cornea->detector */
+    double w0, waist_before_m1; /* the waist radius used and where it lies (mm) */
+    int waist_from_diameter;    /* 1: no 'beam_waist': the waist is beam_diameter_mm / 2
+                                   at the cornea (without the lens) */
+    double m2, lambda_mm, R;
+    double lens_f, lens_at;     /* the configured lens (lens_at 0: none) */
+    double w_m1, w_m2, w_cornea, w_det;     /* 1/e^2 radii with the configured optics */
+    double nolens_cornea, nolens_det;       /* the same without any lens */
+    /* the scan: a lens at scan_at before the apex (the configured one's place, or
+     * half the m2-cornea leg), focal lengths +-[scan_at/20, 1e5] mm; the one whose
+     * larger radius (cornea or detector) is smallest */
+    double scan_at, best_f, best_cornea, best_det;
+    int best_is_none;           /* 1: no lens does better than every scanned one */
+    /* the centroid's shot-noise limit on the detector: the longest single exposure
+     * the dose allows (and max_on_ms), the photons the cornea reflects (Fresnel at
+     * normal incidence, n 1.376) all detected, sigma = (w/2)/sqrt(N) per axis */
+    int have_dose;              /* 0: the rig file has no laser_power_mw */
+    double expose_ms, photons, reflectance, sigma_um, sigma_best_um;
+} rg_spots;
 /* ==== end of the machine ========================================================= */
 
 
@@ -560,6 +597,12 @@ typedef struct rig_api {
     /* The same sweep's predicted time from start and what capped it (no machine). */
     int (*sweep_time)(const rg_rig *rig, const long start[RG_NJOINTS], const long *steps,
                       long n, double expose_ms, rg_sweep_stats *st, char *err, size_t cap);
+    /* ---- the beam (rg_spots.c) ---- */
+    /* The beam radius on the cornea and the detector for the apex pose, the focus
+     * lens that balances them and the centroid's shot-noise limit.  RG_OK, or
+     * RG_EINVAL ("FILE:LINE: why" for a rig-file value the geometry rules out; no
+     * wavelength; the apex pose does not solve). */
+    int (*spots)(const rg_rig *rig, rg_spots *s, char *err, size_t cap);
 } rig_api;
 
 typedef const rig_api *(*rig_get_api_fn)(int abi);
