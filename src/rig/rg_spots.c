@@ -52,7 +52,10 @@ static int run(const chain *c, double f, double at, double w[4])
     return 0;
 }
 
-/* The longest single exposure (ms) the dose allows, at most max_on_ms; 0: none. */
+/* The longest single exposure (ms) the dose allows, at most max_on_ms; 0: none.  A
+ * rig file's max_on_ms is already within the dose (the reader checks it with the
+ * heartbeat's hold), so from a file this is max_on_ms; the search serves rigs built
+ * in code. */
 static double longest_exposure(const rg_rig *rig)
 {
     rg_dose d;
