@@ -75,7 +75,8 @@ static int inv5(double m[5][5], double out[5][5])
  * +0.98 D on R 6.5).  p = (a0, b0, a1, a2, a3); V its covariance (the sandwich of
  * the kernel weights; the trend is taken as known).  0, or -1 with fewer than 8
  * spots in reach. */
-static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V[5][5])
+static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V[5][5],
+                     double tr[5])
 {
     double M[5][5] = {{0}}, S[5][5] = {{0}}, b[5] = {0}, Mi[5][5];
     double s2 = 0.25 * z->kr * z->kr, cut = 2.25 * z->kr * z->kr;
@@ -107,11 +108,10 @@ static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V
             cn_zsag(z, x - h, y, &f, &bx, &by) || cn_zsag(z, x, y + h, &f, &cx, &cy) ||
             cn_zsag(z, x, y - h, &f, &ex, &ey))
             return -1;
-        p[0] += gx;
-        p[1] += gy;
-        p[2] += (ax - bx) / (2 * h);
-        p[3] += 0.5 * ((ay - by) + (cx - ex)) / (2 * h);
-        p[4] += (cy - ey) / (2 * h);
+        double t[5] = {gx, gy, (ax - bx) / (2 * h), 0.5 * ((ay - by) + (cx - ex)) / (2 * h),
+                       (cy - ey) / (2 * h)};
+        for (int a = 0; a < 5; a++) p[a] += t[a];
+        if (tr) memcpy(tr, t, sizeof t);
     }
     double T[5][5];
     for (int a = 0; a < 5; a++)
@@ -134,18 +134,21 @@ void cn_zlocal_vertex(cn_zfit *z)
         if (cn_zsag(z, z->xy[2 * i], z->xy[2 * i + 1], &f, &z->zsl[2 * i], &z->zsl[2 * i + 1]))
             z->zsl[2 * i] = z->zsl[2 * i + 1] = 0;
     z->l0x = z->l0y = 0;
-    if (!local_fit(z, 0, 0, p, V)) { z->l0x = p[0]; z->l0y = p[1]; }
+    if (!local_fit(z, 0, 0, p, V, NULL)) { z->l0x = p[0]; z->l0y = p[1]; }
 }
 
 /* Axial and tangential curvature (1/mm) at (x, y) from the local fit, about the
  * normal at the vertex, and the axial one's sd.  Within one kernel radius of the
- * vertex the axial curvature is its limit there, the tangential (f_r / r loses all
- * precision as r -> 0). */
+ * vertex f_r / r of the local fit loses its precision as r -> 0: there the axial
+ * curvature is the Zernike surface's own (its slope is smooth to the vertex) plus
+ * the local fit's departure from it as tangential curvature (the axial's limit at
+ * r -> 0; the whole tangential curvature in its place put a cone's flank 0.11 D above
+ * the true Kmax at 0.76 mm from the vertex on a 9.5 mm zone, t_zone). */
 int cn_zlocal(const cn_zfit *z, double x, double y, double *axial, double *tang,
               double *sd_axial)
 {
-    double p[5], V[5][5], r = hypot(x, y), ex = 1, ey = 0;
-    if (local_fit(z, x, y, p, V)) return -1;
+    double p[5], V[5][5], tr[5], r = hypot(x, y), ex = 1, ey = 0;
+    if (local_fit(z, x, y, p, V, tr)) return -1;
     if (r > 0) { ex = x / r; ey = y / r; }
     double sx = p[0] - z->l0x, sy = p[1] - z->l0y;
     double fr = sx * ex + sy * ey, q = 1 + sx * sx + sy * sy;
@@ -160,7 +163,10 @@ int cn_zlocal(const cn_zfit *z, double x, double y, double *axial, double *tang,
         *axial = fr / (r * sqrt(q));
         if (sd_axial) *sd_axial = sqrt(vr) / (r * sqrt(q));
     } else {
-        *axial = *tang;
+        double zx = tr[0] - z->g0x, zy = tr[1] - z->g0y, zr = zx * ex + zy * ey;
+        double zrr = g[0] * tr[2] + g[1] * tr[3] + g[2] * tr[4];
+        double za = r > 1e-6 ? zr / (r * sqrt(1 + zx * zx + zy * zy)) : zrr;
+        *axial = za + (*tang - zrr / pow(1 + zr * zr, 1.5));
         if (sd_axial) *sd_axial = sqrt(vt) / t15;
     }
     return isfinite(*axial) && isfinite(*tang) ? 0 : -1;

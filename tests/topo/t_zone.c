@@ -257,7 +257,13 @@ int main(int argc, char **argv)
             printf("#   true surface's indices: Kmax %.3f D at (%.2f, %.2f), central K %.3f D, "
                    "I-S %.3f D, screen %d (%s)\n", kt.kmax, kt.kmax_x, kt.kmax_y, kt.ck, kt.is,
                    kt.screen, kt.why);
-            (void)krc;
+            double eloc = hypot(k->kmax_x - kt.kmax_x, k->kmax_y - kt.kmax_y);
+            ct_check(krc == 0 && fabs(k->kmax - kt.kmax) <= 0.5 && eloc <= 0.25 &&
+                     fabs(k->is - kt.is) <= 0.3 && k->screen == kt.screen,
+                     "%s: Kmax %.3f D against %.3f, %.3f mm from its place, I-S %.3f against "
+                     "%.3f, central K %.3f against %.3f, screen %d against %d (the issue's "
+                     "0.5 D, 0.25 mm, 0.3 D)", s->name, k->kmax, kt.kmax, eloc, k->is, kt.is,
+                     k->ck, kt.ck, k->screen, kt.screen);
         }
         if (i < 3) {
             /* a sphere is no cone, however steep (R 6.5: 51.92 D, past Rabinowitz's
