@@ -62,13 +62,21 @@ static int inv5(double m[5][5], double out[5][5])
 }
 
 /* The measured slopes about (x, y), fitted locally (the curvatures come from the
- * data where they are, not from a global surface: a cone 0.8 mm wide near the
- * zone's edge is beyond what 20 orders of Zernike polynomials follow to the noise):
- * fx = a0 + a1 dx + a2 dy, fy = b0 + a2 dx + a3 dy (one Hessian), each spot weighted
- * by its slope's 1 / sigma^2 and a Gaussian kernel of sd kr / 2 (cut at 1.5 kr).
- * p = (a0, b0, a1, a2, a3); V its covariance (the sandwich of the kernel weights).
- * 0, or -1 with fewer than 8 spots in reach. */
-static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V[5][5])
+ * data where they are, not from a global surface alone: a cone 0.8 mm wide near the
+ * zone's edge can be beyond what the Zernike orders follow to the noise): the
+ * departure of the measured slopes from the Zernike surface's, fx - Zx = a0 + a1 dx
+ * + a2 dy, fy - Zy = b0 + a2 dx + a3 dy (one Hessian), each spot weighted by its
+ * slope's 1 / sigma^2 and a Gaussian kernel of sd kr / 2 (cut at 1.5 kr), then the
+ * Zernike surface's slopes and Hessian at (x, y) added back.  The trend taken out is
+ * what keeps the kernel from biasing the curvature: a linear fit of a sphere's own
+ * slopes reads its axial power high by about 1.5 (kr / 2)^2 / R^2 inside the data
+ * and more where the kernel is cut by the zone's edge (a 9.5 mm zone of 770 spots,
+ * kr 0.77 mm: central K +0.21 D and Kmax +0.73 D at the edge on R 7.8, +0.40 and
+ * +0.98 D on R 6.5).  p = (a0, b0, a1, a2, a3); V its covariance (the sandwich of
+ * the kernel weights; the trend is taken as known).  0, or -1 with fewer than 8
+ * spots in reach. */
+static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V[5][5],
+                     double tr[5])
 {
     double M[5][5] = {{0}}, S[5][5] = {{0}}, b[5] = {0}, Mi[5][5];
     double s2 = 0.25 * z->kr * z->kr, cut = 2.25 * z->kr * z->kr;
@@ -78,8 +86,9 @@ static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V
         if (d2 > cut || !(z->wt[i] > 0)) continue;
         double k = exp(-d2 / (2 * s2)), w = k * z->wt[i], w2 = k * k * z->wt[i];
         double ru[5] = {1, 0, dx, dy, 0}, rv[5] = {0, 1, 0, dx, dy};
+        double eu = z->sl[2 * i] - z->zsl[2 * i], ev = z->sl[2 * i + 1] - z->zsl[2 * i + 1];
         for (int a = 0; a < 5; a++) {
-            b[a] += w * (ru[a] * z->sl[2 * i] + rv[a] * z->sl[2 * i + 1]);
+            b[a] += w * (ru[a] * eu + rv[a] * ev);
             for (int c = 0; c < 5; c++) {
                 M[a][c] += w * (ru[a] * ru[c] + rv[a] * rv[c]);
                 S[a][c] += w2 * (ru[a] * ru[c] + rv[a] * rv[c]);
@@ -91,6 +100,18 @@ static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V
     for (int a = 0; a < 5; a++) {
         p[a] = 0;
         for (int c = 0; c < 5; c++) p[a] += Mi[a][c] * b[c];
+    }
+    {   /* the trend back: the Zernike surface's slopes and Hessian at (x, y) */
+        const double h = 1e-3;
+        double f, gx, gy, ax, ay, bx, by, cx, cy, ex, ey;
+        if (cn_zsag(z, x, y, &f, &gx, &gy) || cn_zsag(z, x + h, y, &f, &ax, &ay) ||
+            cn_zsag(z, x - h, y, &f, &bx, &by) || cn_zsag(z, x, y + h, &f, &cx, &cy) ||
+            cn_zsag(z, x, y - h, &f, &ex, &ey))
+            return -1;
+        double t[5] = {gx, gy, (ax - bx) / (2 * h), 0.5 * ((ay - by) + (cx - ex)) / (2 * h),
+                       (cy - ey) / (2 * h)};
+        for (int a = 0; a < 5; a++) p[a] += t[a];
+        if (tr) memcpy(tr, t, sizeof t);
     }
     double T[5][5];
     for (int a = 0; a < 5; a++)
@@ -108,20 +129,26 @@ static int local_fit(const cn_zfit *z, double x, double y, double p[5], double V
 
 void cn_zlocal_vertex(cn_zfit *z)
 {
-    double p[5], V[5][5];
+    double p[5], V[5][5], f;
+    for (int i = 0; i < z->npts; i++)
+        if (cn_zsag(z, z->xy[2 * i], z->xy[2 * i + 1], &f, &z->zsl[2 * i], &z->zsl[2 * i + 1]))
+            z->zsl[2 * i] = z->zsl[2 * i + 1] = 0;
     z->l0x = z->l0y = 0;
-    if (!local_fit(z, 0, 0, p, V)) { z->l0x = p[0]; z->l0y = p[1]; }
+    if (!local_fit(z, 0, 0, p, V, NULL)) { z->l0x = p[0]; z->l0y = p[1]; }
 }
 
 /* Axial and tangential curvature (1/mm) at (x, y) from the local fit, about the
  * normal at the vertex, and the axial one's sd.  Within one kernel radius of the
- * vertex the axial curvature is its limit there, the tangential (f_r / r loses all
- * precision as r -> 0). */
+ * vertex f_r / r of the local fit loses its precision as r -> 0: there the axial
+ * curvature is the Zernike surface's own (its slope is smooth to the vertex) plus
+ * the local fit's departure from it as tangential curvature (the axial's limit at
+ * r -> 0; the whole tangential curvature in its place put a cone's flank 0.11 D above
+ * the true Kmax at 0.76 mm from the vertex on a 9.5 mm zone, t_zone). */
 int cn_zlocal(const cn_zfit *z, double x, double y, double *axial, double *tang,
               double *sd_axial)
 {
-    double p[5], V[5][5], r = hypot(x, y), ex = 1, ey = 0;
-    if (local_fit(z, x, y, p, V)) return -1;
+    double p[5], V[5][5], tr[5], r = hypot(x, y), ex = 1, ey = 0;
+    if (local_fit(z, x, y, p, V, tr)) return -1;
     if (r > 0) { ex = x / r; ey = y / r; }
     double sx = p[0] - z->l0x, sy = p[1] - z->l0y;
     double fr = sx * ex + sy * ey, q = 1 + sx * sx + sy * sy;
@@ -136,7 +163,10 @@ int cn_zlocal(const cn_zfit *z, double x, double y, double *axial, double *tang,
         *axial = fr / (r * sqrt(q));
         if (sd_axial) *sd_axial = sqrt(vr) / (r * sqrt(q));
     } else {
-        *axial = *tang;
+        double zx = tr[0] - z->g0x, zy = tr[1] - z->g0y, zr = zx * ex + zy * ey;
+        double zrr = g[0] * tr[2] + g[1] * tr[3] + g[2] * tr[4];
+        double za = r > 1e-6 ? zr / (r * sqrt(1 + zx * zx + zy * zy)) : zrr;
+        *axial = za + (*tang - zrr / pow(1 + zr * zr, 1.5));
         if (sd_axial) *sd_axial = sqrt(vt) / t15;
     }
     return isfinite(*axial) && isfinite(*tang) ? 0 : -1;
@@ -281,7 +311,17 @@ static void screen(cn_kc *o)
     o->why[0] = 0;
 #define FLAG(lvl, ...) do { if ((lvl) > o->screen) o->screen = (lvl); \
         if (l < sizeof o->why) l += snprintf(o->why + l, sizeof o->why - l, __VA_ARGS__); } while (0)
-    if (o->ck > 48.7) FLAG(CN_KC_KERATOCONUS, "central K %.2f D > 48.7; ", o->ck);
+    /* central K counts only with a sign of the cone's asymmetry (I-S or KISA% past
+       its suspect limit): on its own it cannot tell a steep regular cornea from a
+       cone (the R 6.5 test sphere, 51.92 D all over, screened KERATOCONUS), which
+       is the specificity KISA% (K times I-S, AST, SRAX) was built for; a steep
+       central K without one is said, not screened */
+    int asym = o->is > 1.4 || o->kisa > 60;
+    if (o->ck > 47.2 && !asym)
+        FLAG(CN_KC_NORMAL, "central K %.2f D %s, on a regular surface (I-S %.2f D <= 1.4, "
+             "KISA%% not past 60): steep, not a cone's sign alone; ", o->ck,
+             o->ck > 48.7 ? "> 48.7" : "in 47.2-48.7", o->is);
+    else if (o->ck > 48.7) FLAG(CN_KC_KERATOCONUS, "central K %.2f D > 48.7; ", o->ck);
     else if (o->ck > 47.2) FLAG(CN_KC_SUSPECT, "central K %.2f D in 47.2-48.7; ", o->ck);
     if (o->is > 1.8) FLAG(CN_KC_KERATOCONUS, "I-S %.2f D > 1.8; ", o->is);
     else if (o->is > 1.4) FLAG(CN_KC_SUSPECT, "I-S %.2f D in 1.4-1.8; ", o->is);

@@ -524,6 +524,16 @@ int cn_zfit_run(const rg_geometry *g, const cn_spot *spots, int n, const cn_para
         rc = recon_once(g, spots, n, &p, model, cap, 15, z, err, errcap);
         if (rc) return rc;
         iters += z->iterations;
+        if (cap < mo && z->order >= cap) {
+            /* the cap binds: the data ask for more than order 8 can carry, and the
+               sphere through a surface that misses them is no frame (a cone on a
+               9.5 mm zone: chi2/dof 5e5 at order 8, the frame walked 1.9 mm down
+               in R with the apex 0.77 mm in, to chi2/dof 4e3 and the ISO
+               comparison -75 um off); the full order from this frame */
+            cap = mo;
+            pass--;
+            continue;
+        }
         double a, b, c;
         if (sphere_of(z, &a, &b, &c, &R)) { snprintf(err, errcap, "no sphere through the surface"); return CN_EFIT; }
         /* the centre back in the rig: T + M (a, b, c), M's rows from cn_to_eye */

@@ -194,8 +194,8 @@ enum cn_map_kind {
  * distance from the reference's axis) in the eye frame of a reference sphere fit,
  * fitted to the slopes the spots give (deflectometry), the radial order the lowest
  * BIC's, for the departure from a base sphere (z below; mm, into the eye, as cn_sag). */
-#define CN_ZORDER 20
-#define CN_ZTERMS 231                  /* (CN_ZORDER + 1)(CN_ZORDER + 2) / 2 */
+#define CN_ZORDER 26
+#define CN_ZTERMS 378                  /* (CN_ZORDER + 1)(CN_ZORDER + 2) / 2 */
 #define CN_ZPTS 10000
 typedef struct cn_zfit {
     cn_params ref;                 /* the reference fit's parameters: the eye frame */
@@ -211,6 +211,8 @@ typedef struct cn_zfit {
     double xy[2 * CN_ZPTS];        /* where the spots met the surface (eye frame) */
     double sl[2 * CN_ZPTS];        /* the slopes each spot gives there (fx, fy) */
     double wt[CN_ZPTS];            /* their weight, 1 / sigma_slope^2 */
+    double zsl[2 * CN_ZPTS];       /* the Zernike surface's own slopes there: the
+                                      trend the local curvature fits take out */
     double kr;                     /* the curvatures' local fit: kernel radius (mm) */
     double l0x, l0y;               /* the local fit's slope at the origin (vertex) */
     double R0;                     /* the base sphere (the reference's radius, mm): z =

@@ -630,6 +630,8 @@ static void say_surface(cs *s, tp_run *r)
         say(s, CS(TOPO_SCREEN_KC), k->why, k->kmax_x, k->kmax_y);
     else if (k->screen == CN_KC_SUSPECT)
         say(s, CS(TOPO_SCREEN_SUSPECT), k->why, k->kmax_x, k->kmax_y);
+    else if (k->ck > 47.2)   /* steep but regular: cn_kc.c says why it is not screened */
+        say(s, CS(TOPO_SCREEN_STEEP), k->why);
     else
         say(s, "%s", CS(TOPO_SCREEN_NORMAL));
 }

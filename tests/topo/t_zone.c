@@ -236,6 +236,50 @@ int main(int argc, char **argv)
                  "%s: zone %.1f mm covered (>= 8), %d spots off the sensor", s->name,
                  c->zone_mm, lost(r));
         if (i < 3) zmin = fmin(zmin, c->zone_mm);
+        if (r->have_z) {
+            const cn_kc *k = &r->kc;
+            printf("#   indices: Kmax %.3f D at (%.2f, %.2f), central K %.3f D (%d rings), I-S %.3f D, "
+                   "AST %.3f D, screen %d (%s)\n", k->kmax, k->kmax_x, k->kmax_y, k->ck,
+                   k->ck_rings, k->is, k->ast, k->screen, k->why);
+        }
+        if (r->have_z && s->h > 0) {
+            /* the cone: its indices against the engine's of the true surface on the
+               same zone (kc_model, checked in t_topo against that test's own
+               computation from the definitions) */
+            const cn_kc *k = &r->kc;
+            cn_kc kt;
+            cn_params tp0 = {{0}};
+            tp0.p[CN_R] = s->R1;
+            tp0.p[CN_DX] = s->dx;
+            tp0.p[CN_DY] = s->dy;
+            cn_bump b = {s->h, s->w, s->x0, s->y0};
+            int krc = cn->kc_model(CN_SPHERE, &tp0, &b, k->zone_r, &kt);
+            printf("#   true surface's indices: Kmax %.3f D at (%.2f, %.2f), central K %.3f D, "
+                   "I-S %.3f D, screen %d (%s)\n", kt.kmax, kt.kmax_x, kt.kmax_y, kt.ck, kt.is,
+                   kt.screen, kt.why);
+            double eloc = hypot(k->kmax_x - kt.kmax_x, k->kmax_y - kt.kmax_y);
+            ct_check(krc == 0 && fabs(k->kmax - kt.kmax) <= 0.5 && eloc <= 0.25 &&
+                     fabs(k->is - kt.is) <= 0.3 && k->screen == kt.screen,
+                     "%s: Kmax %.3f D against %.3f, %.3f mm from its place, I-S %.3f against "
+                     "%.3f, central K %.3f against %.3f, screen %d against %d (the issue's "
+                     "0.5 D, 0.25 mm, 0.3 D)", s->name, k->kmax, kt.kmax, eloc, k->is, kt.is,
+                     k->ck, kt.ck, k->screen, kt.screen);
+        }
+        if (i < 3) {
+            /* a sphere is no cone, however steep (R 6.5: 51.92 D, past Rabinowitz's
+               48.7 D for central K, screened KERATOCONUS on K alone), and its Kmax and
+               central K are 337.5 / R everywhere.  0.1 D: a fifth of the issue's Kmax
+               limit on the cone (0.5 D) and of the 0.5 D steps of a clinical colour
+               scale; the kernel's bias this replaced was +0.73..+0.98 D (Kmax) and
+               +0.21..+0.40 D (central K) on this zone, the noise's about 0.01 D */
+            const cn_kc *k = &r->kc;
+            double K = 337.5 / s->R1;
+            ct_check(r->have_z && k->screen == CN_KC_NORMAL && fabs(k->kmax - K) <= 0.1 &&
+                     fabs(k->ck - K) <= 0.1,
+                     "%s: screen %d (0: normal), Kmax %.3f +- %.3f D, central K %.3f D, "
+                     "against 337.5/R %.3f (within 0.1 D)", s->name, k->screen, k->kmax,
+                     k->sd_kmax, k->ck, K);
+        }
         tp_iso iso;
         rg_cornea pl;
         memset(&pl, 0, sizeof pl);
