@@ -24,7 +24,7 @@
 #include <stddef.h>
 #include "rig/rig.h"
 
-#define CORNEA_ABI 3
+#define CORNEA_ABI 4            /* 4: cn_zfit grew (order 26, the slopes' departure zsl[]) */
 #define CORNEA_API_SYMBOL "cornea_get_api"
 
 enum { CN_OK = 0, CN_EINVAL = -1, CN_ENOMEM = -2, CN_EFIT = -3, CN_ESTOP = -4,
