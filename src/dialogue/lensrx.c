@@ -225,6 +225,22 @@ int lr_prepare(lr_lens *L, char *why, size_t cap)
     return 0;
 }
 
+void lr_rx_surface(const ln_surface *s, double z, trace_rx_surface *t)
+{
+    t->z = z;
+    t->radius = isfinite(s->r) ? s->r : 0;
+    t->conic = s->conic;
+    t->nasph = s->nasph < TRACE_MAXASPH ? s->nasph : TRACE_MAXASPH;
+    for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
+    t->semi_diameter = s->semi;
+    t->mirror = s->mirror;
+    t->coordbrk = s->coordbrk;
+    t->order = s->cb_order;
+    t->decenter[0] = s->cb_dec[0];
+    t->decenter[1] = s->cb_dec[1];
+    for (int k = 0; k < 3; k++) t->tilt[k] = s->cb_tilt[k];
+}
+
 int lr_at(const lr_lens *L, double lambda, lr_wl *w, char *why, size_t cap)
 {
     const ln_lens *l = &L->lens;
@@ -236,18 +252,7 @@ int lr_at(const lr_lens *L, double lambda, lr_wl *w, char *why, size_t cap)
     for (int i = 0; i < l->nsurf; i++) {
         const ln_surface *s = &l->surf[i];
         trace_rx_surface *t = &w->surf[i];
-        t->z = z;
-        t->radius = isfinite(s->r) ? s->r : 0;
-        t->conic = s->conic;
-        t->nasph = s->nasph < TRACE_MAXASPH ? s->nasph : TRACE_MAXASPH;
-        for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
-        t->semi_diameter = s->semi;
-        t->mirror = s->mirror;
-        t->coordbrk = s->coordbrk;
-        t->order = s->cb_order;
-        t->decenter[0] = s->cb_dec[0];
-        t->decenter[1] = s->cb_dec[1];
-        for (int k = 0; k < 3; k++) t->tilt[k] = s->cb_tilt[k];
+        lr_rx_surface(s, z, t);
         if (ln_index(l, i, lambda, &t->n_right, NULL, why, cap) != LN_OK) return -1;
         z += s->t;
     }

@@ -65,6 +65,9 @@ int lr_ask_lens(lr_lens *L, calc *c, const lr_texts *t);
 int lr_ask_count(lr_lens *L, const char *q, const char *bad, int lo, int hi, int *v);
 /* Pupils and image plane at the primary wavelength: 0 (check z_image), or -1 with why. */
 int lr_prepare(lr_lens *L, char *why, size_t cap);
+/* Surface s of a lens file at vertex z as the tracer's trace_rx_surface (all but its
+ * index: the caller's, per wavelength). */
+void lr_rx_surface(const ln_surface *s, double z, trace_rx_surface *t);
 /* Wavelength lambda (um): its pupils and trace_rx.  0, or -1 with why. */
 int lr_at(const lr_lens *L, double lambda, lr_wl *w, char *why, size_t cap);
 /* The aim request for pupil point (px, py) (stop coordinates, 1 at its rim) of field f. */

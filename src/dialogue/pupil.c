@@ -167,18 +167,7 @@ static int build_rx(pdlg *d, wl_ctx *w, double lambda, double r_stop, double z_i
     for (int i = 0; i < l->nsurf; i++) {
         const ln_surface *s = &l->surf[i];
         trace_rx_surface *t = &w->surf[i];
-        t->z = z;
-        t->radius = isfinite(s->r) ? s->r : 0;
-        t->conic = s->conic;
-        t->nasph = s->nasph < TRACE_MAXASPH ? s->nasph : TRACE_MAXASPH;
-        for (int k = 0; k < t->nasph; k++) t->asph[k] = s->asph[k];
-        t->semi_diameter = s->semi;
-        t->mirror = s->mirror;
-        t->coordbrk = s->coordbrk;
-        t->order = s->cb_order;
-        t->decenter[0] = s->cb_dec[0];
-        t->decenter[1] = s->cb_dec[1];
-        for (int k = 0; k < 3; k++) t->tilt[k] = s->cb_tilt[k];
+        lr_rx_surface(s, z, t);
         if (ln_index(l, i, lambda, &t->n_right, NULL, why, cap) != LN_OK) return -1;
         z += s->t;
     }

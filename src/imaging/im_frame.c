@@ -330,6 +330,49 @@ static int is_tiff(const unsigned char *b, size_t n)
                       (b[0] == 'M' && b[1] == 'M' && b[2] == 0 && b[3] == 42));
 }
 
+/* A TIFF's first image: its stated width and height (tags 256, 257 of the first IFD)
+ * checked before the decoder allocates for them: at most IM_MAX_PIXELS, and at most
+ * TIFF_MAX_RATIO pixels a byte of the file (no TIFF compression packs more: LZW,
+ * the densest, about 1300:1), so that a few hundred bytes cannot state a frame the
+ * decoder then spends seconds filling (the fuzzer found one: 58892 x 9993 in 270
+ * bytes, 6 s in libtiff). */
+#define TIFF_MAX_RATIO 4096
+static int im_tiff_check(const unsigned char *b, size_t n, const char *name, char *err,
+                         size_t cap)
+{
+    int le = b[0] == 'I';
+#define T16(p) (le ? (uint32_t)(p)[0] | (uint32_t)(p)[1] << 8 : (uint32_t)(p)[0] << 8 | (p)[1])
+#define T32(p) (le ? T16(p) | T16((p) + 2) << 16 : T16(p) << 16 | T16((p) + 2))
+    uint32_t ifd = T32(b + 4), w = 0, h = 0;
+    if (ifd < 8 || ifd > n - 2)
+        return im_err(err, cap, IM_EFORMAT, "%s: corrupt TIFF (its first directory at "
+                      "byte %lu lies outside the file)", name, (unsigned long)ifd);
+    uint32_t ne = T16(b + ifd);
+    if ((size_t)ne * 12 > n - ifd - 2)
+        return im_err(err, cap, IM_EFORMAT, "%s: corrupt TIFF (a directory of %lu entries "
+                      "at byte %lu runs past the end)", name, (unsigned long)ne,
+                      (unsigned long)ifd);
+    for (uint32_t i = 0; i < ne; i++) {
+        const unsigned char *e = b + ifd + 2 + 12 * i;
+        uint32_t tag = T16(e), type = T16(e + 2), v = type == 3 ? T16(e + 8) : T32(e + 8);
+        if (type != 3 && type != 4) continue;
+        if (tag == 256) w = v;
+        if (tag == 257) h = v;
+    }
+#undef T16
+#undef T32
+    if (w == 0 || h == 0)
+        return im_err(err, cap, IM_EFORMAT, "%s: TIFF without a width and height", name);
+    unsigned long long px = (unsigned long long)w * h;
+    if (px > (unsigned long long)IM_MAX_PIXELS)
+        return im_err(err, cap, IM_EFORMAT, "%s: %lux%lu is more than %ld pixels", name,
+                      (unsigned long)w, (unsigned long)h, (long)IM_MAX_PIXELS);
+    if (px > (unsigned long long)TIFF_MAX_RATIO * n)
+        return im_err(err, cap, IM_EFORMAT, "%s: a %lux%lu TIFF cannot be held in %zu bytes "
+                      "(truncated or corrupt)", name, (unsigned long)w, (unsigned long)h, n);
+    return IM_OK;
+}
+
 int im_decode(const void *buf, size_t len, const char *name, im_frame **out,
               int *was_colour, char *err, size_t cap)
 {
@@ -343,14 +386,16 @@ int im_decode(const void *buf, size_t len, const char *name, im_frame **out,
     } else if (!is_tiff(b, len)) {
         return im_err(err, cap, IM_EFORMAT, "%s: not a PNG or TIFF image (a raw frame "
                       "needs its width and height stated)", name);
+    } else if ((rc = im_tiff_check(b, len, name, err, cap)) != IM_OK) {
+        return rc;
     }
     return im_cv_decode(buf, len, name, out, was_colour, err, cap);
 }
 
 int im_read(const char *path, im_frame **out, int *was_colour, char *err, size_t cap)
 {
-    void *buf;
-    size_t len;
+    void *buf = NULL;
+    size_t len = 0;
     int rc;
     *out = NULL;
     if ((rc = im_read_file(path, IM_MAX_FILE, &buf, &len, err, cap)) != IM_OK) return rc;

@@ -93,6 +93,9 @@ int  rg_scan_time(const rg_rig *rig, const long start[RG_NJOINTS], const long *s
                   const long *order, long n, double expose_ms, rg_scan_stats *st, char *err,
                   size_t cap);
 const char *rg_scan_limit_text(const rg_scan_stats *st, char *buf, size_t cap);
+/* every target (n rows of RG_NJOINTS steps) within its axis's travel: 0, or
+ * RG_ETRAVEL with the first one outside named in err (rg_scan.c, rg_sweep.c) */
+int  rg_check_targets(const rg_rig *rig, const long *steps, long n, char *err, size_t cap);
 void rg_wait(rg_machine *m, int64_t deadline);  /* sleep_until + lateness record */
 int  rg_pulse(rg_machine *m, unsigned mask, int64_t at, int64_t tick, char *err, size_t cap);
 int  rg_settle(rg_machine *m, char *err, size_t cap);

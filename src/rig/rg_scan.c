@@ -26,7 +26,7 @@ static double leg(const rg_rig *rig, const long *a, const long *b)
     return rg_move_time(rig, a, b, NULL, NULL, NULL, NULL);
 }
 
-static int check_targets(const rg_rig *rig, const long *steps, long n, char *err, size_t cap)
+int rg_check_targets(const rg_rig *rig, const long *steps, long n, char *err, size_t cap)
 {
     for (long i = 0; i < n; i++)
         for (int j = 0; j < RG_NJOINTS; j++) {
@@ -75,7 +75,7 @@ int rg_scan_order(const rg_rig *rig, const long start[RG_NJOINTS], const long *s
         return RG_EINVAL;
     }
     if (n == 0) return 0;
-    if ((rc = check_targets(rig, steps, n, err, cap))) return rc;
+    if ((rc = rg_check_targets(rig, steps, n, err, cap))) return rc;
     if (n > RG_SCAN_ORDER_MAX) {        /* O(n^2): beyond this, the given order */
         for (long k = 0; k < n; k++) order[k] = k;
         return 0;
@@ -140,7 +140,7 @@ int rg_scan_time(const rg_rig *rig, const long start[RG_NJOINTS], const long *st
     int rc;
     memset(st, 0, sizeof *st);
     st->n = n;
-    if ((rc = check_targets(rig, steps, n, err, cap))) return rc;
+    if ((rc = rg_check_targets(rig, steps, n, err, cap))) return rc;
     for (long k = 0; k < n; k++) {
         const long *to = steps + (order ? order[k] : k) * RG_NJOINTS;
         int vj, aj;

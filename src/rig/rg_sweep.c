@@ -69,22 +69,6 @@ static void path_at(const leg *L, const long *steps, long n, double T, double ta
     for (int j = 0; j < RG_NJOINTS; j++) x[j] = a[j] + f * (double)(b[j] - a[j]);
 }
 
-static int check_all(const rg_rig *rig, const long *steps, long n, char *err, size_t cap)
-{
-    static const char *const jn[RG_NJOINTS] = {"m1a", "m1b", "u", "v", "m2a", "m2b"};
-    for (long i = 0; i < n; i++)
-        for (int j = 0; j < RG_NJOINTS; j++) {
-            const rg_axis *x = &rig->axis[j];
-            double v = steps[i * RG_NJOINTS + j] / x->steps_per;
-            if (v < x->min - 1e-9 || v > x->max + 1e-9) {
-                snprintf(err, cap, "target %ld: axis %s at %.6g %s is outside its travel "
-                         "[%g, %g]", i + 1, jn[j], v, x->linear ? "mm" : "deg", x->min, x->max);
-                return RG_ETRAVEL;
-            }
-        }
-    return 0;
-}
-
 /* The legs of the sweep through steps[0..n-1] (n - 1 of them, t0 their start in
  * sweep time); st (may be NULL) gets what capped each. */
 static int plan(const rg_rig *rig, const long *steps, long n, double ms, leg **out,
@@ -159,7 +143,7 @@ int rg_sweep_time(const rg_rig *rig, const long start[RG_NJOINTS], const long *s
     memset(st, 0, sizeof *st);
     st->n = n;
     if (n <= 0) return 0;
-    if ((rc = check_all(rig, steps, n, err, cap))) return rc;
+    if ((rc = rg_check_targets(rig, steps, n, err, cap))) return rc;
     if ((rc = plan(rig, steps, n, expose_ms, &L, &T, st, err, cap))) return rc;
     free(L);
     double first = rg_move_time(rig, start, steps, NULL, NULL, NULL, NULL);
@@ -258,7 +242,7 @@ int rg_sweep(rg_machine *m, const long *steps, long n, double ms, rg_stop_fn sto
         return RG_EINVAL;
     }
     if (n <= 0) return 0;
-    if ((rc = check_all(rig, steps, n, err, cap))) return rc;
+    if ((rc = rg_check_targets(rig, steps, n, err, cap))) return rc;
     /* the whole sweep's dose, before anything moves or emits */
     if ((rc = rg_dose_plan(m, ms, n, &d, err, cap))) return rc;
     if ((rc = plan(rig, steps, n, ms, &L, &T, NULL, err, cap))) return rc;
