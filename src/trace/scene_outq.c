@@ -108,6 +108,21 @@ static void *formatter(void *arg)
     return NULL;
 }
 
+
+/* The queue's memory (its threads joined, or never started). */
+static void release(soq *q)
+{
+    if (q->slot)
+        for (int i = 0; i < q->nslot; i++) {
+            free(q->slot[i].rows);
+            free(q->slot[i].text);
+        }
+    free(q->slot);
+    free(q->th);
+    free(q->own_cache);
+    free(q);
+}
+
 soq *soq_new(FILE *f, int nthread, size_t chunk, size_t text_cap, soq_format fmt,
              void *ctx, size_t cache_size)
 {
@@ -137,15 +152,7 @@ soq *soq_new(FILE *f, int nthread, size_t chunk, size_t text_cap, soq_format fmt
         if (pthread_create(&q->th[i], NULL, formatter, q)) break;
     return q;
 bad:
-    if (q->slot)
-        for (int i = 0; i < q->nslot; i++) {
-            free(q->slot[i].rows);
-            free(q->slot[i].text);
-        }
-    free(q->slot);
-    free(q->th);
-    free(q->own_cache);
-    free(q);
+    release(q);
     return NULL;
 }
 
@@ -191,12 +198,5 @@ void soq_free(soq *q)
     soq_finish(q, 0);
     pthread_mutex_destroy(&q->mu);
     pthread_cond_destroy(&q->cv);
-    for (int i = 0; i < q->nslot; i++) {
-        free(q->slot[i].rows);
-        free(q->slot[i].text);
-    }
-    free(q->slot);
-    free(q->th);
-    free(q->own_cache);
-    free(q);
+    release(q);
 }
