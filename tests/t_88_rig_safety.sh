@@ -106,4 +106,4 @@ else
 fi
 
 # the libgpiod backend on the gpio-sim chip
-gpio_vm 23 tests/rig/vm.rig build/obj/rig_vm/vm_safety vm.rig
+gpio_vm 24 tests/rig/vm.rig build/obj/rig_vm/vm_safety vm.rig
