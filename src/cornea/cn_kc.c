@@ -17,19 +17,50 @@
 /* A surface the indices read: axial power (D) at (x, y), 0 or -1. */
 typedef struct kc_surf {
     const cn_zfit *z;           /* the reconstruction, or */
-    cn_surf s;                  /* an analytic surface */
+    cn_surf s;                  /* an analytic surface, posed by: */
+    double D[3];                /* its apex about the nominal apex (rig frame) */
+    double E[3][3];             /* E[k]: rig axis k in its eye frame */
     double g0x, g0y;            /* its slope at the origin (taken out, as cn_zlocal) */
     double ox, oy;              /* the frame's origin about the rig's nominal apex */
 } kc_surf;
 
+/* The analytic surface's slopes in the measurement's frame (cn_recon.c's last: the
+ * instrument's axes, x = y = 0 on its axis through the nominal apex): the surface met
+ * along the rig's z line through (x, y), its normal turned back into the rig.  On a
+ * decentred or tilted eye this is what the reconstruction's axial power is about (its
+ * eye frame put a 2 deg tilted eye's true Kmax 0.45 mm from the measured one). */
+static int model_slope(const kc_surf *k, double x, double y, double *fx, double *fy)
+{
+    double P[3] = {x - k->D[0], y - k->D[1], -k->D[2]}, p[3], d[3], z = 0, zx = 0, zy = 0;
+    for (int i = 0; i < 3; i++) {
+        p[i] = k->E[0][i] * P[0] + k->E[1][i] * P[1] + k->E[2][i] * P[2];
+        d[i] = k->E[2][i];
+    }
+    double t = -p[2] / d[2];
+    for (int it = 0; it < 40; it++) {   /* Newton on p_z + t d_z - sag(p_xy + t d_xy) */
+        if (cn_sag(&k->s, p[0] + t * d[0], p[1] + t * d[1], &z, &zx, &zy)) return -1;
+        double g = p[2] + t * d[2] - z, dg = d[2] - zx * d[0] - zy * d[1];
+        if (!(fabs(dg) > 1e-9)) return -1;
+        t -= g / dg;
+        if (fabs(g / dg) < 1e-14) break;
+    }
+    if (cn_sag(&k->s, p[0] + t * d[0], p[1] + t * d[1], &z, &zx, &zy)) return -1;
+    double ne[3] = {-zx, -zy, 1}, n[3];
+    for (int i = 0; i < 3; i++) n[i] = k->E[i][0] * ne[0] + k->E[i][1] * ne[1] + k->E[i][2] * ne[2];
+    if (!(n[2] > 1e-9)) return -1;
+    *fx = -n[0] / n[2];
+    *fy = -n[1] / n[2];
+    return 0;
+}
+
 /* Axial curvature of the analytic surface about its normal at the origin. */
 static int model_axial(const kc_surf *k, double x, double y, double *axial)
 {
-    double r = hypot(x, y), ex = 1, ey = 0, z, ax, ay, bx, by, cx, cy;
+    double r = hypot(x, y), ex = 1, ey = 0, ax, ay, bx, by, cx, cy;
     const double h = 1e-4;
     if (r > 0) { ex = x / r; ey = y / r; }
-    if (cn_sag(&k->s, x, y, &z, &ax, &ay) || cn_sag(&k->s, x + h * ex, y + h * ey, &z, &bx, &by) ||
-        cn_sag(&k->s, x - h * ex, y - h * ey, &z, &cx, &cy))
+    if (model_slope(k, x, y, &ax, &ay) || model_slope(k, x + h * ex, y + h * ey, &bx, &by) ||
+        model_slope(k, x - h * ex, y - h * ey, &cx, &cy))
         return -1;
     ax -= k->g0x;
     ay -= k->g0y;
@@ -342,10 +373,18 @@ int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_
     memset(k, 0, sizeof *k);
     cn_surface(model, p, &s.s);
     if (bump) s.s.bump = *bump;
-    double z0;
-    cn_sag(&s.s, 0, 0, &z0, &s.g0x, &s.g0y);
-    s.ox = p->p[CN_DX];
-    s.oy = p->p[CN_DY];
+    /* the pose: the apex and the rig's axes in the eye frame (cn_to_eye) */
+    static const double zero[3] = {0, 0, 0};
+    cn_params rot = *p;
+    double o[3];
+    for (int i = 0; i < 3; i++) { s.D[i] = p->p[CN_DX + i]; rot.p[CN_DX + i] = 0; }
+    cn_to_eye(&rot, zero, zero, o);
+    for (int j = 0; j < 3; j++) {
+        double b[3] = {j == 0, j == 1, j == 2};
+        cn_to_eye(&rot, zero, b, s.E[j]);
+        for (int i = 0; i < 3; i++) s.E[j][i] -= o[i];
+    }
+    if (model_slope(&s, 0, 0, &s.g0x, &s.g0y)) return CN_EINVAL;
     if (indices(&s, zone_r, k)) return CN_EINVAL;
     screen(k);
     return CN_OK;

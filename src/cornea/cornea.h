@@ -332,7 +332,9 @@ typedef struct cornea_api {
     /* The keratoconus indices and screen. */
     int (*kc)(const cn_zfit *z, cn_kc *k);
     /* The same indices of an analytic surface (model, p, bump; the truth in tests and
-     * benchmarks), without sd, in the eye frame of p. */
+     * benchmarks), without sd, in the frame the reconstruction reports them in: x, y
+     * about the instrument's axis through the rig's nominal apex, axial power about
+     * the surface's normal where that axis meets it (p's pose taken into account). */
     int (*kc_model)(int model, const cn_params *p, const cn_bump *bump, double zone_r,
                     cn_kc *k);
 } cornea_api;

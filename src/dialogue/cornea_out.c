@@ -96,7 +96,7 @@ static const double dsteps[] = {0.25, 0.5, 1.0, 1.5, 2.0, 2.5, 5.0, 10.0};
 
 int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
                   const cn_result *r, const cn_spot *sp, int n, const cn_zfit *zf,
-                  const cn_kc *kc,
+                  const cn_kc *kc, int eye,
                   int (*stop)(void *), void (*say)(void *ctx, const char *line),
                   void *ctx, char *msg, size_t cap)
 {
@@ -123,8 +123,9 @@ int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
                                         "Axial curvature, absolute scale"};
     static const char *const file[] = {"-elevation.png", "-axial.png", "-tangential.png",
                                        "-residual.png", "-axial-abs.png"};
-    /* the pictures' marks: the instrument's view, superior up (the eye, OD or OS, is
-       not asked: both readings of x are named); Sim K and Kmax of the data */
+    /* the pictures' marks: the examiner's view, superior up; the eye named (OD: nasal
+       to the right, OS: to the left) or, when not, both readings of x; Sim K and
+       Kmax of the data */
     char marks[200] = "";
     if (zf && kc)
         snprintf(marks, sizeof marks, "; Sim K %.2f / %.2f D @ %.0f, Kmax %.2f D at "
@@ -139,9 +140,13 @@ int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
         m.xmin = m.ymin = -hmax;
         m.xmax = m.ymax = hmax;
         m.disc = hmax;
-        m.title = title[kind];
-        if (zf) {
-            m.xlabel = "x (mm), examiner's view: OD nasal to the right, OS nasal to the left";
+        char ttl[120];
+        snprintf(ttl, sizeof ttl, "%s%s", title[kind], eye == 1 ? ", OD" : eye == 2 ? ", OS" : "");
+        m.title = ttl;
+        if (zf || eye) {
+            m.xlabel = eye == 1 ? "x (mm), examiner's view: T (temporal) left, N (nasal) right"
+                       : eye == 2 ? "x (mm), examiner's view: N (nasal) left, T (temporal) right"
+                       : "x (mm), examiner's view: OD nasal to the right, OS nasal to the left";
             m.ylabel = "y (mm), superior up";
         }
         if (zf && kind != 3) {

@@ -30,11 +30,13 @@ int cs_write_report(const cornea_api *cn, const char *name, const char *text, si
                     int nrows, char *msg, size_t cap);
 /* The maps.  zf (NULL: the fitted model's surface): the surface from the data, drawn
  * only where there are data, with its indices kc on the pictures, and the axial map
- * a second time on the absolute scale.  say(ctx, line) is told each map's scale and
- * file.  0, or -1 with why in msg (a stop: no file under its final name). */
+ * a second time on the absolute scale.  eye: 1 OD, 2 OS (the title names it, the x
+ * axis its nasal and temporal sides), 0 not named (both readings of x are said).
+ * say(ctx, line) is told each map's scale and file.  0, or -1 with why in msg (a
+ * stop: no file under its final name). */
 int cs_write_maps(const cornea_api *cn, const rg_geometry *g, const char *name,
                   const cn_result *r, const cn_spot *sp, int n, const cn_zfit *zf,
-                  const cn_kc *kc,
+                  const cn_kc *kc, int eye,
                   int (*stop)(void *), void (*say)(void *ctx, const char *line),
                   void *ctx, char *msg, size_t cap);
 /* The manifest of one scan's frames: PATTERN with its %d made "-frames" and its

@@ -63,6 +63,7 @@ typedef struct cs {
     char *text;                 /* the report as said, for NAME.txt */
     cn_kc kt;                   /* the true surface's indices (tk 1) */
     int tk;
+    int eye;                    /* the maps' eye: 0 not named, 1 OD, 2 OS */
     tp_iso iso;                 /* the zone pattern on a synthetic eye (have_iso 1) */
     int have_iso;
     int real_clock;             /* the scan runs on a chip: its machine time varies */
@@ -279,7 +280,7 @@ static int cs_files(cs *s, const tp_run *r, int maps, const cs_truth *tr)
         {"kmax_y", k2->kmax_y, k2->sd_kmax_loc, "mm"}, {"central_K", k2->ck, k2->sd_ck, "D"},
         {"I_S", k2->is, k2->sd_is, "D"}, {"I_S_r", k2->is_r, NAN, "mm"},
         {"simk1", k2->simk1, k2->sd_simk, "D"}, {"simk2", k2->simk2, k2->sd_simk, "D"},
-        {"AST", k2->ast, k2->sd_ast, "D"}, {"SRAX", k2->srax, k2->sd_srax, "deg"},
+        {"AST", k2->ast, k2->sd_ast, "D"}, {"SRAX", k2->srax, NAN, "deg"},
         {"KISA", k2->kisa, k2->sd_kisa, "%"}, {"kc_screen", k2->screen, NAN, ""},
         {"true_kmax", tk ? kt.kmax : NAN, NAN, "D"}, {"true_kmax_x", tk ? kt.kmax_x : NAN, NAN, "mm"},
         {"true_kmax_y", tk ? kt.kmax_y : NAN, NAN, "mm"}, {"true_central_K", tk ? kt.ck : NAN, NAN, "D"},
@@ -307,8 +308,10 @@ static int cs_files(cs *s, const tp_run *r, int maps, const cs_truth *tr)
     memcpy(all + nrows, zrows, sizeof *all * (size_t)nz);
     memcpy(all + nrows + nz, crows, sizeof *all * (size_t)nc);
     nz += nc;
+    if (maps && s->eye)
+        say(s, CS(EYE), s->eye == 1 ? CS(EYE_OD) : CS(EYE_OS), s->eye == 1 ? "right" : "left");
     if (maps && cs_write_maps(cn, r->g, s->report, &r->res, sp, n, r->have_z ? r->zf : NULL,
-                              &r->kc, stop_cb, say_line, s, msg, sizeof msg)) {
+                              &r->kc, s->eye, stop_cb, say_line, s, msg, sizeof msg)) {
         rc = lm_stop_requested() ? LM_FAIL : calc_fail(&s->cc, CS(NO_REPORT));
         fprintf(stderr, "lensmat: ");
         fprintf(stderr, CS(REPORT_FAILED), s->report, msg);
@@ -332,6 +335,7 @@ int lm_cornea_scan(lm_io *io)
     static const char *const models[] = {"sphere", "conic", "biconic", "asphere", NULL};
     static const char *const chips[] = {"none", "sim", "gpiod", NULL};
     static const char *const patterns[] = {"spiral", "rings", "grid", "zone", NULL};
+    static const char *const map_answers[] = {"n", "y", "OD", "OS", "no", "yes", NULL};
     static const char *const sources[] = {"frames", "model", "camera", NULL};
     cs *s = calloc(1, sizeof *s);
     tp_run *r = calloc(1, sizeof *r);
@@ -426,8 +430,12 @@ int lm_cornea_scan(lm_io *io)
     int maps = 0;
     if ((rc = lm_ask_file(io, CS(REPORT), CS(REPORT), CS(REPORT_WHAT), check_report, s,
                           s->report, sizeof s->report)) ||
-        (strcmp(s->report, "-") && (rc = calc_yn(c, CS(MAPS), CS(MAPS_WHAT), &maps))))
+        (strcmp(s->report, "-") && (rc = calc_choice(c, CS(MAPS), CS(MAPS_WHAT), map_answers,
+                                                     &maps))))
         goto out;
+    /* n y OD OS no yes: maps 0 none, else drawn; the eye 1 OD, 2 OS, 0 not named */
+    s->eye = maps == 2 ? 1 : maps == 3 ? 2 : 0;
+    maps = maps != 0 && maps != 4;
 
     /* the rig's geometry: the rig file's, or the example */
     static rg_geometry g;
@@ -529,9 +537,13 @@ int lm_cornea_scan(lm_io *io)
         say(s, CS(TRUTH), eye.R, eye.R2, km, cyl);
         s->tk = r->have_z &&
                 !cn->kc_model(CN_BICONIC, &t, cone.h > 0 ? &cone : NULL, r->zf->rho, &s->kt);
-        if (s->tk)
+        if (s->tk) {
+            char srax[40] = "not defined", kisa[40] = "not defined";
+            if (isfinite(s->kt.srax)) snprintf(srax, sizeof srax, "%.0f deg", s->kt.srax);
+            if (isfinite(s->kt.kisa)) snprintf(kisa, sizeof kisa, "%.0f %%", s->kt.kisa);
             say(s, CS(TOPO_TRUTH), s->kt.kmax, s->kt.kmax_x, s->kt.kmax_y, s->kt.ck, s->kt.is,
-                s->kt.srax, s->kt.kisa);
+                srax, kisa);
+        }
         if (!r->res.rejected_model && r->res.converged)   /* else no numbers to compare */
             say(s, CS(ERRORS), (r->res.k.R - t.p[CN_R]) * 1e3, r->res.k.Km - km, axis_err);
     }
@@ -622,10 +634,21 @@ static void say_surface(cs *s, tp_run *r)
         k->sd_simk *= f; k->sd_ast *= f; k->sd_srax *= f; k->sd_kisa *= f;
     }
     say(s, CS(TOPO_KMAX), k->kmax, k->sd_kmax, k->kmax_x, k->kmax_y, k->sd_kmax_loc);
+    if (s->eye)     /* +x is the examiner's right: nasal on OD, temporal on OS */
+        say(s, CS(KMAX_WHERE), fabs(k->kmax_y), k->kmax_y < 0 ? "inferior" : "superior",
+            fabs(k->kmax_x), (k->kmax_x >= 0) == (s->eye == 1) ? "nasal" : "temporal",
+            s->eye == 1 ? CS(EYE_OD) : CS(EYE_OS));
     say(s, CS(TOPO_CK), k->ck, k->sd_ck, k->ck_rings, k->simk1, k->simk2, k->simk_axis,
         fmin(1.5, 0.9 * k->zone_r), k->ast, k->sd_ast);
+    /* SRAX has no sd (the engine does not propagate one to an argmax): printed bare,
+       and KISA's sd says it leaves SRAX out */
+    char srax[160], kisa[80];
+    if (isfinite(k->srax)) snprintf(srax, sizeof srax, CS(TOPO_SRAX), k->srax);
+    else snprintf(srax, sizeof srax, "%s", CS(TOPO_SRAX_NONE));
+    if (isfinite(k->kisa)) snprintf(kisa, sizeof kisa, CS(TOPO_KISA), k->kisa, k->sd_kisa);
+    else snprintf(kisa, sizeof kisa, "%s", CS(TOPO_KISA_NONE));
     say(s, CS(TOPO_IS), k->is, k->sd_is, k->is_r, k->is_r < 3 ? CS(TOPO_IS_SHORT) : "",
-        k->srax, k->sd_srax, k->kisa, k->sd_kisa);
+        srax, kisa);
     if (k->screen == CN_KC_KERATOCONUS)
         say(s, CS(TOPO_SCREEN_KC), k->why, k->kmax_x, k->kmax_y);
     else if (k->screen == CN_KC_SUSPECT)
