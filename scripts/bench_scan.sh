@@ -41,4 +41,12 @@ echo "BENCH cornea_scan1000_sim_s $f s"
 echo "BENCH cornea_scan1000_stopgo_sim_s $s s"
 echo "BENCH cornea_scan1000_oldrig_sim_s $old s"
 echo "BENCH cornea_scan1000_fly_vs_stopgo $(awk -v a="$f" -v b="$s" 'BEGIN { printf "%.3f", a / b }') x"
+# one rig for both the clinical zone and the fast scan: golden/rig/wide-zone.rig (the
+# zone's geometry with the example's motors), the zone pattern over 8 mm, 1000
+# targets, on the fly; the scan's own pass (the coarse passes before it are said too)
+printf 'biconic\ngolden/rig/wide-zone.rig\nsim\n-\n0.02\nzone\n1000\n8\nmodel\n7.8\n-0.26\n0.75\n0\n0\n0\n0\n0\n0.04\n3.45\n1\n0\n-\n' > "$O/wide.in"
+"$L" --cornea-scan -i "$O/wide.in" "$O/wide.rec" > "$O/wide.out" 2> "$O/wide.err" ||
+    { echo "bench_scan: wide failed: $(head -1 "$O/wide.err")" >&2; exit 1; }
+grep -E '^(Zone pass|Pattern zone|Scan on the machine|Coverage)' "$O/wide.rec" | sed 's/^/# wide-zone rig: /'
+echo "BENCH cornea_scan1000_widezone_sim_s $(simt wide) s"
 "$D" 1000 | grep -E '^(BENCH|#|FAIL)'

@@ -118,3 +118,17 @@ tp_posed() {
          END { exit !(k != "" && tk != "" && (k - tk) ^ 2 < 0.05 ^ 2 && (x - tx) ^ 2 + (y - ty) ^ 2 < 0.05 ^ 2) }' "$TP/po.rec"
 }
 check "--cornea-scan: a decentred, tilted coned eye's Kmax within 0.05 D and 0.05 mm of the true surface's (instrument frame)" tp_posed
+# SRAX's and KISA's sd (cn_kc.c: SRAX's from how sharp each half's steepest
+# semi-meridian is against its noise) against the spread of 6 seeds of the same coned
+# eye at 0.5 px: the seeds' sd within 3x the reported one (and SRAX within 1 deg)
+tp_srax_sd() {
+    for sd in 1 2 3 4 5 6; do
+        printf 'biconic\n-\nspiral\n500\n12\nmodel\n7.8\n-0.26\n0.75\n0\n0\n0\n0\n0\n0.5\n5\n%s\n10\n0.6\n0.7\n-0.5\n-\n' "$sd" > "$TP/sr$sd.in"
+        (cd "$TP" && "$BIN" --cornea-scan -i "sr$sd.in" "sr$sd.rec" > /dev/null 2> "sr$sd.err") || { cat "$TP/sr$sd.err"; return 1; }
+        grep '^I-S' "$TP/sr$sd.rec" | sed 's/.*SRAX/SRAX/'
+    done | awk '{ n++; s += $2; ss += $2 * $2; rs += $4; k += $7; kk += $7 * $7; rk += $9 }
+        END { ms = s / n; sds = sqrt((ss - n * ms * ms) / (n - 1)); mk = k / n; sdk = sqrt((kk - n * mk * mk) / (n - 1));
+              printf "SRAX seeds sd %.2f, reported %.2f; KISA seeds sd %.1f, reported %.1f\n", sds, rs / n, sdk, rk / n;
+              exit !(n == 6 && sds <= 3 * (rs / n) + 1 && sdk <= 3 * rk / n && sdk >= rk / n / 3) }'
+}
+check "--cornea-scan: SRAX's and KISA's sd against the spread of 6 seeds of a coned eye (within 3x)" tp_srax_sd

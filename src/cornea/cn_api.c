@@ -33,6 +33,7 @@ static const cornea_api api = {
     .zmap = cn_zmap,
     .kc = cn_kc_of,
     .kc_model = cn_kc_model,
+    .kc_model_in = cn_kc_model_in,
 };
 
 __attribute__((visibility("default"))) const cornea_api *cornea_get_api(int abi)

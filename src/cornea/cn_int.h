@@ -69,6 +69,8 @@ int cn_zlocal(const cn_zfit *z, double x, double y, double *axial, double *tang,
 int cn_zmap(int kind, const cn_zfit *z, double hmax, int n, double *grid, double *aux);
 int cn_kc_of(const cn_zfit *z, cn_kc *k);
 int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_r, cn_kc *k);
+int cn_kc_model_in(int model, const cn_params *p, const cn_bump *bump, const cn_params *frame,
+                   double zone_r, cn_kc *k);
 
 /* cn_analyse.c: Jacobian, SVD, covariance, determinacy, clinical numbers */
 void cn_free_mask(int model, int fix_tilt, int free[CN_NPARAM]);

@@ -17,23 +17,23 @@
 /* A surface the indices read: axial power (D) at (x, y), 0 or -1. */
 typedef struct kc_surf {
     const cn_zfit *z;           /* the reconstruction, or */
-    cn_surf s;                  /* an analytic surface, posed by: */
-    double D[3];                /* its apex about the nominal apex (rig frame) */
-    double E[3][3];             /* E[k]: rig axis k in its eye frame */
+    cn_surf s;                  /* an analytic surface, seen from a frame: */
+    double O[3];                /* the frame's origin in the surface's eye frame */
+    double E[3][3];             /* E[k]: the frame's axis k in the eye frame */
     double g0x, g0y;            /* its slope at the origin (taken out, as cn_zlocal) */
     double ox, oy;              /* the frame's origin about the rig's nominal apex */
 } kc_surf;
 
-/* The analytic surface's slopes in the measurement's frame (cn_recon.c's last: the
- * instrument's axes, x = y = 0 on its axis through the nominal apex): the surface met
- * along the rig's z line through (x, y), its normal turned back into the rig.  On a
- * decentred or tilted eye this is what the reconstruction's axial power is about (its
- * eye frame put a 2 deg tilted eye's true Kmax 0.45 mm from the measured one). */
+/* The analytic surface's slopes in a frame (the reconstruction's, cn_recon.c: the
+ * reference model's eye frame when that fits, else the instrument's axes): the
+ * surface met along the frame's z line through (x, y), its normal turned back into
+ * the frame.  Taken in the surface's own frame instead, a 2 deg tilted, decentred
+ * coned eye's true Kmax sat 0.45 mm from a correct measurement in the instrument's. */
 static int model_slope(const kc_surf *k, double x, double y, double *fx, double *fy)
 {
-    double P[3] = {x - k->D[0], y - k->D[1], -k->D[2]}, p[3], d[3], z = 0, zx = 0, zy = 0;
+    double p[3], d[3], z = 0, zx = 0, zy = 0;
     for (int i = 0; i < 3; i++) {
-        p[i] = k->E[0][i] * P[0] + k->E[1][i] * P[1] + k->E[2][i] * P[2];
+        p[i] = k->O[i] + x * k->E[0][i] + y * k->E[1][i];
         d[i] = k->E[2][i];
     }
     double t = -p[2] / d[2];
@@ -244,6 +244,24 @@ static int ring(const kc_surf *k, double r, double *mean, double *amp, double *s
     return 0;
 }
 
+/* The mean axial power of each semi-meridian (1 deg steps, 0.5 mm to lim), and the
+ * steepest of the upper (0-179) and lower (180-359) halves. */
+static void semi_meridians(const kc_surf *k, double lim, double sm[360], int *au, int *al)
+{
+    double bu = -INFINITY, bl = -INFINITY, p;
+    *au = 0;
+    *al = 180;
+    for (int dg = 0; dg < 360; dg++) {
+        double a = dg * DEG, sum = 0;
+        int nn = 0;
+        for (double r = 0.5; r <= lim; r += 0.1)
+            if (!power(k, r * cos(a), r * sin(a), &p)) { sum += p; nn++; }
+        sm[dg] = nn ? sum / nn : -INFINITY;
+        if (dg < 180) { if (sm[dg] > bu) { bu = sm[dg]; *au = dg; } }
+        else if (sm[dg] > bl) { bl = sm[dg]; *al = dg; }
+    }
+}
+
 /* The indices of one surface (no sd). */
 static int indices(const kc_surf *k, double zone, cn_kc *o)
 {
@@ -305,17 +323,11 @@ static int indices(const kc_surf *k, double zone, cn_kc *o)
     /* SRAX: the steepest semi-meridian above and below the horizontal (mean axial
        power from 0.5 mm to the zone's edge, 1 deg steps); the angle between them
        less 180 */
-    double sm[360], bu = -INFINITY, bl = -INFINITY;
-    int au = 0, al = 180;
-    for (int dg = 0; dg < 360; dg++) {
-        double a = dg * DEG, sum = 0;
-        int nn = 0;
-        for (double r = 0.5; r <= lim; r += 0.1)
-            if (!power(k, r * cos(a), r * sin(a), &p)) { sum += p; nn++; }
-        sm[dg] = nn ? sum / nn : -INFINITY;
-        if (dg < 180) { if (sm[dg] > bu) { bu = sm[dg]; au = dg; } }
-        else if (sm[dg] > bl) { bl = sm[dg]; al = dg; }
-    }
+    double sm[360], bu, bl;
+    int au, al;
+    semi_meridians(k, lim, sm, &au, &al);
+    bu = sm[au];
+    bl = sm[al];
     /* each half's steepest semi-meridian must be one: a cone straight below steepens
        the two semi-meridians either side of it alike, and the upper half's flanks
        alike, and which of two equals wins is noise (the bench's cone read 35 deg
@@ -367,27 +379,42 @@ static void screen(cn_kc *o)
     if (l >= 2 && l < sizeof o->why) o->why[l - 2] = 0;
 }
 
-int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_r, cn_kc *k)
+int cn_kc_model_in(int model, const cn_params *p, const cn_bump *bump, const cn_params *frame,
+                   double zone_r, cn_kc *k)
 {
     kc_surf s = {0};
     memset(k, 0, sizeof *k);
     cn_surface(model, p, &s.s);
     if (bump) s.s.bump = *bump;
-    /* the pose: the apex and the rig's axes in the eye frame (cn_to_eye) */
+    /* the frame in the eye frame (cn_to_eye: eye = Mp^T (x - Dp), frame = Mf^T (x - Df)):
+       its origin Mp^T (Df - Dp), its axis k Mp^T Mf b_k */
     static const double zero[3] = {0, 0, 0};
-    cn_params rot = *p;
-    double o[3];
-    for (int i = 0; i < 3; i++) { s.D[i] = p->p[CN_DX + i]; rot.p[CN_DX + i] = 0; }
-    cn_to_eye(&rot, zero, zero, o);
-    for (int j = 0; j < 3; j++) {
-        double b[3] = {j == 0, j == 1, j == 2};
-        cn_to_eye(&rot, zero, b, s.E[j]);
-        for (int i = 0; i < 3; i++) s.E[j][i] -= o[i];
+    cn_params prot = *p, frot = *frame;
+    double Df[3], Mf[3][3];
+    for (int i = 0; i < 3; i++) {
+        Df[i] = frame->p[CN_DX + i];
+        prot.p[CN_DX + i] = frot.p[CN_DX + i] = 0;
     }
+    cn_to_eye(p, zero, Df, s.O);
+    for (int j = 0; j < 3; j++) {       /* Mf[j][k] = (Mf^T b_j)_k */
+        double b[3] = {j == 0, j == 1, j == 2};
+        cn_to_eye(&frot, zero, b, Mf[j]);
+    }
+    for (int c = 0; c < 3; c++) {
+        double a[3] = {Mf[0][c], Mf[1][c], Mf[2][c]};   /* Mf b_c, in the rig */
+        cn_to_eye(&prot, zero, a, s.E[c]);
+    }
+    s.ox = Df[0];
+    s.oy = Df[1];
     if (model_slope(&s, 0, 0, &s.g0x, &s.g0y)) return CN_EINVAL;
     if (indices(&s, zone_r, k)) return CN_EINVAL;
     screen(k);
     return CN_OK;
+}
+
+int cn_kc_model(int model, const cn_params *p, const cn_bump *bump, double zone_r, cn_kc *k)
+{
+    return cn_kc_model_in(model, p, bump, p, zone_r, k);
 }
 
 /* The radius of the largest circle about the frame's origin that the data fill: the
@@ -453,12 +480,33 @@ int cn_kc_of(const cn_zfit *z, cn_kc *k)
     k->sd_simk = nv ? sqrt(v / nv) / sqrt(indep) : INFINITY;
     k->sd_ck = k->sd_simk;
     k->sd_ast = 2 * k->sd_simk;
-    k->sd_srax = INFINITY;          /* not propagated: SRAX enters the screen via KISA */
+    /* SRAX's sd: an argmax has no derivative, so from how sharp each half's steepest
+       semi-meridian is against its own noise: the semi-meridians within sqrt(2) sd
+       (a difference of two means) of the half's maximum span +-w about it, and w / sqrt(3)
+       (a uniform spread over them) is that direction's sd; SRAX's is the two halves'
+       in quadrature.  A semi-meridian's mean's sd: the power's sd at its middle over
+       the root of the independent kernels along it, (lim - 0.5) / kr. */
+    k->sd_srax = NAN;
+    if (isfinite(k->srax)) {
+        double lim = 0.9 * k->zone_r, sm[360], rm = 0.5 * (0.5 + lim), w2 = 0;
+        double nind = fmax(1, (lim - 0.5) / z->kr);
+        int am[2];
+        semi_meridians(&s, lim, sm, &am[0], &am[1]);
+        for (int h = 0; h < 2; h++) {
+            double a = am[h] * DEG, sdm = INFINITY, w = 0;
+            if (!power_sd(&s, rm * cos(a), rm * sin(a), &pe, &sdd)) sdm = sdd / sqrt(nind);
+            for (int dg = h * 180; dg < h * 180 + 180; dg++)
+                if (sm[dg] >= sm[am[h]] - sqrt(2.0) * sdm) w = fmax(w, abs(dg - am[h]));
+            w2 += w * w / 3 + 1.0 / 12;     /* + the 1 deg grid's own spread */
+        }
+        k->sd_srax = sqrt(w2);
+    }
     (void)sd;
     double rel = 0;
     if (k->ck) rel += pow(k->sd_ck / k->ck, 2);
     if (k->is) rel += pow(k->sd_is / k->is, 2);
     if (k->ast) rel += pow(k->sd_ast / k->ast, 2);
+    if (k->srax > 0 && isfinite(k->sd_srax)) rel += pow(k->sd_srax / k->srax, 2);
     k->sd_kisa = fabs(k->kisa) * sqrt(rel);
     return CN_OK;
 }

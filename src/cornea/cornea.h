@@ -24,7 +24,8 @@
 #include <stddef.h>
 #include "rig/rig.h"
 
-#define CORNEA_ABI 4            /* 4: cn_zfit grew (order 26, the slopes' departure zsl[]) */
+#define CORNEA_ABI 5            /* 4: cn_zfit grew (order 26, the slopes' departure zsl[]);
+                                   5: kc_model_in */
 #define CORNEA_API_SYMBOL "cornea_get_api"
 
 enum { CN_OK = 0, CN_EINVAL = -1, CN_ENOMEM = -2, CN_EFIT = -3, CN_ESTOP = -4,
@@ -332,11 +333,15 @@ typedef struct cornea_api {
     /* The keratoconus indices and screen. */
     int (*kc)(const cn_zfit *z, cn_kc *k);
     /* The same indices of an analytic surface (model, p, bump; the truth in tests and
-     * benchmarks), without sd, in the frame the reconstruction reports them in: x, y
-     * about the instrument's axis through the rig's nominal apex, axial power about
-     * the surface's normal where that axis meets it (p's pose taken into account). */
+     * benchmarks), without sd, in the eye frame of p. */
     int (*kc_model)(int model, const cn_params *p, const cn_bump *bump, double zone_r,
                     cn_kc *k);
+    /* ... in a given frame (a pose; the measurement's is its reconstruction's z->ref:
+     * the reference model's eye frame when that fits, else the instrument's axes):
+     * the surface met along the frame's z lines, axial power about its normal at the
+     * frame's origin, x, y as cn_kc_of reports them.  kc_model is this with frame p. */
+    int (*kc_model_in)(int model, const cn_params *p, const cn_bump *bump,
+                       const cn_params *frame, double zone_r, cn_kc *k);
 } cornea_api;
 
 typedef const cornea_api *(*cornea_get_api_fn)(int abi);

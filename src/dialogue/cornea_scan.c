@@ -280,7 +280,7 @@ static int cs_files(cs *s, const tp_run *r, int maps, const cs_truth *tr)
         {"kmax_y", k2->kmax_y, k2->sd_kmax_loc, "mm"}, {"central_K", k2->ck, k2->sd_ck, "D"},
         {"I_S", k2->is, k2->sd_is, "D"}, {"I_S_r", k2->is_r, NAN, "mm"},
         {"simk1", k2->simk1, k2->sd_simk, "D"}, {"simk2", k2->simk2, k2->sd_simk, "D"},
-        {"AST", k2->ast, k2->sd_ast, "D"}, {"SRAX", k2->srax, NAN, "deg"},
+        {"AST", k2->ast, k2->sd_ast, "D"}, {"SRAX", k2->srax, k2->sd_srax, "deg"},
         {"KISA", k2->kisa, k2->sd_kisa, "%"}, {"kc_screen", k2->screen, NAN, ""},
         {"true_kmax", tk ? kt.kmax : NAN, NAN, "D"}, {"true_kmax_x", tk ? kt.kmax_x : NAN, NAN, "mm"},
         {"true_kmax_y", tk ? kt.kmax_y : NAN, NAN, "mm"}, {"true_central_K", tk ? kt.ck : NAN, NAN, "D"},
@@ -536,7 +536,8 @@ int lm_cornea_scan(lm_io *io)
     if (rc == LM_GO && r->have_truth) {
         say(s, CS(TRUTH), eye.R, eye.R2, km, cyl);
         s->tk = r->have_z &&
-                !cn->kc_model(CN_BICONIC, &t, cone.h > 0 ? &cone : NULL, r->zf->rho, &s->kt);
+                !cn->kc_model_in(CN_BICONIC, &t, cone.h > 0 ? &cone : NULL, &r->zf->ref,
+                                 r->zf->rho, &s->kt);
         if (s->tk) {
             char srax[40] = "not defined", kisa[40] = "not defined";
             if (isfinite(s->kt.srax)) snprintf(srax, sizeof srax, "%.0f deg", s->kt.srax);
@@ -640,10 +641,9 @@ static void say_surface(cs *s, tp_run *r)
             s->eye == 1 ? CS(EYE_OD) : CS(EYE_OS));
     say(s, CS(TOPO_CK), k->ck, k->sd_ck, k->ck_rings, k->simk1, k->simk2, k->simk_axis,
         fmin(1.5, 0.9 * k->zone_r), k->ast, k->sd_ast);
-    /* SRAX has no sd (the engine does not propagate one to an argmax): printed bare,
-       and KISA's sd says it leaves SRAX out */
+    /* SRAX and KISA may be undefined (cn_kc.c): said so, not printed as nan */
     char srax[160], kisa[80];
-    if (isfinite(k->srax)) snprintf(srax, sizeof srax, CS(TOPO_SRAX), k->srax);
+    if (isfinite(k->srax)) snprintf(srax, sizeof srax, CS(TOPO_SRAX), k->srax, k->sd_srax);
     else snprintf(srax, sizeof srax, "%s", CS(TOPO_SRAX_NONE));
     if (isfinite(k->kisa)) snprintf(kisa, sizeof kisa, CS(TOPO_KISA), k->kisa, k->sd_kisa);
     else snprintf(kisa, sizeof kisa, "%s", CS(TOPO_KISA_NONE));

@@ -24,6 +24,7 @@ int main(int argc, char **argv)
     static char text[1 << 20], ex[1 << 16];
     char dir[] = "/tmp/bench_safety.XXXXXX", logp[600];
     double worst = 0, homed_at = -1;
+    long t0[RG_NJOINTS] = {0};
     int runs = 0;
     rg_rig rig;
     if (ex0) snprintf(ex, sizeof ex, "%s", ex0);
@@ -41,6 +42,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "%s\n", err);
             return 1;
         }
+        rg->position(m, t0, NULL);
         rg->close(m);
         {
             char *log = unit_slurp(logp), *p = log ? strstr(log, " homed") : NULL;
@@ -48,10 +50,19 @@ int main(int argc, char **argv)
             if (p) homed_at = atof(p);
         }
     }
+    /* the move: m1a over most of its travel from home (a trapezoid of the axis's speed
+       and acceleration), its duration T from them, so the openings fall in it whatever
+       the rig's motors (the example's were 1.1 s for 2000 steps, now 0.1 s) */
+    const rg_axis *ax = &rig.axis[RG_J_M1A];
+    long nsteps = lround(0.9 * (ax->max * ax->steps_per - t0[RG_J_M1A]));
+    double V = ax->speed * ax->steps_per, A = ax->accel * ax->steps_per;
+    double T = nsteps > V * V / A ? nsteps / V + V / A : 2 * sqrt(nsteps / A);
+    double span_ms = (T * 1e3 - 60) / 200, tick_ms = rig.tick_us / 1e3;
     for (int k = 0; k < 200 && homed_at > 0; k++) {
-        /* the move starts 5 ms (settle) after homing and lasts 1.1 s: openings from
-         * 50 ms into it, each at another phase of the 250 us control step */
-        double at_ms = (homed_at + 0.005) * 1e3 + 50 + k * 5.0 + k * 0.25 / 200 * 1.0 + 0.0013;
+        /* the move starts after homing and its settle: openings from 50 ms into it to
+         * 10 ms before its end, each at another phase of the control step */
+        double at_ms = (homed_at + rig.settle_ms / 1e3) * 1e3 + 50 + k * span_ms +
+                       k * tick_ms / 200 + 0.0013;
         rg_open_opts o = {RG_BACKEND_SIM, NULL, logp, NULL, 0};
         rg_machine *m;
         long t[RG_NJOINTS];
@@ -61,7 +72,7 @@ int main(int argc, char **argv)
             rg->open(&rig, &o, &m, err, sizeof err)) { fprintf(stderr, "%s\n", err); return 1; }
         rg->home(m, NULL, NULL, err, sizeof err);
         rg->position(m, t, NULL);
-        t[RG_J_M1A] += 2000;
+        t[RG_J_M1A] += nsteps;
         rg->move_steps(m, t, NULL, NULL, err, sizeof err);
         rg->close(m);
         log = unit_slurp(logp);
