@@ -648,9 +648,11 @@ typedef struct rig_api {
                       long n, double expose_ms, rg_sweep_stats *st, char *err, size_t cap);
     /* ---- the beam (rg_spots.c) ---- */
     /* The beam radius on the cornea and the detector for the apex pose, the focus
-     * lens that balances them and the centroid's shot-noise limit.  RG_OK, or
-     * RG_EINVAL ("FILE:LINE: why" for a rig-file value the geometry rules out; no
-     * wavelength; the apex pose does not solve). */
+     * lens that balances them and the centroid's shot-noise limit; then (ABI 2) the
+     * oblique incidence over the scan (rg_spots.apex, big, small, steep).  A rig that
+     * cannot reach the apex: its first scan target that solves (ref_not_apex).  RG_OK,
+     * or RG_EINVAL ("FILE:LINE: why" for a rig-file value the geometry rules out; no
+     * wavelength; no pose of the scan solves). */
     int (*spots)(const rg_rig *rig, rg_spots *s, char *err, size_t cap);
     /* ---- ABI 2: the cornea's oblique incidence (rg_spotscan.c, rg_cornea.c) ---- */
     /* The placed cornea's second fundamental form at rig point p (on the surface) on
