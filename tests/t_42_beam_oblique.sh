@@ -86,6 +86,7 @@ check "rig beam oblique: ASan build, the same session" sh -c "cd '$D/a' && LENSM
 obl_wide() {   # blind at the apex: a stand-in pose, no apex line, incidence past 40 deg
     obl_session "$D/w" "$TOP/golden/rig/wide-zone.rig" || return 1
     grep -q "^Beam: the apex pose does not solve (m2 or its mount blocks" "$D/w/r.rec" &&
+        grep -q "^Beam, that pose: laser to m1" "$D/w/r.rec" &&
         grep -q '^Oblique incidence, apex pose: none' "$D/w/r.rec" &&
         awk '/^Scan: .* poses have a beam/ { inc = $(NF - 7) } END { exit !(inc > 40) }' \
             "$D/w/r.rec"

@@ -520,7 +520,8 @@ static int do_beam(rdlg *d)
         d->api->solve(&d->rig.geom, &t0, NULL, &sol, err, sizeof err);
         lm_say(d->io, LM_BOTH, P(BEAM_PATH_REF), err, s.ref.a, s.ref.b / DEG);
     }
-    lm_say(d->io, LM_BOTH, P(BEAM_PATH), s.path[0], s.path[1], s.path[2], s.path[3], s.R);
+    lm_say(d->io, LM_BOTH, s.ref_not_apex ? P(BEAM_PATH_STAND) : P(BEAM_PATH), s.path[0],
+           s.path[1], s.path[2], s.path[3], s.R);
     if (s.waist_from_diameter)
         lm_say(d->io, LM_BOTH, P(BEAM_LASER_DERIVED), s.w0, s.m2, s.lambda_mm * 1e6);
     else
