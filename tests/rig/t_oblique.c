@@ -287,6 +287,11 @@ int main(int argc, char **argv)
           rel(s.apex.foot_minor, fmin(s.apex.w_t, s.apex.w_s)) < 1e-9,
           "apex pose: the beam meets the detector square on (%.1e rad): footprint = section "
           "%.5g x %.5g mm", s.apex.det_inc, s.apex.foot_major, s.apex.foot_minor);
+    /* the apex pose's plane of incidence is the rig's y-z plane and x' the rig's +x:
+     * the tangential (larger) axis lies along y' */
+    CHECK(s.apex.w_t > s.apex.w_s && fabs(fabs(s.apex.foot_angle) - 90 * RT_DEG) < 1e-6,
+          "apex pose: the major axis at %.6f deg from x' (the plane of incidence: 90)",
+          s.apex.foot_angle / RT_DEG);
     scan_checks("example, lens", &r, &s);
     CHECK(load(base, "cornea biconic\ncornea_R 7.9\ncornea_R2 7.3\ncornea_Q -0.2\n"
                "cornea_Q2 -0.1\ncornea_axis 25\n", &r, err, sizeof err) == 0 &&
