@@ -478,6 +478,33 @@ static int do_scan(rdlg *d)
 
 /* ---- the session ---------------------------------------------------------------- */
 
+/* One pose's extreme spot line: the apex (RG_T_ANGLES 0 0) at height 0. */
+static void spot_line(rdlg *d, const char *fmt, const rg_spot_pose *p)
+{
+    double h = p->target.kind == RG_T_HEIGHT ? p->target.a : 0;
+    double ph = p->target.kind == RG_T_HEIGHT ? p->target.b / DEG : 0;
+    lm_say(d->io, LM_BOTH, fmt, p->foot_major, p->foot_minor, p->foot_angle / DEG, h, ph,
+           p->theta / DEG, p->f_t, p->f_s, p->psi / DEG);
+}
+
+/* The cornea's oblique incidence (ABI 2: rg_spots' scan fields): the apex pose, then
+ * the scan's incidence, its largest and smallest detector spot and the centroid. */
+static void beam_oblique(rdlg *d, const rg_spots *s)
+{
+    const rg_spot_pose *st = &s->steep;
+    if (s->ref_not_apex) lm_say(d->io, LM_BOTH, "%s", P(BEAM_OBLIQUE_NONE));
+    else lm_say(d->io, LM_BOTH, P(BEAM_OBLIQUE), s->apex.theta / DEG, s->apex.f_t,
+                s->apex.f_s, s->apex.foot_major, s->apex.foot_minor);
+    lm_say(d->io, LM_BOTH, P(BEAM_SCAN), s->scan_n, s->scan_n + s->scan_bad, RG_SPOTS_POSES,
+           s->scan_h, st->theta / DEG, st->target.kind == RG_T_HEIGHT ? st->target.a : 0,
+           st->target.kind == RG_T_HEIGHT ? st->target.b / DEG : 0);
+    spot_line(d, P(BEAM_SPOT_LARGE), &s->big);
+    spot_line(d, P(BEAM_SPOT_SMALL), &s->small);
+    if (s->have_dose && s->photons > 0)
+        lm_say(d->io, LM_BOTH, P(BEAM_CENTROID_SCAN), s->big.sigma_major_um,
+               s->big.sigma_minor_um, s->small.sigma_major_um, s->small.sigma_minor_um);
+}
+
 /* The beam on the cornea and the detector (rig_api.spots): the engine computes,
  * this prints. */
 static int do_beam(rdlg *d)
@@ -487,7 +514,14 @@ static int do_beam(rdlg *d)
     int rc;
     if (!d->api->spots) return refused(d, RG_EINVAL, P(NO_GEOMETRY));
     if ((rc = d->api->spots(&d->rig, &s, err, sizeof err))) return refused(d, rc, err);
-    lm_say(d->io, LM_BOTH, P(BEAM_PATH), s.path[0], s.path[1], s.path[2], s.path[3], s.R);
+    if (s.ref_not_apex) {
+        rg_target t0 = {RG_T_ANGLES, 0, 0};
+        rg_solution sol;
+        d->api->solve(&d->rig.geom, &t0, NULL, &sol, err, sizeof err);
+        lm_say(d->io, LM_BOTH, P(BEAM_PATH_REF), err, s.ref.a, s.ref.b / DEG);
+    }
+    lm_say(d->io, LM_BOTH, s.ref_not_apex ? P(BEAM_PATH_STAND) : P(BEAM_PATH), s.path[0],
+           s.path[1], s.path[2], s.path[3], s.R);
     if (s.waist_from_diameter)
         lm_say(d->io, LM_BOTH, P(BEAM_LASER_DERIVED), s.w0, s.m2, s.lambda_mm * 1e6);
     else
@@ -505,6 +539,7 @@ static int do_beam(rdlg *d)
         lm_say(d->io, LM_BOTH, P(BEAM_CENTROID), s.expose_ms, s.reflectance, s.photons,
                s.sigma_um, s.sigma_best_um);
     else lm_say(d->io, LM_BOTH, "%s", P(BEAM_NO_DOSE));
+    beam_oblique(d, &s);
     return LM_GO;
 }
 

@@ -1,8 +1,9 @@
 /* rg_cornea.c -- the cornea models of section 33 (sphere, conic, even asphere) and the
  * biconic (toric) of real corneas, in the eye frame (apex at the origin, +z into the
  * eye), placed in the rig by the eye's pose: sag and slopes, outward normal, ray hits,
- * and target points (theta, phi about the apex centre of curvature, or height and
- * meridian). */
+ * target points (theta, phi about the apex centre of curvature, or height and
+ * meridian), and the surface's curvatures on two tangent directions (the beam's
+ * oblique reflection, rg_spotscan.c). */
 #include <stdio.h>
 #include "rig/rg_geom.h"
 #include "rig/rg_vec.h"
@@ -246,4 +247,74 @@ void rg_eye_pose(rg_cornea *c, double rx, double ry, double rz, const double at[
                    -sy, cy * sx, cy * cx};
     for (int i = 0; i < 9; i++) c->rot[i] = m[i];
     v3copy(c->trans, at);
+}
+
+/* Second derivatives of the sag at (x, y) in the eye frame (hxx, hxy, hyy): analytic,
+ * the rotational sag as z''(s) along the radius and z'(s)/s across it; the biconic's
+ * z = N / (1 + S), S = sqrt(u), by the quotient rule in its own axes, then turned. */
+static int sag_hessian(const rg_cornea *c, double x, double y, double h[3])
+{
+    if (c->model != RG_BICONIC) {
+        double s2 = x * x + y * y, cv = 1 / c->R, k1 = c->model == RG_SPHERE ? 1 : 1 + c->Q;
+        double u = 1 - k1 * cv * cv * s2;
+        if (u <= 0) return -1;
+        double w = sqrt(u), zs = cv / w, zss = cv / (u * w);   /* z'/s and z'' */
+        if (c->model == RG_ASPHERE) {
+            double p = s2;          /* s^(2+2i) */
+            for (int i = 0; i < c->nasph; i++) {
+                zs += c->asph[i] * (4 + 2 * i) * p;
+                zss += c->asph[i] * (4 + 2 * i) * (3 + 2 * i) * p;
+                p *= s2;
+            }
+        }
+        h[0] = h[2] = zs;
+        h[1] = 0;
+        if (s2 > 0) {
+            double d = (zss - zs) / s2;
+            h[0] += d * x * x; h[1] += d * x * y; h[2] += d * y * y;
+        }
+        return 0;
+    }
+    double ca = cos(c->axis), sa = sin(c->axis);
+    double xp = ca * x + sa * y, yp = -sa * x + ca * y;
+    double cx = 1 / c->R, cy = 1 / c->R2;
+    double kx = (1 + c->Q) * cx * cx, ky = (1 + c->Q2) * cy * cy;
+    double u = 1 - kx * xp * xp - ky * yp * yp;
+    if (u <= 0) return -1;
+    double S = sqrt(u), D = 1 + S, N = cx * xp * xp + cy * yp * yp;
+    double Ni[2] = {2 * cx * xp, 2 * cy * yp}, Nii[2] = {2 * cx, 2 * cy};
+    double ui[2] = {-2 * kx * xp, -2 * ky * yp}, uii[2] = {-2 * kx, -2 * ky};
+    double Si[2] = {ui[0] / (2 * S), ui[1] / (2 * S)}, hp[3];
+    for (int k = 0; k < 3; k++) {       /* (i, j) = (0,0), (0,1), (1,1) */
+        int i = k == 2, j = k > 0;
+        double Nij = i == j ? Nii[i] : 0, uij = i == j ? uii[i] : 0;
+        double Sij = uij / (2 * S) - ui[i] * ui[j] / (4 * S * S * S);
+        hp[k] = Nij / D - (Ni[i] * Si[j] + Ni[j] * Si[i]) / (D * D) - N * Sij / (D * D) +
+                2 * N * Si[i] * Si[j] / (D * D * D);
+    }
+    /* H = Rt H' R with (xp, yp) = R (x, y), R = [ca sa; -sa ca] */
+    h[0] = ca * ca * hp[0] - 2 * ca * sa * hp[1] + sa * sa * hp[2];
+    h[1] = ca * sa * (hp[0] - hp[2]) + (ca * ca - sa * sa) * hp[1];
+    h[2] = sa * sa * hp[0] + 2 * ca * sa * hp[1] + ca * ca * hp[2];
+    return 0;
+}
+
+int rg_cornea_curvature(const rg_cornea *c, const double p[3], const double e1[3],
+                        const double e2[3], double K[3])
+{
+    double rel[3], pe[3], a[3], b[3], h[3], z, fx, fy;
+    v3sub(rel, p, c->trans);
+    m3tmul(pe, c->rot, rel);
+    m3tmul(a, c->rot, e1);
+    m3tmul(b, c->rot, e2);
+    if (rg_sag(c, pe[0], pe[1], &z, &fx, &fy) || sag_hessian(c, pe[0], pe[1], h)) return RG_EUNREACH;
+    /* II(a, b) = (a_xy)^T H (b_xy) / |(fx, fy, -1)|: a tangent vector's xy part is its
+     * coordinate differential; the inward normal (-fx, -fy, 1)/|.| */
+    double g = sqrt(1 + fx * fx + fy * fy);
+#define II(u, v) ((u[0] * (h[0] * v[0] + h[1] * v[1]) + u[1] * (h[1] * v[0] + h[2] * v[1])) / g)
+    K[0] = II(a, a);
+    K[1] = II(b, b);
+    K[2] = II(a, b);
+#undef II
+    return RG_OK;
 }

@@ -21,6 +21,9 @@ RG_HIDDEN int rg_cornea_hit(const rg_cornea *c, const double o[3], const double 
 RG_HIDDEN double rg_cornea_height(const rg_cornea *c, const double p[3]);
 RG_HIDDEN int rg_cornea_point(const rg_cornea *c, const rg_target *t, double p[3],
                               double n[3], char *err, size_t errcap);
+/* rig_api.cornea_curvature: the second fundamental form on two tangent vectors. */
+RG_HIDDEN int rg_cornea_curvature(const rg_cornea *c, const double p[3], const double e1[3],
+                                  const double e2[3], double K[3]);
 RG_HIDDEN void rg_eye_pose(rg_cornea *c, double rx, double ry, double rz,
                            const double at[3]);
 

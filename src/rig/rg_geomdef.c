@@ -331,6 +331,7 @@ void rg_geometry_fill(rig_api *a)
     a->eye_pose = rg_eye_pose;
     a->joint_name = rg_joint_name;
     a->cornea_point = rg_cornea_point;
+    a->cornea_curvature = rg_cornea_curvature;
     a->solve = rg_solve;
     a->forward = rg_forward;
     a->gimbal_normal = rg_gimbal_normal;

@@ -127,6 +127,20 @@ int  rg_dose_rig(const rg_rig *rig, double ms, long n, rg_dose *d, char *err, si
 int  rg_dose_plan(const rg_machine *m, double ms, long n, rg_dose *d, char *err, size_t cap);
 /* rg_spots.c */
 int  rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap);
+struct px_beam;
+/* The laser's beam to the cornea along path with a lens f at `at` before it (0: none). */
+int  rg_spots_to_cornea(const rg_spots *s, const double path[4], double f, double at,
+                        struct px_beam *b, double w[3]);
+/* rg_spotscan.c: the cornea's oblique incidence (rig_api.spot_chain, spot_pose) and the
+ * scan's extremes in s (called by rg_spots_run once the apex figures are in). */
+int  rg_spot_chain(const rg_spots *s, const double path[4], double theta, double k_t,
+                   double k_s, double k_ts, rg_spot_pose *p, char *err, size_t cap);
+int  rg_spot_pose_run(const rg_rig *rig, const rg_spots *s, const rg_target *t,
+                  rg_spot_pose *p, char *err, size_t cap);
+int  rg_spots_scan(const rg_rig *rig, rg_spots *s, char *err, size_t cap);
+/* The scan's k-th target (0 <= k < RG_SPOTS_POSES) and its largest height. */
+rg_target rg_spots_target(const rg_rig *rig, int k);
+double rg_spots_height(const rg_rig *rig);
 /* rg_file.c */
 int  rg_rig_load(const char *path, rg_rig *rig, char *err, size_t cap);
 int  rg_rig_parse(const char *text, size_t len, const char *name, rg_rig *rig, char *err,

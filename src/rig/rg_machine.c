@@ -140,4 +140,6 @@ void rg_machine_fill(rig_api *a)
     a->sweep = rg_sweep;
     a->sweep_time = rg_sweep_time;
     a->spots = rg_spots_run;
+    a->spot_chain = rg_spot_chain;
+    a->spot_pose = rg_spot_pose_run;
 }

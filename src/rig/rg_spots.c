@@ -5,7 +5,8 @@
  * through the paraxial engine's public functions (paraxial.h: px_beam_*, linked into
  * this module as hidden objects, like the trace module's glass catalogue).  Flat
  * mirrors are the identity; the cornea is a convex mirror of its apex radius, on axis
- * (unfolded: a thin lens of power -2/R). */
+ * (unfolded: a thin lens of power -2/R).  The oblique incidence, pose by pose over a
+ * scan, is rg_spotscan.c's (called at the end). */
 #include <math.h>
 #include <stdio.h>
 #include "rig/rg_hw.h"
@@ -22,9 +23,31 @@ static double dist(const double a[3], const double b[3])
 }
 
 typedef struct chain {
-    const rg_spots *s;
-    double w0, z_m1;            /* waist radius; distance past the waist at m1 */
+    const rg_spots *s;          /* the laser's waist (w0, waist_before_m1) and path */
 } chain;
+
+/* The beam from the laser's waist along path (laser->m1, m1->m2, m2->cornea) to the
+ * cornea with a lens of focal length f at `at` mm before it (f = 0: no lens): *b at the
+ * cornea, w[0..2] the radii at m1, m2 and the cornea; 0 or PX_BAD.  The apex model
+ * (run) and the oblique one (rg_spotscan.c) share it. */
+int rg_spots_to_cornea(const rg_spots *s, const double path[4], double f, double at,
+                       px_beam *b, double w[3])
+{
+    px_beam_at p;
+    double l2 = path[2];
+    if (px_beam_waist(s->w0, s->waist_before_m1, s->lambda_mm, s->m2, 1, b)) return PX_BAD;
+    px_beam_props(b, &p); w[0] = p.w;
+    if (px_beam_apply(b, px_translation(path[1]), 1)) return PX_BAD;
+    px_beam_props(b, &p); w[1] = p.w;
+    if (f != 0) {
+        px_mat lens = {1, 0, -1 / f, 1};
+        if (px_beam_apply(b, px_translation(l2 - at), 1) || px_beam_apply(b, lens, 1) ||
+            px_beam_apply(b, px_translation(at), 1))
+            return PX_BAD;
+    } else if (px_beam_apply(b, px_translation(l2), 1)) return PX_BAD;
+    px_beam_props(b, &p); w[2] = p.w;
+    return 0;
+}
 
 /* Radii at m1, m2, the cornea and the detector with a lens of focal length f at `at`
  * mm before the apex (f = 0: no lens); 0 or PX_BAD. */
@@ -33,18 +56,7 @@ static int run(const chain *c, double f, double at, double w[4])
     const rg_spots *s = c->s;
     px_beam b;
     px_beam_at p;
-    double l2 = s->path[2];
-    if (px_beam_waist(c->w0, c->z_m1, s->lambda_mm, s->m2, 1, &b)) return PX_BAD;
-    px_beam_props(&b, &p); w[0] = p.w;
-    if (px_beam_apply(&b, px_translation(s->path[1]), 1)) return PX_BAD;
-    px_beam_props(&b, &p); w[1] = p.w;
-    if (f != 0) {
-        px_mat lens = {1, 0, -1 / f, 1};
-        if (px_beam_apply(&b, px_translation(l2 - at), 1) || px_beam_apply(&b, lens, 1) ||
-            px_beam_apply(&b, px_translation(at), 1))
-            return PX_BAD;
-    } else if (px_beam_apply(&b, px_translation(l2), 1)) return PX_BAD;
-    px_beam_props(&b, &p); w[2] = p.w;
+    if (rg_spots_to_cornea(s, s->path, f, at, &b, w)) return PX_BAD;
     px_mat mirror = {1, 0, 2 / s->R, 1};             /* power -2/R: C = +2/R */
     if (px_beam_apply(&b, mirror, 1) || px_beam_apply(&b, px_translation(s->path[3]), 1))
         return PX_BAD;
@@ -86,8 +98,20 @@ int rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
         snprintf(err, cap, "%s: the beam needs 'beam_waist' or 'beam_diameter_mm'", rig->path);
         return RG_EINVAL;
     }
-    if (!geo || !geo->solve || geo->solve(&rig->geom, &t, NULL, &sol, err, cap))
-        return RG_EINVAL;
+    if (!geo || !geo->solve) return RG_EINVAL;
+    if (geo->solve(&rig->geom, &t, NULL, &sol, err, cap)) {
+        /* a rig blind at the apex (the wide-zone rig: m2 in the way): the scan's first
+         * target that solves (the spiral's heights grow) stands in for it */
+        char e[RG_ERRMAX];
+        int k = 0;
+        for (; k < RG_SPOTS_POSES; k++) {
+            t = rg_spots_target(rig, k);
+            if (!geo->solve(&rig->geom, &t, NULL, &sol, e, sizeof e)) break;
+        }
+        if (k == RG_SPOTS_POSES) return RG_EINVAL;
+        s->ref_not_apex = 1;
+    }
+    s->ref = t;
     s->path[0] = dist(rig->geom.laser_at, sol.beam.h1);
     s->path[1] = dist(sol.beam.h1, sol.beam.h2);
     s->path[2] = dist(sol.beam.h2, sol.beam.spot);
@@ -116,8 +140,6 @@ int rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
         s->waist_before_m1 = -(s->path[1] + s->path[2]);
     }
     c.s = s;
-    c.w0 = s->w0;
-    c.z_m1 = s->waist_before_m1;
     if (run(&c, 0, 0, w)) goto bad;
     s->nolens_cornea = w[2];
     s->nolens_det = w[3];
@@ -170,7 +192,9 @@ int rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
             s->sigma_best_um = 1e3 * (s->best_det / 2) / sqrt(s->photons);
         }
     }
-    return RG_OK;
+    /* the oblique incidence over the scan (ABI 2; the figures above stay the apex's
+     * at normal incidence) */
+    return rg_spots_scan(rig, s, err, cap);
 bad:
     snprintf(err, cap, "the beam through the rig is not a beam (a singular optic?)");
     return RG_EINVAL;

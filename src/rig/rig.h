@@ -17,7 +17,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define RIG_ABI 1
+#define RIG_ABI 2               /* 2: rg_spot_pose, rg_spots' scan fields, cornea_curvature,
+                                   spot_chain, spot_pose (the cornea's oblique incidence) */
 #define RIG_API_SYMBOL "rig_get_api"
 
 enum { RG_OK = 0, RG_EINVAL = -1, RG_ENOMEM = -2, RG_EIO = -3, RG_ESTOP = -4,
@@ -411,12 +412,45 @@ typedef struct rg_sweep_stats {
     double v_max[RG_NJOINTS];   /* fastest speed of each joint during an exposure
                                    (steps/s) */
 } rg_sweep_stats;
-/* The beam on the cornea and on the detector for the apex pose (rg_spots.c): the
+/* The beam on the cornea and on the detector for the apex pose (rg_spots.c; a rig that
+ * cannot reach the apex: the scan's first target that does, rg_spots.ref): the
  * laser's Gaussian beam (q parameter, the paraxial engine's px_beam) along the solved
  * path laser -> m1 -> m2 -> [focus lens] -> cornea apex -> detector plane, flat
  * mirrors, the cornea a convex mirror of its apex radius R (a thin lens of power
  * -2/R, on-axis: the oblique incidence's astigmatism is left out).  Lengths mm. */
 #define RG_SPOTS_SCAN 2001      /* focal lengths scanned (log-spaced, each sign) */
+/* The beam through one pose with the cornea's oblique incidence (rg_spotscan.c, doc/rig.md
+ * "Oblique incidence"): the beam reaches the cornea round (flat mirrors, a thin round
+ * lens); the cornea reflects it with the power matrix, in the reflected beam's section
+ * (t: in the plane of incidence, s: across it), P = 2 [k_t / cos(theta), k_ts; k_ts,
+ * k_s cos(theta)] (k_t, k_s the surface's normal curvatures along the plane of
+ * incidence and across it, k_ts the twist; a sphere: Coddington's f_t = -(R/2)
+ * cos(theta), f_s = -R / (2 cos(theta))).  A round beam times a symmetric P is a
+ * simple astigmatic beam whose axes are P's eigenvectors: exact for every k_ts (psi
+ * the axes' angle from the plane of incidence), each axis's q carried apart.  The
+ * configured focus lens stays lens_at before the point the beam meets the cornea. */
+typedef struct rg_spot_pose {
+    rg_target target;           /* the target solved (apex: RG_T_ANGLES 0 0) */
+    rg_pose pose;
+    double path[4];             /* laser->m1, m1->m2, m2->cornea, cornea->detector plane */
+    double theta;               /* incidence on the cornea (rad; rg_beam.inc3) */
+    double k_t, k_s, k_ts;      /* cornea's normal curvatures along / across the plane of
+                                   incidence, twist (1/mm; convex > 0) */
+    double f_t, f_s;            /* the reflection's focal lengths along the beam's two
+                                   axes (mm; convex: < 0); psi 0: Coddington's */
+    double psi;                 /* the t axis's angle from the plane of incidence, toward
+                                   the sagittal direction (rad, |psi| <= pi/4) */
+    double w_cornea;            /* beam radius on the cornea (round) */
+    double w_t, w_s;            /* 1/e^2 radii at the detector plane, the beam's section */
+    double det_inc;             /* angle of the beam to the detector plane's normal (rad) */
+    double foot_major, foot_minor;  /* the spot's 1/e^2 semi-axes in the detector plane */
+    double foot_angle;          /* the major axis from the detector's x' axis (rad, in
+                                   (-pi/2, pi/2]; x': rig +x across the plane's normal,
+                                   y' = normal x x') */
+    double sigma_major_um, sigma_minor_um;  /* the centroid's shot-noise limit along
+                                   them: (axis/2)/sqrt(photons) (0: no dose) */
+} rg_spot_pose;
+#define RG_SPOTS_POSES 200      /* the scan: targets besides the apex */
 typedef struct rg_spots {
     double path[4];             /* laser->m1, m1->m2, m2->cornea, cornea->detector */
     double w0, waist_before_m1; /* the waist radius used and where it lies (mm) */
@@ -436,6 +470,21 @@ typedef struct rg_spots {
      * normal incidence, n 1.376) all detected, sigma = (w/2)/sqrt(N) per axis */
     int have_dose;              /* 0: the rig file has no laser_power_mw */
     double expose_ms, photons, reflectance, sigma_um, sigma_best_um;
+    /* ---- ABI 2: the oblique incidence over a scan (the fields above: the apex pose at
+     * normal incidence, unchanged).  The scan: the apex and RG_SPOTS_POSES targets of
+     * the dialogue's sunflower spiral, height h_k = scan_h sqrt((k + 0.5)/n), meridian
+     * k * 137.50776405 deg, scan_h the cornea's zone (R/2 when the zone is 0). */
+    double scan_h;
+    long scan_n, scan_bad;      /* poses computed; targets that did not solve (skipped) */
+    rg_spot_pose apex;          /* the apex pose, oblique */
+    rg_spot_pose big, small;    /* the poses of the largest and smallest footprint major
+                                   axis on the detector */
+    rg_spot_pose steep;         /* the pose of the largest incidence on the cornea */
+    int ref_not_apex;           /* 1: the apex pose does not solve (a rig blind there):
+                                   the fields above the ABI 2 line are for the pose of
+                                   ref, the scan's first target that solves; apex stays
+                                   zero and the scan does not count it */
+    rg_target ref;              /* the pose those fields are for (apex: RG_T_ANGLES 0 0) */
 } rg_spots;
 /* ==== end of the machine ========================================================= */
 
@@ -599,10 +648,30 @@ typedef struct rig_api {
                       long n, double expose_ms, rg_sweep_stats *st, char *err, size_t cap);
     /* ---- the beam (rg_spots.c) ---- */
     /* The beam radius on the cornea and the detector for the apex pose, the focus
-     * lens that balances them and the centroid's shot-noise limit.  RG_OK, or
-     * RG_EINVAL ("FILE:LINE: why" for a rig-file value the geometry rules out; no
-     * wavelength; the apex pose does not solve). */
+     * lens that balances them and the centroid's shot-noise limit; then (ABI 2) the
+     * oblique incidence over the scan (rg_spots.apex, big, small, steep).  A rig that
+     * cannot reach the apex: its first scan target that solves (ref_not_apex).  RG_OK,
+     * or RG_EINVAL ("FILE:LINE: why" for a rig-file value the geometry rules out; no
+     * wavelength; no pose of the scan solves). */
     int (*spots)(const rg_rig *rig, rg_spots *s, char *err, size_t cap);
+    /* ---- ABI 2: the cornea's oblique incidence (rg_spotscan.c, rg_cornea.c) ---- */
+    /* The placed cornea's second fundamental form at rig point p (on the surface) on
+     * the unit tangent vectors e1, e2 (rig frame): K[0] = k(e1), K[1] = k(e2), K[2] =
+     * II(e1, e2) (1/mm; convex > 0; analytic second derivatives of the sag).  RG_OK or
+     * RG_EUNREACH (off the surface). */
+    int (*cornea_curvature)(const rg_cornea *c, const double p[3], const double e1[3],
+                            const double e2[3], double K[3]);
+    /* The beam along path (as rg_spot_pose.path) with the laser, lens and photons of s
+     * (from spots), a cornea of curvatures k_t, k_s, k_ts met at incidence theta: fills
+     * p's path, theta, k_*, f_t, f_s, psi, w_cornea, w_t, w_s (the rest untouched).
+     * theta 0, k_t = k_s = 1/R, k_ts 0 is the apex model of spots: w_t = w_s = w_det
+     * exactly.  RG_OK or RG_EINVAL (the lens off the leg, not a beam). */
+    int (*spot_chain)(const rg_spots *s, const double path[4], double theta, double k_t,
+                      double k_s, double k_ts, rg_spot_pose *p, char *err, size_t cap);
+    /* One target's pose solved and its beam (all of p).  RG_OK, RG_EUNREACH (the
+     * target does not solve, or its beam misses the detector plane), RG_EINVAL. */
+    int (*spot_pose)(const rg_rig *rig, const rg_spots *s, const rg_target *t,
+                     rg_spot_pose *p, char *err, size_t cap);
 } rig_api;
 
 typedef const rig_api *(*rig_get_api_fn)(int abi);
