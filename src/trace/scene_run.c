@@ -249,8 +249,8 @@ static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s
 }
 
 /* Source s at wavelength l (0: none named). */
-static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, double l,
-                      char *err)
+static int add_source(const trace_api *tr, trace_scene *ts, const sc_scene *sc,
+                      const sc_source *s, double l, char *err)
 {
     trace_source t;
     trace_ray *rays = NULL;
@@ -263,9 +263,13 @@ static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, 
                   NULL))
         return -1;
     t.lambda = l;
-    if (s->polarised) {
+    if (s->polarised == 1) {
         t.pol = TRACE_LINEAR;
         memcpy(t.pol_dir, s->pol, sizeof t.pol_dir);
+    } else if (s->polarised == 2) {   /* in the Stokes frame: its reference (0: +x) */
+        t.pol = TRACE_ELLIPTIC;
+        memcpy(t.pol_dir, sc->polar_ref, sizeof t.pol_dir);
+        memcpy(t.jones, s->jones, sizeof t.jones);
     }
     t.half_angle = s->angle * DEG;
     t.count = s->count;
@@ -527,7 +531,7 @@ static int build_scene(const trace_api *tr, const sc_scene *sc, double l,
     for (int i = 0; i < sc->nsurf; i++)
         if (add_surface(tr, ts, &sc->surf[i], l, err)) goto bad;
     for (int i = 0; i < sc->nsource; i++)
-        if (source_at(sc, &sc->source[i], l) && add_source(tr, ts, &sc->source[i], l, err))
+        if (source_at(sc, &sc->source[i], l) && add_source(tr, ts, sc, &sc->source[i], l, err))
             goto bad;
     *out_ts = ts;
     return 0;
