@@ -345,6 +345,8 @@ typedef struct out {
     int stopped;
     int wl;                     /* write the wavelength column (the scene names some) */
     uint64_t ray0;              /* rays of the wavelengths traced before this run */
+    double *stokes;             /* polarization on: the hit's S0..S3 (scene_polout.c
+                                   keeps each record's), else NULL */
 } out;
 
 /* Poll the stop callback; 1 (and o->stopped) if the trace must stop. */
@@ -373,7 +375,10 @@ static int w_hit(void *ctx, const trace_hit *h)
 {
     out *o = ctx;
     if (poll_records(o)) return 1;
-    return so_hit(o->hit_t, o->hit, h, h->ray + o->ray0);
+    int rc = so_hit(o->hit_t, o->hit, h, h->ray + o->ray0, o->stokes);
+    if (o->stokes)   /* a hit without its record would say so, not repeat the last */
+        for (int i = 0; i < 4; i++) o->stokes[i] = NAN;
+    return rc;
 }
 
 /* A progress line on stderr, only on a terminal and once the trace has run 1 s. */
@@ -430,7 +435,8 @@ static so_table *table(const sc_scene *sc, FILE *f, int fmt, int hits, int wl,
                        const char *name, char *err)
 {
     char why[SC_ERRMAX / 2];
-    so_table *t = so_open(f, (sc_out_format)fmt, hits, wl, sc->threads, why, sizeof why);
+    so_table *t = so_open(f, (sc_out_format)fmt, hits, wl, hits && sc->polar, sc->threads,
+                          why, sizeof why);
     if (!t) snprintf(err, SC_ERRMAX, "%s: %s", name, why);
     return t;
 }
@@ -588,6 +594,7 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     o.tty = isatty(2);
     o.t0 = now_ms();
     o.wl = sc->named_wl;
+    o.stokes = sc->polar ? po.stokes : NULL;
     sink.ctx = &o;
     sink.progress = w_progress;
     if (sc->out_segments) {
