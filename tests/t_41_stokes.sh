@@ -261,7 +261,8 @@ else
 fi
 
 # Without polarization the hits files are byte for byte the main build's: the example
-# singlet (CSV), the prism (.npy, HDF5, csv17, segments) and a linearly polarized source
+# singlet (CSV), the prism (.npy, HDF5, csv17, segments) and a linearly polarized source;
+# the polar table of unpolarized and linear sources through a coated retarding lens too
 stokes_same() (
     d=$SW/same; rm -rf "$d"; mkdir -p "$d/new" "$d/old" && cd "$d" || return 1
     cp "$TOP/scenes/singlet.scene" "$TOP/scenes/prism.scene" "$TOP/scenes/prism.obj" new/ &&
@@ -270,12 +271,17 @@ stokes_same() (
     sed 's/^output hits prism-hits.csv$/output hits prism-17.csv csv17/' new/prism.scene > new/p17.scene &&
     printf '%s\n' 'cap refract 1 1.5 vertex 0 0 0 radius 20 aperture 8' 'plane detect at 0 0 30 normal 0 0 1 disc 50' \
         'source cone from 0 0 -10 dir 0 0 1 angle 20 rings 10 pol 0 1 0' 'output hits lin.csv' > new/lin.scene &&
+    printf '%s\n' 'cap refract 1 1.5 coating c vertex 0 0 0 radius 20 aperture 8' 'coating c layer 1.38 100' \
+        'cap refract 1.5 1 retarder 1 1 0 30 vertex 0 0 4 radius -20 aperture 8' 'sphere detect center 0 0 0 radius 50' \
+        'source cone from 0 0 -10 dir 0 0 1 angle 20 rings 12' 'source cone from 0 0 -10 dir 0 0 1 angle 20 rings 5 pol 1 2 0' \
+        'output polar tab.csv' 'output summary tab.sum' > new/tab.scene &&
     cp new/* old/ || return 1
-    for s in singlet.scene prism.scene pn.scene ph.scene p17.scene lin.scene; do
+    for s in singlet.scene prism.scene pn.scene ph.scene p17.scene lin.scene tab.scene; do
         trace_in "$BIN" "$d/new" $s && trace_in "$MAINBIN" "$d/old" $s || { echo "$s failed"; return 1; }
     done
     n=0
-    for f in singlet-hits.csv prism-hits.csv prism-hits.npy prism-all.h5 prism-17.csv lin.csv prism.l; do
+    for f in singlet-hits.csv prism-hits.csv prism-hits.npy prism-all.h5 prism-17.csv lin.csv prism.l \
+             tab.csv tab.sum; do
         cmp "new/$f" "old/$f" || return 1; n=$((n + 1))
     done
     head -1 new/singlet-hits.csv | grep -qx 'ray,depth,surface,triangle,x,y,z,dx,dy,dz,power_s,power_p,power,length,opl' || return 1
@@ -283,7 +289,7 @@ stokes_same() (
 )
 if [ -x "$MAINBIN" ] && [ "$(cd "$SW" && printf 'scene\n%s/scenes/singlet.scene\nn\n' "$TOP" > m.in &&
         "$MAINBIN" --trace -i m.in m.rec > /dev/null 2>&1 && echo ok)" = ok ]; then
-    check "no polarization: hits (CSV, .npy, HDF5, csv17) and segments byte-identical to the main build's" stokes_same
+    check "no polarization: hits (CSV, .npy, HDF5, csv17) and segments byte-identical to the main build's; a polar table too" stokes_same
 else
     echo "SKIP t_41: no working main build at $MAINBIN (LENSMAT_MAIN): the byte comparison was not made"
 fi
