@@ -144,9 +144,7 @@ static int parse_fields(reader *r, int first, const char *dname, const char *all
         }
         snprintf(what, sizeof what, "%s: '%s'", dname, w);
         if (keys[k].nargs == ARGS_TOKS) {
-            f->at[k] = i;
-            while (i < r->nt && key_index(&r->t[i]) < 0) i++;
-            f->count[k] = i - f->at[k];
+            for (f->at[k] = i; i < r->nt && key_index(&r->t[i]) < 0; i++) f->count[k]++;
             continue;
         }
         if (keys[k].nargs == ARGS_WL) {
@@ -513,10 +511,8 @@ static int read_source(reader *r, sc_scene *sc)
             return sl_fail(r, "%s: medium %g: an index of refraction must be positive", dname,
                         s.medium);
     }
-    if (has(&f, "pol")) {
-        int k = key_index(&(tok){"pol", 3});
-        if (sc_source_pol(r, f.at[k], f.count[k], dname, &s)) return -1;
-    }
+    int kp = key_index(&(tok){"pol", 3});
+    if (f.has[kp] && sc_source_pol(r, f.at[kp], f.count[kp], dname, &s)) return -1;
     if (has(&f, "angle")) {
         s.angle = val(&f, "angle")[0];
         if (s.angle < 0 || s.angle >= (t == SC_FAN ? 180 : 90))
