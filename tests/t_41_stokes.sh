@@ -10,9 +10,12 @@
 # Fresnel), the hits' columns against the polar table row by row and the summary, the
 # two engine paths (coherency and PRT) agreeing for an elliptical source, .npy and
 # HDF5 read back by NumPy/h5py, scenes without polarization byte-identical to the main
-# build's, and the refusals with FILE:LINE.
+# build's, and the refusals with FILE:LINE; the engine's elliptical sources through its
+# table in tests/trace/t_stokes.c.
 
 cd "$TOP" || return 1
+unit "$TOP/build/obj/trace_tests/t_stokes"    # the engine's side (tests/trace/t_stokes.c)
+unit "$TOP/build/asan/trace_tests/t_stokes"
 SW=$WORK/stokes
 mkdir -p "$SW"
 PY=/usr/bin/python3
