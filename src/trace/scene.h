@@ -97,8 +97,11 @@ typedef struct sc_source {
     double lambda[SC_MAXWL];  /* its wavelengths, um (`lambda`: nm, um or F d C e g
                                  hene), in the order given */
     int nlambda;              /* 0: none named (the d line where a glass needs one) */
-    int polarised;            /* 1: linear along pol[] (else unpolarised) */
+    int polarised;            /* 1: linear along pol[] (unit), 2: the Jones vector
+                                 jones (re, im of Jx, Jy; unit length) in the Stokes
+                                 frame (polarization ref), 0: unpolarised */
     double pol[3];
+    double jones[2][2];
     const char *src;          /* defined at src:line */
     long line;
 } sc_source;
@@ -229,7 +232,7 @@ typedef struct sc_tess_row {
  * without refinement, with analytic normals, with full re-intersection. */
 int sc_tess_table(const sc_tess_spec *spec, sc_tess_row *rows, char *err);
 
-#define SC_API_ABI 2
+#define SC_API_ABI 3
 #define SC_API_SYMBOL "lm_scene_api"
 typedef struct scene_api {
     int abi;

@@ -23,6 +23,7 @@
 #else
 #include <hdf5.h>
 #endif
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -45,19 +46,23 @@ static const column hit_cols[] = {
     {"ray", C_U64}, {"depth", C_I32}, {"surface", C_I32}, {"triangle", C_I64},
     {"x", C_F64}, {"y", C_F64}, {"z", C_F64}, {"dx", C_F64}, {"dy", C_F64}, {"dz", C_F64},
     {"power_s", C_F64}, {"power_p", C_F64}, {"power", C_F64}, {"length", C_F64},
-    {"opl", C_F64}, {"lambda_nm", C_NM}};
+    {"opl", C_F64}, {"lambda_nm", C_NM}, {"S0", C_F64}, {"S1", C_F64}, {"S2", C_F64},
+    {"S3", C_F64}};
 static const column seg_cols[] = {
     {"x0", C_F64}, {"y0", C_F64}, {"z0", C_F64}, {"x1", C_F64}, {"y1", C_F64},
     {"z1", C_F64}, {"lambda_nm", C_NM}};
 #define NHIT (int)(sizeof hit_cols / sizeof hit_cols[0])
 #define NSEG (int)(sizeof seg_cols / sizeof seg_cols[0])
+#define HIT_WL 15            /* hit_cols[15]: lambda_nm, then the Stokes parameters */
 
 static size_t col_size(int type) { return type == C_I32 ? 4 : 8; }
 
 struct so_table {
     sc_out_format fmt;
     int hits;                  /* 1: hits, 0: segments */
-    int ncol;                  /* the wavelength column is the last one, when named */
+    int ncol;                  /* columns of this table: ... */
+    int wl, st;                /* ... with the wavelength, with the Stokes parameters */
+    column col[NHIT];          /* (the hits' lambda_nm, S0..S3 only when asked for) */
     size_t row;                /* bytes a binary row */
     uint64_t nrows;
     long header;               /* .npy: bytes of the header (rewritten at the end) */
@@ -68,7 +73,7 @@ struct so_table {
     char nm_text[40];          /* and that text */
 };
 
-static const column *cols(const so_table *t) { return t->hits ? hit_cols : seg_cols; }
+static const column *cols(const so_table *t) { return t->col; }
 
 /* lambda um in nm as "%.10g" prints it, into text; the value that reads back. */
 static double nm_text(double lambda, char *text, size_t cap)
@@ -202,19 +207,25 @@ static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n,
 
 enum { CHUNK = 1 << 19 };   /* bytes of rows a hand-over (CSV: about 1 MB of text) */
 
-so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int threads, char *err,
-                  size_t errmax)
+so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int stokes, int threads,
+                  char *err, size_t errmax)
 {
     so_table *t = calloc(1, sizeof *t);
     if (!t) return snprintf(err, errmax, "out of memory"), NULL;
     t->fmt = fmt;
     t->hits = hits;
-    t->ncol = (hits ? NHIT : NSEG) - (wl ? 0 : 1);
+    t->wl = wl != 0;
+    t->st = hits && stokes;
+    for (int i = 0; i < (hits ? NHIT : NSEG); i++) {
+        int k = hits ? i - HIT_WL : i - (NSEG - 1);   /* 0: lambda_nm, > 0: S0..S3 */
+        if ((k == 0 && !t->wl) || (k > 0 && !t->st)) continue;
+        t->col[t->ncol++] = hits ? hit_cols[i] : seg_cols[i];
+    }
     for (int i = 0; i < t->ncol; i++) t->row += col_size(cols(t)[i].type);
     if (fmt == SC_OUT_TEXT || fmt == SC_OUT_CSV17) {
         if (hits)
             for (int i = 0; i < t->ncol; i++)
-                fprintf(f, "%s%s", hit_cols[i].name, i + 1 < t->ncol ? "," : "\n");
+                fprintf(f, "%s%s", t->col[i].name, i + 1 < t->ncol ? "," : "\n");
         if (fmt == SC_OUT_CSV17 || !hits) return t;   /* written as they come */
     }
     if (fmt == SC_OUT_NPY) {
@@ -270,8 +281,10 @@ static unsigned char *row_slot(so_table *t)
 
 #define PUT(p, v) (memcpy((p), &(v), sizeof (v)), (p) += sizeof (v))
 
-int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray)
+int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double stokes[4])
 {
+    static const double none[4] = {NAN, NAN, NAN, NAN};
+    const double *sv = stokes ? stokes : none;
     /* the double columns, in hit_cols' order */
     const double v[11] = {h->pos[0], h->pos[1], h->pos[2], h->dir[0], h->dir[1], h->dir[2],
                           h->power_s, h->power_p, h->power_s + h->power_p, h->length,
@@ -282,8 +295,10 @@ int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray)
                     h->surface, h->prim, v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
                     v[8], v[9], v[10]) < 0)
             return 1;
-        return (t->ncol == NHIT ? fprintf(f, ",%.10g\n", h->lambda * 1e3)
-                                : fputs("\n", f)) < 0;
+        if (t->wl && fprintf(f, ",%.10g", h->lambda * 1e3) < 0) return 1;
+        if (t->st && fprintf(f, ",%.17g,%.17g,%.17g,%.17g", sv[0], sv[1], sv[2], sv[3]) < 0)
+            return 1;
+        return fputs("\n", f) < 0;
     }
     unsigned char *p = row_slot(t);
     if (!p) return 1;
@@ -295,17 +310,18 @@ int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray)
     PUT(p, prim);
     memcpy(p, v, sizeof v);
     p += sizeof v;
-    if (t->ncol == NHIT) {   /* CSV: the wavelength as it came (the formatter prints it) */
+    if (t->wl) {   /* CSV: the wavelength as it came (the formatter prints it) */
         double nm = t->fmt == SC_OUT_TEXT ? h->lambda : nm_of(t, h->lambda);
         PUT(p, nm);
     }
+    if (t->st) memcpy(p, sv, 4 * sizeof *sv);
     return 0;
 }
 
 int so_segment(so_table *t, FILE *f, const trace_segment *s)
 {
     if (t->fmt == SC_OUT_TEXT || t->fmt == SC_OUT_CSV17) {   /* the seed's p.l form */
-        if (t->ncol == NSEG) {
+        if (t->wl) {
             double nm = s->lambda * 1e3;
             return fprintf(f, "%.10g %.10g %.10g %.10g\n%.10g %.10g %.10g %.10g\n",
                            s->p0[0], s->p0[1], s->p0[2], nm, s->p1[0], s->p1[1],
@@ -318,7 +334,7 @@ int so_segment(so_table *t, FILE *f, const trace_segment *s)
     if (!p) return 1;
     memcpy(p, s->p0, sizeof s->p0);
     memcpy(p + 24, s->p1, sizeof s->p1);
-    if (t->ncol == NSEG) {
+    if (t->wl) {
         double nm = nm_of(t, s->lambda);
         memcpy(p + 48, &nm, sizeof nm);
     }

@@ -12,12 +12,13 @@
 typedef struct so_table so_table;
 /* A hits (hits=1) or segments table in format fmt written to f (its header now;
  * nothing written to f for SC_OUT_H5: the rows are kept for so_h5_write); wl: with the
- * wavelength column; threads: the trace's (0: all cores), as many formatter threads
- * for a CSV.  NULL with a message on failure. */
-so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int threads, char *err,
-                  size_t errmax);
-/* One row; 0, or non-zero on a write error (or out of memory). */
-int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray);
+ * wavelength column; stokes (hits): with S0..S3 last; threads: the trace's (0: all
+ * cores), as many formatter threads for a CSV.  NULL with a message on failure. */
+so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int stokes, int threads,
+                  char *err, size_t errmax);
+/* One row (stokes: the hit's S0..S3 for a table with them, NULL: NaN); 0, or non-zero
+ * on a write error (or out of memory). */
+int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double stokes[4]);
 int so_segment(so_table *t, FILE *f, const trace_segment *s);
 /* The table's end (.npy: the rest of the rows, the header's row count); 0 or -1. */
 int so_finish(so_table *t, FILE *f, char *err, size_t errmax);

@@ -13,9 +13,12 @@ typedef struct sp_out {
     long header;                /* .npy: its header's bytes (rewritten at the end) */
     uint64_t rows, ray0;        /* rows written; rays of the wavelengths before */
     double nm;                  /* the run's wavelength column */
+    double stokes[4];           /* the last record's S0..S3 (for the hits' columns:
+                                   the engine hands it just before its hit), else NaN */
 } sp_out;
 
-/* Open the table (sc->out_polar); 0 or -1 (err). */
+/* Open the table (sc->out_polar); 0 or -1 (err).  (Without one, po is still the
+ * records' sink: sp_engine hands them to it for the hits' Stokes columns.) */
 int sp_open(const sc_scene *sc, sp_out *po, char *err);
 /* Polarization on in ts for a run at l um (0: none named) whose rays are numbered from
  * ray0: elements, coatings, the table's rows.  0 or -1 (err: FILE:LINE). */

@@ -1,5 +1,6 @@
 /* scene_polar.c -- the scene file's polarization lines (the reader's part: libc and
- * libm only, fuzzed with the other readers): `polarization on|off [ref X Y Z]`,
+ * libm only, fuzzed with the other readers): a source's `pol` key (linear, circular,
+ * elliptical, a Jones vector), `polarization on|off [ref X Y Z]`,
  * `coating NAME layer N D [layer N D ...]` (thin films, D in nm), `output polar FILE
  * [csv|npy]`, and, once the file is read, each surface's coating found by name and
  * polarization switched on where an element, a coating or the output asks for it.
@@ -89,6 +90,73 @@ static int read_output(reader *r, sc_scene *sc)
     memcpy(sc->out_polar, r->t[2].s, n);
     sc->out_polar[n] = '\0';
     sc->out_polar_format = npy ? SC_OUT_NPY : SC_OUT_TEXT;
+    return 0;
+}
+
+#define DEG (3.14159265358979323846 / 180)
+
+/* A source's polarization state.  The Jones vectors are in the Stokes frame (x', y' =
+ * dir x x', x' the `polarization ref` projected perpendicular to the ray), fields
+ * exp(i(kz - wt)): S3 = 2 Im(Jx* Jy) > 0 turns from x' toward y', counterclockwise
+ * facing the source, left-handed in the optics naming (Hecht, Born & Wolf); `right`
+ * is (1, -i)/sqrt 2, S3 = -S0 (the --polar calculator's r). */
+int sc_source_pol(reader *r, int first, int n, const char *dname, sc_source *s)
+{
+    const tok *t = &r->t[first];
+    char what[64];
+    double v[4];
+    snprintf(what, sizeof what, "%s: 'pol'", dname);
+    if (n == 3 && !sl_tok_is(t, "ellipse")) {   /* linear: the field's direction */
+        for (int i = 0; i < 3; i++)
+            if (sl_tok_num(r, &t[i], what, &s->pol[i])) return -1;
+        double m = sqrt(dot3(s->pol, s->pol));
+        if (!(m > 0) || !isfinite(m))
+            return sl_fail(r, "%s: 'pol' %g %g %g is a zero-length direction", dname,
+                           s->pol[0], s->pol[1], s->pol[2]);
+        for (int i = 0; i < 3; i++) s->pol[i] /= m;
+        s->polarised = 1;
+        return 0;
+    }
+    if (n == 1 && (sl_tok_is(t, "right") || sl_tok_is(t, "left"))) {
+        double h = sqrt(0.5);
+        memset(s->jones, 0, sizeof s->jones);
+        s->jones[0][0] = h;
+        s->jones[1][1] = sl_tok_is(t, "right") ? -h : h;
+        s->polarised = 2;
+        return 0;
+    }
+    int ell = 0, jon = 0;
+    if (n >= 1) { ell = sl_tok_is(t, "ellipse"); jon = sl_tok_is(t, "jones"); }
+    if (!(ell && n == 3) && !(jon && n == 5))
+        return sl_fail(r, "%s: 'pol' expects X Y Z (linear), right or left (circular, "
+                       "optics convention: right turns clockwise facing the source), "
+                       "ellipse AZ CHI (azimuth, ellipticity angle in degrees) or jones "
+                       "JX JY PX PY (amplitudes, phases in degrees)", dname);
+    for (int i = 0; i < n - 1; i++)
+        if (sl_tok_num(r, &t[1 + i], what, &v[i])) return -1;
+    if (ell) {
+        if (!(fabs(v[1]) <= 45))
+            return sl_fail(r, "%s: 'pol ellipse': the ellipticity angle %g must lie in "
+                           "[-45, 45] degrees (tan CHI = minor / major axis; > 0: "
+                           "left-handed)", dname, v[1]);
+        double ps = v[0] * DEG, ch = v[1] * DEG;   /* R(psi) (cos chi, i sin chi) */
+        s->jones[0][0] = cos(ps) * cos(ch);
+        s->jones[0][1] = -sin(ps) * sin(ch);
+        s->jones[1][0] = sin(ps) * cos(ch);
+        s->jones[1][1] = cos(ps) * sin(ch);
+    } else {
+        if (!(v[0] >= 0 && v[1] >= 0) || !(v[0] > 0 || v[1] > 0))
+            return sl_fail(r, "%s: 'pol jones': the amplitudes %g %g must be at least 0 and "
+                           "not both 0", dname, v[0], v[1]);
+        double m = hypot(v[0], v[1]);
+        if (!isfinite(m) || !isfinite(v[0] / m * cos(v[2] * DEG)))
+            return sl_fail(r, "%s: 'pol jones': the amplitudes are too large", dname);
+        for (int i = 0; i < 2; i++) {
+            s->jones[i][0] = v[i] / m * cos(v[2 + i] * DEG);
+            s->jones[i][1] = v[i] / m * sin(v[2 + i] * DEG);
+        }
+    }
+    s->polarised = 2;
     return 0;
 }
 

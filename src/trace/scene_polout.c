@@ -64,10 +64,13 @@ int sp_open(const sc_scene *sc, sp_out *po, char *err)
     return 0;
 }
 
-/* The engine's record: one row. */
+/* The engine's record: the hit's Stokes parameters kept for its row of the hits, and
+ * one row of the table when there is one. */
 static int row(void *ctx, const trace_polar_hit *p)
 {
     sp_out *po = ctx;
+    memcpy(po->stokes, p->stokes, sizeof po->stokes);
+    if (!po->open) return 0;
     double v[NDBL], S0 = p->stokes[0];
     uint64_t ray = p->ray + po->ray0;
     int32_t dep = p->depth, surf = p->surface;
@@ -109,7 +112,8 @@ int sp_engine(const trace_api *tr, trace_scene *ts, const sc_scene *sc, double l
     po->ray0 = ray0;
     snprintf(nm, sizeof nm, "%.10g", l * 1e3);   /* as the hits' lambda_nm */
     po->nm = strtod(nm, NULL);
-    if (tr->polarization(ts, 1, ref, po->open ? row : NULL, po) != TRACE_OK)
+    for (int i = 0; i < 4; i++) po->stokes[i] = NAN;
+    if (tr->polarization(ts, 1, ref, row, po) != TRACE_OK)
         return snprintf(err, SC_ERRMAX, "%s: %s", sc->name, tr->error(ts)), -1;
     for (int i = 0; i < sc->nsurf; i++) {
         const sc_surface *s = &sc->surf[i];

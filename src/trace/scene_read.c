@@ -23,11 +23,12 @@
 
 /* The keys a directive may carry, with their number of values.  ARGS_WORD: one
  * word (a file name); ARGS_VAR: numbers up to the next key; ARGS_WL: wavelengths up
- * to the next key (px_wavelength: nm above 100, else um, or F d C e g hene).  The
+ * to the next key (px_wavelength: nm above 100, else um, or F d C e g hene);
+ * ARGS_TOKS: words and numbers up to the next key, read by the key's own reader.  The
  * values of `refract` and `medium` are indices: a number, or a glass (a catalogue
  * name, a model glass ND/VD, a medium of the seed), optionally after the word
  * `glass`. */
-enum { ARGS_WORD = -1, ARGS_VAR = -2, ARGS_WL = -3 };
+enum { ARGS_WORD = -1, ARGS_VAR = -2, ARGS_WL = -3, ARGS_TOKS = -4 };
 typedef struct keydef { const char *name; int nargs; } keydef;
 static const keydef keys[] = {
     {"refract", 2}, {"mirror", 0}, {"absorb", 0}, {"detect", 0}, {"media", ARGS_WORD},
@@ -37,7 +38,7 @@ static const keydef keys[] = {
     {"file", ARGS_WORD}, {"sphere", 4},
     {"from", 3}, {"dir", 3}, {"to", 6}, {"angle", 1}, {"rays", 1}, {"rings", 1},
     {"toward", 3}, {"grid", 1}, {"waist", 1}, {"wavelength", 1}, {"trunc", 1},
-    {"power", 1}, {"medium", 1}, {"pol", 3}, {"lambda", ARGS_WL},
+    {"power", 1}, {"medium", 1}, {"pol", ARGS_TOKS}, {"lambda", ARGS_WL},
     {"polarizer", 3}, {"retarder", 4}, {"qwp", 3}, {"hwp", 3}, {"coating", ARGS_WORD},
 };
 #define POLKEYS " polarizer retarder qwp hwp coating"   /* refracting surfaces */
@@ -49,6 +50,7 @@ typedef struct fields {
     double num[NKEYS][SC_MAXCOEF];
     int count[NKEYS];
     tok word[NKEYS];
+    int at[NKEYS];                       /* ARGS_TOKS: the first token (count: how many) */
     char glass[NKEYS][2][SC_GLASSMAX];   /* index keys: a glass named ("": a number) */
 } fields;
 
@@ -141,6 +143,10 @@ static int parse_fields(reader *r, int first, const char *dname, const char *all
             continue;
         }
         snprintf(what, sizeof what, "%s: '%s'", dname, w);
+        if (keys[k].nargs == ARGS_TOKS) {
+            for (f->at[k] = i; i < r->nt && key_index(&r->t[i]) < 0; i++) f->count[k]++;
+            continue;
+        }
         if (keys[k].nargs == ARGS_WL) {
             while (i < r->nt && key_index(&r->t[i]) < 0) {
                 char b[NUMLEN];
@@ -505,10 +511,8 @@ static int read_source(reader *r, sc_scene *sc)
             return sl_fail(r, "%s: medium %g: an index of refraction must be positive", dname,
                         s.medium);
     }
-    if (has(&f, "pol")) {
-        if (unit_vec(r, &f, dname, "pol", s.pol)) return -1;
-        s.polarised = 1;
-    }
+    int kp = key_index(&(tok){"pol", 3});
+    if (f.has[kp] && sc_source_pol(r, f.at[kp], f.count[kp], dname, &s)) return -1;
     if (has(&f, "angle")) {
         s.angle = val(&f, "angle")[0];
         if (s.angle < 0 || s.angle >= (t == SC_FAN ? 180 : 90))

@@ -249,8 +249,8 @@ static int add_surface(const trace_api *tr, trace_scene *ts, const sc_surface *s
 }
 
 /* Source s at wavelength l (0: none named). */
-static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, double l,
-                      char *err)
+static int add_source(const trace_api *tr, trace_scene *ts, const sc_scene *sc,
+                      const sc_source *s, double l, char *err)
 {
     trace_source t;
     trace_ray *rays = NULL;
@@ -263,9 +263,13 @@ static int add_source(const trace_api *tr, trace_scene *ts, const sc_source *s, 
                   NULL))
         return -1;
     t.lambda = l;
-    if (s->polarised) {
+    if (s->polarised == 1) {
         t.pol = TRACE_LINEAR;
         memcpy(t.pol_dir, s->pol, sizeof t.pol_dir);
+    } else if (s->polarised == 2) {   /* in the Stokes frame: its reference (0: +x) */
+        t.pol = TRACE_ELLIPTIC;
+        memcpy(t.pol_dir, sc->polar_ref, sizeof t.pol_dir);
+        memcpy(t.jones, s->jones, sizeof t.jones);
     }
     t.half_angle = s->angle * DEG;
     t.count = s->count;
@@ -341,6 +345,8 @@ typedef struct out {
     int stopped;
     int wl;                     /* write the wavelength column (the scene names some) */
     uint64_t ray0;              /* rays of the wavelengths traced before this run */
+    double *stokes;             /* polarization on: the hit's S0..S3 (scene_polout.c
+                                   keeps each record's), else NULL */
 } out;
 
 /* Poll the stop callback; 1 (and o->stopped) if the trace must stop. */
@@ -369,7 +375,10 @@ static int w_hit(void *ctx, const trace_hit *h)
 {
     out *o = ctx;
     if (poll_records(o)) return 1;
-    return so_hit(o->hit_t, o->hit, h, h->ray + o->ray0);
+    int rc = so_hit(o->hit_t, o->hit, h, h->ray + o->ray0, o->stokes);
+    if (o->stokes)   /* a hit without its record would say so, not repeat the last */
+        for (int i = 0; i < 4; i++) o->stokes[i] = NAN;
+    return rc;
 }
 
 /* A progress line on stderr, only on a terminal and once the trace has run 1 s. */
@@ -426,7 +435,8 @@ static so_table *table(const sc_scene *sc, FILE *f, int fmt, int hits, int wl,
                        const char *name, char *err)
 {
     char why[SC_ERRMAX / 2];
-    so_table *t = so_open(f, (sc_out_format)fmt, hits, wl, sc->threads, why, sizeof why);
+    so_table *t = so_open(f, (sc_out_format)fmt, hits, wl, hits && sc->polar, sc->threads,
+                          why, sizeof why);
     if (!t) snprintf(err, SC_ERRMAX, "%s: %s", name, why);
     return t;
 }
@@ -527,7 +537,7 @@ static int build_scene(const trace_api *tr, const sc_scene *sc, double l,
     for (int i = 0; i < sc->nsurf; i++)
         if (add_surface(tr, ts, &sc->surf[i], l, err)) goto bad;
     for (int i = 0; i < sc->nsource; i++)
-        if (source_at(sc, &sc->source[i], l) && add_source(tr, ts, &sc->source[i], l, err))
+        if (source_at(sc, &sc->source[i], l) && add_source(tr, ts, sc, &sc->source[i], l, err))
             goto bad;
     *out_ts = ts;
     return 0;
@@ -584,6 +594,7 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     o.tty = isatty(2);
     o.t0 = now_ms();
     o.wl = sc->named_wl;
+    o.stokes = sc->polar ? po.stokes : NULL;
     sink.ctx = &o;
     sink.progress = w_progress;
     if (sc->out_segments) {

@@ -35,11 +35,12 @@ typedef struct pray {
 } pray;
 
 /* What every ray of one source ray's tree shares: its source coherency as
- * a1 a1^T + a2 a2^T (real vectors perpendicular to the source direction) and the
- * input frame of its Jones matrix. */
+ * a1 a1^H + a2 a2^H (vectors perpendicular to the source direction, real parts a and
+ * imaginary parts ai: zero but for an elliptical source) and the input frame of its
+ * Jones matrix. */
 typedef struct ptree {
-    double a[2][3];
-    int na;                    /* 1: linearly polarized (a[1] = 0), else 2 */
+    double a[2][3], ai[2][3];
+    int na;                    /* 1: fully polarized (a[1] = 0), else 2 */
     double xin[3], yin[3];
 } ptree;
 
@@ -350,9 +351,10 @@ static void sync(tr_wray *r, const pray *q, const ptree *t, const double s[3])
         double sr = 0, si = 0, qr = 0, qi = 0;
         for (int i = 0; i < 3; i++) {
             double er = 0, ei = 0;
-            for (int k = 0; k < 3; k++) {
-                er += creal(q->P[i][k]) * t->a[j][k];
-                ei += cimag(q->P[i][k]) * t->a[j][k];
+            for (int k = 0; k < 3; k++) {   /* (the ai terms are exact zeros but for
+                                               an elliptical source) */
+                er += creal(q->P[i][k]) * t->a[j][k] - cimag(q->P[i][k]) * t->ai[j][k];
+                ei += cimag(q->P[i][k]) * t->a[j][k] + creal(q->P[i][k]) * t->ai[j][k];
             }
             sr += s[i] * er; si += s[i] * ei;
             qr += f[i] * er; qi += f[i] * ei;
@@ -406,7 +408,12 @@ static void emit_polar(tr_worker *w, tr_out *out, const tr_wray *r, const pray *
     for (int j = 0; j < t->na; j++) {
         cplx ex = 0, ey = 0;
         for (int i = 0; i < 3; i++) {
-            cplx E = q->P[i][0] * t->a[j][0] + q->P[i][1] * t->a[j][1] + q->P[i][2] * t->a[j][2];
+            double er = 0, ei = 0;
+            for (int k = 0; k < 3; k++) {
+                er += creal(q->P[i][k]) * t->a[j][k] - cimag(q->P[i][k]) * t->ai[j][k];
+                ei += cimag(q->P[i][k]) * t->a[j][k] + creal(q->P[i][k]) * t->ai[j][k];
+            }
+            cplx E = CMPLX(er, ei);
             ex += x[i] * E;
             ey += y[i] * E;
         }
@@ -626,11 +633,24 @@ static void tree_start(tr_worker *w, const tr_ray0 *r0)
     for (int i = 0; i < 3; i++) pw->cur.P[i][i] = 1;
     pw->cur.g = 1;
     pw->cur.cx = 0;
-    pw->t.na = r0->pol.jpp > 0 ? 2 : 1;
     v_cross(r0->d, r0->pol.e, f);
+    /* J = [[a, c], [c*, b]] in (e, f), c = <Es Ep*>: J = v1 v1^H + v2 v2^H with
+     * v1 = (sqrt a, c* / sqrt a), v2 = (0, sqrt(b - |c|^2 / a)) (Cholesky); with c = 0
+     * the two fields of before, e and f */
+    double a = r0->pol.jss, b = r0->pol.jpp, cr = r0->pol.jre, ci = r0->pol.jim;
+    double sa = sqrt(a), c2 = cr * cr + ci * ci, ur = 0, ui = 0, rest = b;
+    if (c2 > 0 && sa > 0) {
+        ur = cr / sa;
+        ui = -ci / sa;
+        rest = b - c2 / a;
+        if (rest < 1e-12 * (a + b)) rest = 0;   /* a fully polarized state */
+    }
+    pw->t.na = rest > 0 ? 2 : 1;
     for (int i = 0; i < 3; i++) {
-        pw->t.a[0][i] = sqrt(r0->pol.jss) * r0->pol.e[i];
-        pw->t.a[1][i] = sqrt(r0->pol.jpp) * f[i];
+        pw->t.a[0][i] = ur != 0 ? sa * r0->pol.e[i] + ur * f[i] : sa * r0->pol.e[i];
+        pw->t.ai[0][i] = ui * f[i];
+        pw->t.a[1][i] = sqrt(rest) * f[i];
+        pw->t.ai[1][i] = 0;
     }
     frame_x(w->sc->polar, r0->d, pw->t.xin);
     v_cross(r0->d, pw->t.xin, pw->t.yin);

@@ -218,13 +218,22 @@ int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
         tr_set_err(err, cap, "the Gaussian beam's ray weights are not finite");
         return -1;
     }
-    if (s->pol != TRACE_UNPOLARISED && s->pol != TRACE_LINEAR) {
+    if (s->pol != TRACE_UNPOLARISED && s->pol != TRACE_LINEAR && s->pol != TRACE_ELLIPTIC) {
         tr_set_err(err, cap, "unknown polarisation %d", s->pol);
         return -1;
     }
     if (s->pol == TRACE_LINEAR && (!finite3(s->pol_dir) || v_norm(s->pol_dir) == 0)) {
         tr_set_err(err, cap, "linear polarisation needs a direction");
         return -1;
+    }
+    if (s->pol == TRACE_ELLIPTIC) {
+        double j2 = 0;
+        for (int i = 0; i < 2; i++) j2 += s->jones[i][0] * s->jones[i][0] + s->jones[i][1] * s->jones[i][1];
+        if (!finite3(s->pol_dir) || !(j2 > 0) || !isfinite(j2)) {
+            tr_set_err(err, cap, "a Jones vector must be finite and nonzero (its frame's "
+                       "reference finite)");
+            return -1;
+        }
     }
     if (s->type == TRACE_SRC_GRID) {   /* direction, power, polarisation: once */
         ray_at(ts, 0, -1, &ts->grid0);
@@ -248,9 +257,38 @@ static void dir_at(const tr_source *ts, double th, double phi, double d[3])
         d[i] = ct * ts->s.dir[i] + st * (cp * ts->u[i] + sp * ts->v[i]);
 }
 
+/* The Jones frame's x' for a ray along d (TRACE_ELLIPTIC): the reference pol_dir (zero:
+ * +x) projected perpendicular to d, or for d within 25 degrees of it z x ref (+y if
+ * that is zero) projected -- tr_polar.c's rule for the Stokes frame. */
+static void jones_frame(const double ref0[3], const double d[3], double x[3])
+{
+    double ref[3] = {ref0[0], ref0[1], ref0[2]}, alt[3];
+    if (v_unit(ref)) { ref[0] = 1; ref[1] = ref[2] = 0; }
+    alt[0] = -ref[1];                    /* z x ref */
+    alt[1] = ref[0];
+    alt[2] = 0;
+    if (!(v_norm(alt) > 1e-6)) { alt[0] = 0; alt[1] = 1; alt[2] = 0; }
+    v_unit(alt);
+    const double *r = fabs(v_dot(ref, d)) > 0.90630778703665 ? alt : ref;
+    double c = v_dot(r, d);
+    for (int i = 0; i < 3; i++) x[i] = r[i] - c * d[i];
+    v_unit(x);
+}
+
 static void set_pol(const tr_source *ts, tr_ray0 *r)
 {
     double e[3], k;
+    if (ts->s.pol == TRACE_ELLIPTIC) {   /* the coherency J J^H in (x', d x x') */
+        const double (*j)[2] = ts->s.jones;
+        double a = j[0][0] * j[0][0] + j[0][1] * j[0][1];
+        double b = j[1][0] * j[1][0] + j[1][1] * j[1][1], w = r->power / (a + b);
+        jones_frame(ts->s.pol_dir, r->d, r->pol.e);
+        r->pol.jss = w * a;
+        r->pol.jpp = w * b;
+        r->pol.jre = w * (j[0][0] * j[1][0] + j[0][1] * j[1][1]);   /* Jx conj(Jy) */
+        r->pol.jim = w * (j[0][1] * j[1][0] - j[0][0] * j[1][1]);
+        return;
+    }
     if (ts->s.pol == TRACE_LINEAR) v_set(e, ts->s.pol_dir);
     else { e[0] = 1; e[1] = 0; e[2] = 0; }
     k = v_dot(e, r->d);

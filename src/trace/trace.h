@@ -37,7 +37,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define TRACE_ABI 2     /* 2: trace_rx_surface's mirror and coordinate-break fields */
+#define TRACE_ABI 3     /* 2: trace_rx_surface's mirror and coordinate-break fields;
+                           3: trace_source's Jones vector (TRACE_ELLIPTIC) */
 #define TRACE_API_SYMBOL "trace_get_api"
 
 enum {
@@ -135,7 +136,13 @@ enum trace_source_type {
                              grid of rings x 6r rays to trunc*waist, weighted
                              exp(-2 rho^2/w0^2) */
 };
-enum trace_pol { TRACE_UNPOLARISED, TRACE_LINEAR };
+/* TRACE_ELLIPTIC: fully polarized with the Jones vector trace_source.jones in the
+ * frame (x', y' = dir x x'), x' = pol_dir (zero: +x) projected perpendicular to the
+ * ray -- for rays within 25 degrees of pol_dir, z x pol_dir (+y if that is zero) --
+ * the rule of the Stokes frame (trace_api.polarization), so with pol_dir the Stokes
+ * reference a ray's state at its source is what the detector's Stokes parameters
+ * report: S3 = 2 Im(Jx* Jy) > 0 turns from x' toward y' (fields exp(i(kz - wt))). */
+enum trace_pol { TRACE_UNPOLARISED, TRACE_LINEAR, TRACE_ELLIPTIC };
 
 typedef struct trace_ray {
     double o[3], d[3];
@@ -154,7 +161,8 @@ typedef struct trace_source {
     double power;              /* total; 0: 1 */
     double n_medium;           /* index where the rays start; 0: 1 */
     int pol;                   /* enum trace_pol */
-    double pol_dir[3];         /* TRACE_LINEAR: E direction (projected _|_ ray) */
+    double pol_dir[3];         /* TRACE_LINEAR: E direction (projected _|_ ray);
+                                  TRACE_ELLIPTIC: the Jones frame's x' reference */
     const trace_ray *ray;      /* TRACE_SRC_RAYS: count rays (copied on adding) */
     double alpha_medium;       /* absorption where the rays start (set_absorption) */
     double lambda;             /* the rays' vacuum wavelength, um (0: none named), carried
@@ -162,6 +170,8 @@ typedef struct trace_source {
                                   are the materials' (a caller tracing several
                                   wavelengths gives each its own run with the indices at
                                   that wavelength, as the scene front end does) */
+    double jones[2][2];        /* TRACE_ELLIPTIC: (re, im) of Jx and Jy (any nonzero
+                                  length: the power is the source's) */
 } trace_source;
 
 typedef struct trace_options {
