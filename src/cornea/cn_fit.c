@@ -216,6 +216,10 @@ static int valley_restarts(fctx *c, const cn_params *start, cn_params *best, int
     int dof = 2 * c->n - c->nf, iters = 0;
     double cb = chi2_of(c, best);
     if (dof <= 0 || !((cb - dof) / sqrt(2.0 * dof) > 4)) return 0;
+    /* past chi2/dof 100 the model misses the surface itself, not a valley's minimum: a
+       cone through the biconic spent 1386 of its 1428 iterations in these restarts
+       for a chi2 0.06 % lower, of a model then rejected */
+    if (cb > 100.0 * dof) return 0;
     const double a = 3 * M_PI / 180;
     const double turns[4][2] = {{a, 0}, {-a, 0}, {0, a}, {0, -a}};
     double R = start->p[CN_R];
