@@ -18,12 +18,27 @@ trap 'rm -rf "$WORK"' EXIT
 pass() { PASSED=$((PASSED + 1)); [ -n "$VERBOSE" ] && echo "PASS $*"; return 0; }
 fail() { FAILED=$((FAILED + 1)); echo "FAIL $*"; return 0; }
 # check NAME CMD...: passes when CMD exits 0
+# lsan_tool_failed FILE: LeakSanitizer's own stop-the-world tracer crashed ("Tracer
+# caught signal 11 ... LeakSanitizer has encountered a fatal error", a known
+# intermittent fault of the tool at a threaded program's exit: google/sanitizers#1353)
+# and no sanitizer finding is in FILE.  Seen twice in ~600 ASan runs of a fresh-clone
+# check on this machine, never twice in a row; such a run is said and made again once.
+lsan_tool_failed() {
+    grep -q 'LeakSanitizer has encountered a fatal error' "$1" &&
+        ! grep -q -e 'ERROR: LeakSanitizer: detected' -e 'ERROR: AddressSanitizer' -e 'runtime error:' "$1"
+}
 check() { n=$1; shift; if "$@" >"$WORK/check.out" 2>&1; then pass "$n"
+          elif lsan_tool_failed "$WORK/check.out" && echo "# $n: LeakSanitizer's tracer crashed (the tool, no finding): again" &&
+               "$@" >"$WORK/check.out" 2>&1; then pass "$n"
           else fail "$n"; sed 's/^/    /' "$WORK/check.out" | head -20; fi; }
 # unit BINARY: counts the PASS/FAIL lines a C unit test prints
 unit() {
     if [ ! -x "$1" ]; then fail "$1 (not built)"; return; fi
     "$1" > "$WORK/unit.out" 2>&1; rc=$?
+    if [ "$rc" -ne 0 ] && lsan_tool_failed "$WORK/unit.out"; then
+        echo "# $1: LeakSanitizer's tracer crashed (the tool, no finding): again"
+        "$1" > "$WORK/unit.out" 2>&1; rc=$?
+    fi
     p=$(grep -c '^PASS' "$WORK/unit.out"); f=$(grep -c '^FAIL' "$WORK/unit.out")
     PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
     grep '^FAIL' "$WORK/unit.out" | sed "s|^|$(basename "$1"): |"
