@@ -72,19 +72,7 @@ static void coddington_rays(double R, double th, double eps, double *ft, double 
     *fs = rt_dot(X, dr);
 }
 
-/* ---- the closed forms of the Gaussian beam (as tests/rig/t_spots.c) ----------- */
-static void self(double f, double lm, double *w0, double *s)
-{
-    double zr = M_PI * *w0 * *w0 / lm, u = *s - f;
-    double m = 1 / sqrt((1 - *s / f) * (1 - *s / f) + (zr / f) * (zr / f));
-    *s = f + u * f * f / (u * u + zr * zr);
-    *w0 *= m;
-}
-static double wz(double w0, double z, double lm)
-{
-    double zr = M_PI * w0 * w0 / lm;
-    return w0 * sqrt(1 + (z / zr) * (z / zr));
-}
+#include "beam_forms.h"       /* self(), wz(): the closed forms */
 /* The laser's waist to the cornea along path with the rig's lens (lens_at before
  * the cornea): the waist (*w0) and its distance before the cornea (*sc); then through a
  * mirror of focal length fm to path[3]: the radius there. */

@@ -25,19 +25,7 @@ static int load(const char *extra, rg_rig *r, char *err, size_t cap)
     return rg->rig_parse(text, strlen(text), "x.rig", r, err, cap);
 }
 
-/* Self's thin lens: (w0, s) -> (w0', s'); s before, s' after; lambda_m = M^2 lambda */
-static void self(double f, double lm, double *w0, double *s)
-{
-    double zr = M_PI * *w0 * *w0 / lm, u = *s - f;
-    double m = 1 / sqrt((1 - *s / f) * (1 - *s / f) + (zr / f) * (zr / f));
-    *s = f + u * f * f / (u * u + zr * zr);
-    *w0 *= m;
-}
-static double wz(double w0, double z, double lm)
-{
-    double zr = M_PI * w0 * w0 / lm;
-    return w0 * sqrt(1 + (z / zr) * (z / zr));
-}
+#include "beam_forms.h"       /* self(), wz(): the closed forms */
 
 /* The chain by the closed forms: radii on the cornea and the detector. */
 static void closed(const rg_spots *s, double w0, double z, double f, double at,
