@@ -1,5 +1,6 @@
 # t_41_stokes.sh -- Stokes parameters in the hits output and polarized sources beyond
-# linear (issue 21): `pol right|left`, `pol ellipse AZ CHI`, `pol jones JX JY PX PY`
+# linear (issue 21): `pol right|left`, `pol ellipse AZ CHI`, `pol jones JX JY PX PY`,
+# `pol stokes S1 S2 S3` (partially polarized)
 # (src/trace/scene_polar.c, tr_source.c, tr_polar.c) and the hits' S0..S3 columns
 # (scene_out.c, scene_polout.c).  Every expected value is Mueller calculus written here
 # in awk from the documented conventions (doc/trace.md: fields exp(i(kz - wt)), S3 =
@@ -310,6 +311,45 @@ else
     echo "SKIP t_41: LENSMAT_MAIN (a build from before a change) not given: the byte comparison was not made"
 fi
 
+# partially polarized sources, `pol stokes S1 S2 S3` (over S0): what a detector right
+# behind the source reports is the vector given (a ray along z, a cone about z with
+# `polarization ref 0 1 0`: the frame's rule), the degree of polarization its length;
+# through a polarizer at 30 deg, a quarter-wave plate at 45 deg and a 60-degree
+# retarder at 10 deg, S = M3 M2 M1 S (Mueller, 1e-12); `pol stokes 0 0 0` is the
+# unpolarized source's hits to the bits
+stokes_partial() (
+    d=$SW/part; rm -rf "$d"; mkdir -p "$d" && cd "$d" || return 1
+    printf '%s\n' 'plane detect at 0 0 3 normal 0 0 1 disc 5' 'polarization on ref 0 1 0' \
+        'source ray from 0 0 0 dir 0 0 1 pol stokes 0.3 -0.4 0.5' \
+        'source cone from 0 0 0 dir 0 0 1 angle 10 rings 3 pol stokes 0.3 -0.4 0.5' \
+        'output hits h.csv' > s.scene &&
+    printf '%s\n' 'plane refract 1 1 polarizer 0.86602540378443865 0.5 0 at 0 0 1 normal 0 0 1 disc 5' \
+        'plane refract 1 1 qwp 0.70710678118654752 0.70710678118654752 0 at 0 0 2 normal 0 0 1 disc 5' \
+        'plane refract 1 1 retarder 0.98480775301220806 0.17364817766693035 0 60 at 0 0 3 normal 0 0 1 disc 5' \
+        'plane detect at 0 0 4 normal 0 0 1 disc 5' \
+        'source ray from 0 0 0 dir 0 0 1 pol stokes -0.2 0.1 0.6' 'output hits m.csv' > m.scene &&
+    printf '%s\n' 'cap refract 1 1.5 vertex 0 0 1 radius 20 aperture 6' 'plane detect at 0 0 8 normal 0 0 1 disc 20' \
+        'source cone from 0 0 0 dir 0 0 1 angle 15 rings 4 pol stokes 0 0 0' 'output hits u.csv' \
+        'polarization on' > u.scene &&
+    sed 's/ pol stokes 0 0 0//; s/u.csv/v.csv/' u.scene > v.scene &&
+    for f in s m u v; do trace_in "$BIN" "$d" $f.scene || return 1; done
+    awk "$MUELLER"'NR > 1 { s[0] = 1; s[1] = .3; s[2] = -.4; s[3] = .5
+        for (k = 0; k < 4; k++) o[k] = s[k] * $col["S0"]; e = off(o); n++
+        dop = sqrt($col["S1"] ^ 2 + $col["S2"] ^ 2 + $col["S3"] ^ 2) / $col["S0"]
+        if (e > 1e-12 || ab(dop - sqrt(.5)) > 1e-12) { bad = 1; print "row " NR ": worst " e ", DoP " dop } }
+        END { printf "%d hits at the source: S/S0 = (0.3, -0.4, 0.5), DoP %.15f\n", n, dop
+              exit !(n > 30 && !bad) }' h.csv &&
+    awk "$MUELLER"'NR == 2 { s[0] = 1; s[1] = -.2; s[2] = .1; s[3] = .6
+        pol_m(30 * deg, M1); ret_m(45 * deg, pi / 2, M2); ret_m(10 * deg, 60 * deg, M3)
+        mv(M1, s, a); mv(M2, a, b); mv(M3, b, o); e = off(o)
+        printf "polarizer, qwp, retarder: S = %s %s %s %s, Mueller %.9f %.9f %.9f %.9f, worst %.2g\n",
+            $col["S0"], $col["S1"], $col["S2"], $col["S3"], o[0], o[1], o[2], o[3], e; n++
+        if (e > 1e-12) bad = 1 } END { exit !(n == 1 && !bad) }' m.csv &&
+    cmp u.csv v.csv && echo "pol stokes 0 0 0 through a singlet: $(($(wc -l < u.csv) - 1)) hits, the unpolarized source's bytes"
+)
+check "pol stokes (partially polarized): S/S0 and DoP as given at the source (two frames), Mueller through a polarizer, qwp and retarder (1e-12), 0 0 0 = unpolarized" \
+    stokes_partial
+
 # Refusals, each at its FILE:LINE (exit 2 in a replay)
 stokes_bad() (
     d=$SW/bad; rm -rf "$d"; mkdir -p "$d" && cd "$d" || return 1
@@ -331,7 +371,10 @@ stokes_bad() (
     one 'right left' "bad.scene:2: source ray: 'pol' expects" &&
     one '1 0' "bad.scene:2: source ray: 'pol' expects" &&
     one '0 0 0' "bad.scene:2: source ray: 'pol' 0 0 0 is a zero-length direction" &&
-    one 'right pol left' "bad.scene:2: source ray: 'pol' given twice"
+    one 'right pol left' "bad.scene:2: source ray: 'pol' given twice" &&
+    one 'stokes 0.8 0.6 0.1' "bad.scene:2: source ray: 'pol stokes' 0.8 0.6 0.1: the degree of polarization sqrt(S1^2 + S2^2 + S3^2) = 1.00499 is more than 1" &&
+    one 'stokes 0.5 0.5' "bad.scene:2: source ray: 'pol' expects" &&
+    one 'stokes 0 nan 0' "bad.scene:2: source ray: 'pol': 'nan': NaN is not a number"
 )
 check "bad pol values refused at FILE:LINE (ellipticity beyond 45, negative or zero amplitudes, NaN, unknown words, short lists)" \
     stokes_bad

@@ -82,6 +82,32 @@ polar_threads() (
 )
 check "the polar table is the same on one thread and two (coated, retarding lens, reflections followed)" polar_threads
 
+# the proper retardance is the path's, not the frames': a tilted, coated singlet whose
+# rays (reflections followed) leave in many directions, traced with three Stokes
+# references (an unpolarized source: the same light in every frame); the retardance
+# column is the same for each ray to 1e-9 deg while S1 (frame-bound) changes
+polar_proper() (
+    d=$PW/proper; rm -rf "$d"; mkdir -p "$d" && cd "$d" || return 1
+    for r in "1 0 0" "0 1 0" "0.3 -0.8 0.5"; do
+        printf '%s\n' 'cap refract 1 1.7 coating c vertex 0 0 0 radius 20 aperture 6' \
+            'coating c layer 1.38 100' 'cap refract 1.7 1 vertex 0 0 4 radius -20 aperture 6' \
+            'sphere detect center 0 0 0 radius 40' \
+            'source cone from 3 2 -10 dir -0.2 -0.1 1 angle 12 rings 6' \
+            "polarization on ref $r" "output polar p.csv" > p.scene
+        trace_scene "$BIN" "$d" p.scene && mv p.csv "p-$(echo "$r" | tr ' ' _).csv" || return 1
+    done
+    [ "$(wc -l < p-1_0_0.csv)" -gt 300 ] || return 1
+    paste -d, p-1_0_0.csv p-0_1_0.csv p-0.3_-0.8_0.5.csv | awk -F, 'NR == 1 {
+            for (i = 1; i <= NF; i++) if (!($i in c)) c[$i] = i; w = NF / 3; next }
+        { r = c["retardance_deg"]; s = c["S1"]; n++; if ($r > 1 && $r < 179) mid++
+          for (k = 1; k < 3; k++) { e = $(r + k * w) - $r; if (e < 0) e = -e; if (e > m) m = e
+              f = $(s + k * w) / $(c["S0"] + k * w) - $s / $c["S0"]; if (f < 0) f = -f; if (f > ds) ds = f
+              if ($(c["ray"] + k * w) != $c["ray"] || $(c["depth"] + k * w) != $c["depth"]) bad++ } }
+        END { printf "%d hits (%d with 1..179 deg): retardance differs by at most %.2g deg across references; S1/S0 by up to %.3g\n", n, mid, m, ds
+              exit !(n > 300 && !bad && mid > 50 && m < 1e-9 && ds > 1e-3) }'
+)
+check "the proper retardance does not depend on the Stokes reference (3 references, 1e-9 deg) while S1 does: a tilted coated singlet, reflections followed" polar_proper
+
 # a quarter-wave plate, fast axis x, 45-degree light: circular (V = 1, the --polar
 # calculator's "qwp 0" on its 45-degree input); a half-wave plate: -45 degrees
 polar_qwp() (

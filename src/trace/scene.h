@@ -99,9 +99,12 @@ typedef struct sc_source {
     int nlambda;              /* 0: none named (the d line where a glass needs one) */
     int polarised;            /* 1: linear along pol[] (unit), 2: the Jones vector
                                  jones (re, im of Jx, Jy; unit length) in the Stokes
-                                 frame (polarization ref), 0: unpolarised */
+                                 frame (polarization ref), 3: partially polarized,
+                                 the normalized Stokes vector stokes (S1..S3 / S0)
+                                 in that frame, 0: unpolarised */
     double pol[3];
     double jones[2][2];
+    double stokes[3];
     const char *src;          /* defined at src:line */
     long line;
 } sc_source;
@@ -232,7 +235,7 @@ typedef struct sc_tess_row {
  * without refinement, with analytic normals, with full re-intersection. */
 int sc_tess_table(const sc_tess_spec *spec, sc_tess_row *rows, char *err);
 
-#define SC_API_ABI 3
+#define SC_API_ABI 4   /* 4: sc_source's Stokes vector (pol stokes) */
 #define SC_API_SYMBOL "lm_scene_api"
 typedef struct scene_api {
     int abi;

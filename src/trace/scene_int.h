@@ -63,7 +63,8 @@ int sc_polar_resolve(sc_scene *sc, char *err);
 void sc_polar_free(sc_scene *sc);
 /* A source's `pol` key, its n tokens from r->t[first]: `pol X Y Z` (linear), `pol
  * right|left` (circular), `pol ellipse AZ CHI` (degrees), `pol jones JX JY PX PY`
- * (amplitudes, phases in degrees) into s (polarised, pol, jones); 0 or -1 (FILE:LINE). */
+ * (amplitudes, phases in degrees), `pol stokes S1 S2 S3` (partially polarized, over
+ * S0) into s (polarised, pol, jones, stokes); 0 or -1 (FILE:LINE). */
 int sc_source_pol(reader *r, int first, int n, const char *dname, sc_source *s);
 
 #endif

@@ -106,7 +106,7 @@ int sc_source_pol(reader *r, int first, int n, const char *dname, sc_source *s)
     char what[64];
     double v[4];
     snprintf(what, sizeof what, "%s: 'pol'", dname);
-    if (n == 3 && !sl_tok_is(t, "ellipse")) {   /* linear: the field's direction */
+    if (n == 3 && !sl_tok_is(t, "ellipse") && !sl_tok_is(t, "stokes")) {   /* linear */
         for (int i = 0; i < 3; i++)
             if (sl_tok_num(r, &t[i], what, &s->pol[i])) return -1;
         double m = sqrt(dot3(s->pol, s->pol));
@@ -125,15 +125,30 @@ int sc_source_pol(reader *r, int first, int n, const char *dname, sc_source *s)
         s->polarised = 2;
         return 0;
     }
-    int ell = 0, jon = 0;
-    if (n >= 1) { ell = sl_tok_is(t, "ellipse"); jon = sl_tok_is(t, "jones"); }
-    if (!(ell && n == 3) && !(jon && n == 5))
+    int ell = 0, jon = 0, sto = 0;
+    if (n >= 1) {
+        ell = sl_tok_is(t, "ellipse");
+        jon = sl_tok_is(t, "jones");
+        sto = sl_tok_is(t, "stokes");
+    }
+    if (!(ell && n == 3) && !(jon && n == 5) && !(sto && n == 4))
         return sl_fail(r, "%s: 'pol' expects X Y Z (linear), right or left (circular, "
                        "optics convention: right turns clockwise facing the source), "
-                       "ellipse AZ CHI (azimuth, ellipticity angle in degrees) or jones "
-                       "JX JY PX PY (amplitudes, phases in degrees)", dname);
+                       "ellipse AZ CHI (azimuth, ellipticity angle in degrees), jones "
+                       "JX JY PX PY (amplitudes, phases in degrees) or stokes S1 S2 S3 "
+                       "(partially polarized: over S0, at most 1 in length)", dname);
     for (int i = 0; i < n - 1; i++)
         if (sl_tok_num(r, &t[1 + i], what, &v[i])) return -1;
+    if (sto) {
+        double q = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (!(q <= 1 + 1e-12))
+            return sl_fail(r, "%s: 'pol stokes' %g %g %g: the degree of polarization "
+                           "sqrt(S1^2 + S2^2 + S3^2) = %.6g is more than 1 (give S1 S2 S3 "
+                           "over S0)", dname, v[0], v[1], v[2], sqrt(q));
+        memcpy(s->stokes, v, sizeof s->stokes);
+        s->polarised = 3;
+        return 0;
+    }
     if (ell) {
         if (!(fabs(v[1]) <= 45))
             return sl_fail(r, "%s: 'pol ellipse': the ellipticity angle %g must lie in "

@@ -270,6 +270,10 @@ static int add_source(const trace_api *tr, trace_scene *ts, const sc_scene *sc,
         t.pol = TRACE_ELLIPTIC;
         memcpy(t.pol_dir, sc->polar_ref, sizeof t.pol_dir);
         memcpy(t.jones, s->jones, sizeof t.jones);
+    } else if (s->polarised == 3) {
+        t.pol = TRACE_PARTIAL;
+        memcpy(t.pol_dir, sc->polar_ref, sizeof t.pol_dir);
+        memcpy(t.stokes, s->stokes, sizeof t.stokes);
     }
     t.half_angle = s->angle * DEG;
     t.count = s->count;

@@ -30,6 +30,7 @@ struct tr_polar {
 /* The polarization state of one ray beside its tr_wray: P, the radiometric gain. */
 typedef struct pray {
     cplx P[3][3];
+    double Q[3][3];            /* the parallel transport matrix: P's geometry alone */
     double g;
     int cx;                    /* P has imaginary parts (else they are all 0) */
 } pray;
@@ -232,6 +233,28 @@ static void prt_of(const double kin[3], const double kout[3], const double s[3],
             M[i][j] = as * s[i] * s[j] + ap * pout[i] * pin[j] + kout[i] * kin[j];
 }
 
+/* Q = O_out O_in^T Q, O = [s, k x s, k]: the interface's parallel transport (Chipman,
+ * Lam & Young ch. 11; Yun, McClain & Chipman, Appl. Opt. 50, 2866 (2011)), P's matrix
+ * with every Fresnel amplitude 1 -- the rotation about s that takes kin to kout and
+ * carries transverse vectors without turning them about the ray.  Q^T P is what the
+ * path does to the field beyond the geometry: its retardance is the path's proper
+ * retardance, the same whatever local frames are chosen.  (With Hecht's signs an
+ * ideal mirror, rs = -1 and rp = +1, is then a half-wave: the book's convention.) */
+static void transport(const double kin[3], const double kout[3], const double s[3],
+                      double Q[3][3])
+{
+    double pin[3], pout[3], T[3][3], R[3][3];
+    v_cross(kin, s, pin);
+    v_cross(kout, s, pout);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            T[i][j] = s[i] * s[j] + pout[i] * pin[j] + kout[i] * kin[j];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            R[i][j] = T[i][0] * Q[0][j] + T[i][1] * Q[1][j] + T[i][2] * Q[2][j];
+    memcpy(Q, R, sizeof R);
+}
+
 /* A polarizer's or retarder's matrix for a ray along k (unit). */
 static void element_of(const trace_polar_surface *ps, const double k[3], cplx M[3][3])
 {
@@ -424,8 +447,17 @@ static void emit_polar(tr_worker *w, tr_out *out, const tr_wray *r, const pray *
         h->stokes[2] += q->g * 2 * creal(xy);
         h->stokes[3] += q->g * 2 * cimag(xy);
     }
-    /* J = [x y]^T P [xin yin]; its singular values and the unitary factor's trace */
-    const double *ob[2] = {x, y}, *ib[2] = {t->xin, t->yin};
+    /* J = [Q xin, Q yin]^T P [xin yin] (= [xin yin]^T Q^T P [xin yin]): the Jones matrix
+     * in the source's frame and that frame carried along the path by parallel
+     * transport, so no turn of the frames (the Stokes frames' projection of one
+     * reference, or any other choice) shows up as retardance; its singular values and
+     * the unitary factor's trace */
+    double qx[3], qy[3];
+    for (int i = 0; i < 3; i++) {
+        qx[i] = q->Q[i][0] * t->xin[0] + q->Q[i][1] * t->xin[1] + q->Q[i][2] * t->xin[2];
+        qy[i] = q->Q[i][0] * t->yin[0] + q->Q[i][1] * t->yin[1] + q->Q[i][2] * t->yin[2];
+    }
+    const double *ob[2] = {qx, qy}, *ib[2] = {t->xin, t->yin};
     cplx J[2][2];
     for (int a = 0; a < 2; a++)
         for (int b = 0; b < 2; b++) {
@@ -451,8 +483,12 @@ static void emit_polar(tr_worker *w, tr_out *out, const tr_wray *r, const pray *
         cplx i11 = r22 / rd, i22 = r11 / rd, i12 = -r12 / rd, i21 = -r21 / rd;
         cplx u11 = J[0][0] * i11 + J[0][1] * i21, u22 = J[1][0] * i12 + J[1][1] * i22;
         cplx u12 = J[0][0] * i12 + J[0][1] * i22, u21 = J[1][0] * i11 + J[1][1] * i21;
-        double du = cabs(u11 * u22 - u12 * u21), c = cabs(u11 + u22) / (2 * sqrt(du));
-        h->retardance = 2 * acos(c < 1 ? c : 1);
+        /* U's eigenvalues e^{ia}, e^{ib}: |tr U| = 2 cos((a - b) / 2) and
+         * |tr^2 - 4 det| = |(u11 - u22)^2 + 4 u12 u21| = 4 sin^2((a - b) / 2), both over
+         * |det U|; atan2 of the pair keeps every digit near 0 and pi (acos of the
+         * cosine alone loses half of them there) */
+        cplx dd = (u11 - u22) * (u11 - u22) + 4 * u12 * u21;
+        h->retardance = 2 * atan2(sqrt(cabs(dd)), cabs(u11 + u22));
     }
 }
 
@@ -500,6 +536,7 @@ static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray
         v_unit(r->d);
         prt_of(kin, r->d, s, -1, 1, M);
         mul(M, 0, q->P, &q->cx);
+        transport(kin, r->d, s, q->Q);
         sync(r, q, t, s);
         return tr_strong(w, ty, power(r), p0);
     }
@@ -513,6 +550,7 @@ static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray
         v_unit(r->d);
         prt_of(kin, r->d, s, a[0], a[1], M);
         mul(M, acx, q->P, &q->cx);
+        transport(kin, r->d, s, q->Q);
         sync(r, q, t, s);
         ty->tir++;
         return tr_strong(w, ty, power(r), p0);
@@ -529,6 +567,7 @@ static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray
         c->n = n1;
         prt_of(kin, c->d, s, a[0], a[1], M);
         mul(M, acx, cq->P, &cq->cx);
+        transport(kin, c->d, s, cq->Q);
         sync(c, cq, t, s);
         if (w->o->reflections) {
             tr_keep(w, ty, sp, c, p0);
@@ -550,6 +589,7 @@ static int interact(tr_worker *w, tr_tally *ty, tr_wray *stack, int *sp, tr_wray
         acx = 0;
     }
     mul(M, acx, q->P, &q->cx);
+    transport(kin, r->d, s, q->Q);
     if (ps && ps->element != TRACE_POL_NONE) {
         sync(r, q, t, s);
         double before = power(r);
@@ -630,7 +670,8 @@ static void tree_start(tr_worker *w, const tr_ray0 *r0)
     struct tr_polw *pw = w->pol;
     double f[3];
     memset(pw->cur.P, 0, sizeof pw->cur.P);
-    for (int i = 0; i < 3; i++) pw->cur.P[i][i] = 1;
+    memset(pw->cur.Q, 0, sizeof pw->cur.Q);
+    for (int i = 0; i < 3; i++) pw->cur.P[i][i] = pw->cur.Q[i][i] = 1;
     pw->cur.g = 1;
     pw->cur.cx = 0;
     v_cross(r0->d, r0->pol.e, f);

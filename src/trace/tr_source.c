@@ -218,7 +218,8 @@ int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
         tr_set_err(err, cap, "the Gaussian beam's ray weights are not finite");
         return -1;
     }
-    if (s->pol != TRACE_UNPOLARISED && s->pol != TRACE_LINEAR && s->pol != TRACE_ELLIPTIC) {
+    if (s->pol != TRACE_UNPOLARISED && s->pol != TRACE_LINEAR && s->pol != TRACE_ELLIPTIC &&
+        s->pol != TRACE_PARTIAL) {
         tr_set_err(err, cap, "unknown polarisation %d", s->pol);
         return -1;
     }
@@ -232,6 +233,15 @@ int tr_source_init(tr_source *ts, const trace_source *s, char *err, size_t cap)
         if (!finite3(s->pol_dir) || !(j2 > 0) || !isfinite(j2)) {
             tr_set_err(err, cap, "a Jones vector must be finite and nonzero (its frame's "
                        "reference finite)");
+            return -1;
+        }
+    }
+    if (s->pol == TRACE_PARTIAL) {
+        double q = 0;
+        for (int i = 0; i < 3; i++) q += s->stokes[i] * s->stokes[i];
+        if (!finite3(s->pol_dir) || !finite3(s->stokes) || !(q <= 1 + 1e-12)) {
+            tr_set_err(err, cap, "a Stokes vector must be finite with S1^2 + S2^2 + S3^2 "
+                       "at most S0^2 (its frame's reference finite)");
             return -1;
         }
     }
@@ -257,7 +267,7 @@ static void dir_at(const tr_source *ts, double th, double phi, double d[3])
         d[i] = ct * ts->s.dir[i] + st * (cp * ts->u[i] + sp * ts->v[i]);
 }
 
-/* The Jones frame's x' for a ray along d (TRACE_ELLIPTIC): the reference pol_dir (zero:
+/* The Jones frame's x' for a ray along d (TRACE_ELLIPTIC, TRACE_PARTIAL): the reference pol_dir (zero:
  * +x) projected perpendicular to d, or for d within 25 degrees of it z x ref (+y if
  * that is zero) projected -- tr_polar.c's rule for the Stokes frame. */
 static void jones_frame(const double ref0[3], const double d[3], double x[3])
@@ -287,6 +297,15 @@ static void set_pol(const tr_source *ts, tr_ray0 *r)
         r->pol.jpp = w * b;
         r->pol.jre = w * (j[0][0] * j[1][0] + j[0][1] * j[1][1]);   /* Jx conj(Jy) */
         r->pol.jim = w * (j[0][1] * j[1][0] - j[0][0] * j[1][1]);
+        return;
+    }
+    if (ts->s.pol == TRACE_PARTIAL) {    /* Jx conj(Jy) = (S2 - i S3) / 2 */
+        const double *st = ts->s.stokes, w = 0.5 * r->power;
+        jones_frame(ts->s.pol_dir, r->d, r->pol.e);
+        r->pol.jss = w * (1 + st[0]);
+        r->pol.jpp = w * (1 - st[0]);
+        r->pol.jre = w * st[1];
+        r->pol.jim = -w * st[2];
         return;
     }
     if (ts->s.pol == TRACE_LINEAR) v_set(e, ts->s.pol_dir);

@@ -37,8 +37,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define TRACE_ABI 3     /* 2: trace_rx_surface's mirror and coordinate-break fields;
-                           3: trace_source's Jones vector (TRACE_ELLIPTIC) */
+#define TRACE_ABI 4     /* 2: trace_rx_surface's mirror and coordinate-break fields;
+                           3: trace_source's Jones vector (TRACE_ELLIPTIC);
+                           4: its Stokes vector (TRACE_PARTIAL) */
 #define TRACE_API_SYMBOL "trace_get_api"
 
 enum {
@@ -142,7 +143,10 @@ enum trace_source_type {
  * the rule of the Stokes frame (trace_api.polarization), so with pol_dir the Stokes
  * reference a ray's state at its source is what the detector's Stokes parameters
  * report: S3 = 2 Im(Jx* Jy) > 0 turns from x' toward y' (fields exp(i(kz - wt))). */
-enum trace_pol { TRACE_UNPOLARISED, TRACE_LINEAR, TRACE_ELLIPTIC };
+/* TRACE_PARTIAL: partially polarized, the normalized Stokes vector trace_source.stokes
+ * (S1/S0, S2/S0, S3/S0, length = the degree of polarization, at most 1) in that same
+ * frame: the coherency (S0 + S1, S2 - i S3; S2 + i S3, S0 - S1) / 2. */
+enum trace_pol { TRACE_UNPOLARISED, TRACE_LINEAR, TRACE_ELLIPTIC, TRACE_PARTIAL };
 
 typedef struct trace_ray {
     double o[3], d[3];
@@ -172,6 +176,7 @@ typedef struct trace_source {
                                   that wavelength, as the scene front end does) */
     double jones[2][2];        /* TRACE_ELLIPTIC: (re, im) of Jx and Jy (any nonzero
                                   length: the power is the source's) */
+    double stokes[3];          /* TRACE_PARTIAL: S1/S0, S2/S0, S3/S0 (frame: pol_dir) */
 } trace_source;
 
 typedef struct trace_options {
@@ -397,9 +402,12 @@ typedef struct trace_polar_hit {
                                   x' the reference projected perpendicular to dir;
                                   S3 = 2 Im(Ex* Ey) > 0: E turning from x' toward y' */
     double xref[3];            /* x' */
-    double retardance;         /* of the Jones matrix in the frames x', y' at the source
-                                  ray and here (radians, 0..pi; NaN where a polarizer
-                                  leaves it undefined) */
+    double retardance;         /* the path's proper retardance (radians, 0..pi; NaN
+                                  where a polarizer leaves it undefined): of the Jones
+                                  matrix from the frame x', y' at the source to that
+                                  frame carried along the path by parallel transport
+                                  (Q, Chipman ch. 11), so frame turns are not in it;
+                                  an ideal mirror counts as a half-wave (Hecht's rp) */
     double diattenuation;      /* (smax^2 - smin^2) / (smax^2 + smin^2) of it */
 } trace_polar_hit;
 

@@ -6,6 +6,8 @@
  * section 1.5.4, give 45 degrees a reflection for n = 1.51 at 48 deg 37' and 54 deg
  * 37'); Malus's law through two traced polarizers; a traced quarter-wave plate making
  * circular light (Stokes V = 1) and a half-wave plate turning 45 degrees to -45;
+ * the proper retardance (frames carried by parallel transport) of two TIRs in one
+ * plane and in crossed planes, whatever the Stokes reference and the path's azimuth;
  * a quarter-wave MgF2 coating's R ((n0 ns - n1^2)/(n0 ns + n1^2))^2 and R + T = 1
  * oblique; unpolarized scenes: the same powers with and without polarization; the
  * energy balance. */
@@ -83,6 +85,20 @@ static int run(trace_scene *sc, rec *x, int reflections, trace_summary *sum)
     trace_sink k = {x, NULL, keep_hit, NULL};
     x->n = x->np = 0;
     if (tr->polarization(sc, 1, NULL, keep_pol, x)) return -1;
+    return tr->run(sc, &o, &k, sum);
+}
+
+/* run() with the Stokes frame's reference xref */
+static int run_ref(trace_scene *sc, rec *x, const double xref[3], trace_summary *sum)
+{
+    trace_options o;
+    tr->options_default(&o);
+    o.reflections = 0;
+    o.cutoff = 0;
+    o.threads = 1;
+    trace_sink k = {x, NULL, keep_hit, NULL};
+    x->n = x->np = 0;
+    if (tr->polarization(sc, 1, xref, keep_pol, x)) return -1;
     return tr->run(sc, &o, &k, sum);
 }
 
@@ -210,6 +226,81 @@ static void rhomb(void)
     printf("BENCH wave_rhomb_retardance_err_deg %.3g deg\n", fabs(got - 2 * one));
     printf("BENCH wave_rhomb_vs_published_deg %.3g deg\n", fabs(got - 90));
     tr->scene_free(sc);
+}
+
+/* The TIR retardance closed form (Born & Wolf 1.5.4): glass n into air at th. */
+static double tir_delta(double n, double th)
+{
+    double m = 1 / n, s2 = sin(th) * sin(th);
+    return 2 * atan(cos(th) * sqrt(s2 - m * m) / s2);
+}
+
+/* One ray in glass (n 1.5) along +z meets two planes at th1 and th2 by TIR, the second
+ * plane of incidence turned by psi about the ray from the first's (psi 0: one plane,
+ * 90 degrees: crossed), then a detector; the first plane's own azimuth phi about z.
+ * Returns the hit's retardance (radians) with the Stokes reference xref, or NaN. */
+static double two_tirs(double th1, double th2, double psi, double phi, const double xref[3],
+                       int *ntir)
+{
+    const double n = 1.5, o[3] = {0, 0, 0}, z[3] = {0, 0, 1};
+    double c = cos(phi), s = sin(phi);
+    double N1[3] = {-s * sin(th1), c * sin(th1), -cos(th1)}, A[3] = {0, 0, 5}, k1[3], B[3];
+    for (int i = 0; i < 3; i++) k1[i] = z[i] + 2 * cos(th1) * N1[i];
+    for (int i = 0; i < 3; i++) B[i] = A[i] + 5 * k1[i];
+    /* u: the first plane's s direction (x turned by phi); w = k1 x u, both _|_ k1 */
+    double u[3] = {c, s, 0}, w[3], N2[3], k2[3], C[3];
+    cross(k1, u, w);
+    for (int i = 0; i < 3; i++)
+        N2[i] = -cos(th2) * k1[i] + sin(th2) * (cos(psi) * w[i] + sin(psi) * u[i]);
+    for (int i = 0; i < 3; i++) k2[i] = k1[i] + 2 * cos(th2) * N2[i];
+    for (int i = 0; i < 3; i++) C[i] = B[i] + 5 * k2[i];
+    double e[3] = {1, 2, 0};   /* linear light, neither s nor p */
+    trace_scene *sc = one_ray(o, z, e, n);
+    add_plane(sc, A, N1, 1, TRACE_REFRACT, 1, n);
+    add_plane(sc, B, N2, 1, TRACE_REFRACT, 1, n);
+    add_plane(sc, C, k2, 2, TRACE_DETECT, n, n);
+    static rec x;
+    trace_summary sum;
+    int rc = run_ref(sc, &x, xref, &sum);
+    tr->scene_free(sc);
+    *ntir = (int)sum.tir;
+    return rc == 0 && x.np == 1 ? x.p[0].retardance : NAN;
+}
+
+/* The proper retardance (parallel transport taken out, tr_polar.c's Q): the same for
+ * every Stokes reference and every turn of the whole path about the ray; a single TIR
+ * is the closed form whatever its plane; two TIRs in one plane add, in crossed planes
+ * subtract (the second one's s is the first one's p: delta1 - delta2, 0 for equal
+ * angles), as the 2x2 Jones calculus in the local s, p frames gives. */
+static void proper(void)
+{
+    const double D = PI / 180, refs[4][3] = {{1, 0, 0}, {0, 1, 0}, {0.3, -0.8, 0.5}, {1, 1, 1}};
+    double worst1 = 0, worst2 = 0, worst3 = 0;
+    int bad = 0, nt;
+    for (int r = 0; r < 4; r++)
+        for (int k = 0; k < 5; k++) {
+            double phi = (17 + 41 * k) * D, th = (44 + 5 * k) * D;
+            /* th2 = 0 would not reflect: a single TIR is the pair with a normal exit */
+            double d1 = tir_delta(1.5, th), d2 = tir_delta(1.5, 52 * D);
+            double one = two_tirs(th, 52 * D, 0, phi, refs[r], &nt);
+            if (nt != 2) bad++;
+            double e = fabs(one - fmod(d1 + d2, 2 * PI));
+            if (!(e <= worst1)) worst1 = e;
+            double cr = two_tirs(th, 52 * D, 90 * D, phi, refs[r], &nt);
+            if (nt != 2) bad++;
+            e = fabs(cr - fabs(d1 - d2));
+            if (!(e <= worst2)) worst2 = e;
+            double eq = two_tirs(th, th, 90 * D, phi, refs[r], &nt);
+            if (nt != 2) bad++;
+            if (!(fabs(eq) <= worst3)) worst3 = fabs(eq);
+        }
+    CHECK(bad == 0 && worst1 < 1e-12, "proper retardance: two TIRs in one plane = delta1 + "
+          "delta2 for 4 Stokes references x 5 azimuths and angles: worst %.2e rad", worst1);
+    CHECK(bad == 0 && worst2 < 1e-12, "... in crossed planes = |delta1 - delta2|: worst %.2e "
+          "rad", worst2);
+    CHECK(bad == 0 && worst3 < 1e-12, "... crossed at equal angles cancel: worst %.2e rad",
+          worst3);
+    printf("BENCH wave_proper_retardance_abs_err %.3g rad\n", worst1 > worst2 ? worst1 : worst2);
 }
 
 /* Elements in air along +z: each a plane refract 1 1 with its element. */
@@ -406,6 +497,7 @@ int main(void)
     tr = tt_api();
     fresnel();
     rhomb();
+    proper();
     elements();
     coating();
     same_powers();

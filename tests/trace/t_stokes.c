@@ -160,8 +160,16 @@ int main(void)
     s.pol_dir[1] = INFINITY;
     CHECK(tr->add_source(sc, &s, NULL) < 0, "an infinite frame reference is refused");
     s.pol_dir[1] = 0;
-    s.pol = 3;
+    s.pol = TRACE_PARTIAL + 1;
     CHECK(tr->add_source(sc, &s, NULL) < 0, "an unknown polarization kind is refused");
+    s.pol = TRACE_PARTIAL;
+    s.stokes[0] = 0.6; s.stokes[1] = 0.8; s.stokes[2] = 1e-3;
+    CHECK(tr->add_source(sc, &s, NULL) < 0, "a Stokes vector longer than 1 is refused (%s)",
+          tr->error(sc));
+    s.stokes[2] = NAN;
+    CHECK(tr->add_source(sc, &s, NULL) < 0, "a NaN Stokes vector is refused");
+    s.stokes[2] = 0;
+    CHECK(tr->add_source(sc, &s, NULL) >= 0, "Stokes (0.6, 0.8, 0): fully polarized, taken");
     s.pol = TRACE_ELLIPTIC;
     CHECK(tr->add_source(sc, &s, NULL) >= 0, "Jones (1, 0) is taken");
     tr->scene_free(sc);
