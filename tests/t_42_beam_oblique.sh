@@ -77,6 +77,37 @@ obl_scan() {   # the scan line: the incidence grows past the apex's; large >= sm
                       bmin <= big) }' "$D/a/r.rec"
 }
 check "rig beam oblique: the scan's incidence, largest and smallest spot reported" obl_scan
+# the Fresnel line: R at normal incidence ((n-1)/(n+1))^2 and at the apex pose's 20 deg
+# from Hecht's formulas in awk (unpolarized: the mean), n 1.376; the lowest no higher;
+# the scan's balanced lens no worse than the apex model's on the same scan
+obl_fresnel() {
+    awk 'function hr(th,   n, ci, si, ct, rs, rp) { n = 1.376; ci = cos(th); si = sin(th)
+             ct = sqrt(1 - si * si / (n * n)); rs = (ci - n * ct) / (ci + n * ct)
+             rp = (n * ci - ct) / (n * ci + ct); return (rs * rs + rp * rp) / 2 }
+         function rel(a, b) { return (a - b < 0 ? b - a : a - b) / b }
+         /^Cornea.s reflectance/ { for (i = 1; i <= NF; i++) {
+                 if ($i == "unpolarized):") { r0 = $(i + 1); ra = $(i + 5) }
+                 if ($i == "lowest") rl = $(i + 1) } }
+         /^Balanced over the scan/ { for (i = 1; i <= NF; i++) {
+                 if ($i == "cornea" && $(i - 1) == "worst") { c = $(i + 1) + 0; d = $(i + 5) + 0 }
+             }
+             ac = $(NF - 3) + 0; ad = $(NF - 1) + 0 }
+         END { w0 = hr(0); wa = hr(20 * atan2(0, -1) / 180)
+               printf "R0 %s (%.6g), apex %s (%.6g), lowest %s; scan lens worst %s/%s, apex lens %s/%s\n", r0, w0, ra, wa, rl, c, d, ac, ad
+               exit !(rel(r0, w0) < 1e-3 && rel(ra, wa) < 1e-3 && rl <= ra && c > 0 && d > 0 &&
+                      (c > d ? c : d) <= (ac > ad ? ac : ad)) }' "$D/a/r.rec"
+}
+check "rig beam oblique: the cornea's Fresnel reflectance (normal, apex pose: Hecht in awk), the lens balanced over the scan no worse than the apex model's" obl_fresnel
+obl_pol() {   # a linearly polarized laser: the line says so, the s share is not 0.5; replays
+    mkdir -p "$D/p" && cp "$TOP/golden/rig/example.rig" "$D/p/pol.rig" &&
+    echo "laser_polarization 0 0 1" >> "$D/p/pol.rig" &&
+    obl_session "$D/p" "$D/p/pol.rig" || return 1
+    grep -q "^Cornea's reflectance (Fresnel, n 1.376, the laser's field along 0 0 1):" "$D/p/r.rec" &&
+        ! grep "^Cornea's reflectance" "$D/p/r.rec" | grep -q ', 0.5 of the power in s' &&
+        grep input: "$D/p/r.rec" > "$D/p/in2" &&
+        (cd "$D/p" && "$BIN" --rig r2.rec < in2 > /dev/null 2>&1) && cmp "$D/p/r.rec" "$D/p/r2.rec"
+}
+check "rig beam oblique: laser_polarization 0 0 1 reported, its s share, the record replays" obl_pol
 obl_replay() {
     grep input: "$D/a/r.rec" > "$D/a/in2"
     (cd "$D/a" && "$BIN" --rig r2.rec < in2 > /dev/null 2>&1) && cmp "$D/a/r.rec" "$D/a/r2.rec"

@@ -500,9 +500,32 @@ static void beam_oblique(rdlg *d, const rg_spots *s)
            st->target.kind == RG_T_HEIGHT ? st->target.b / DEG : 0);
     spot_line(d, P(BEAM_SPOT_LARGE), &s->big);
     spot_line(d, P(BEAM_SPOT_SMALL), &s->small);
+    const rg_spot_pose *dm = &s->dim;
+    char how[96];
+    if (s->laser_pol_set)
+        snprintf(how, sizeof how, P(BEAM_FRESNEL_LIN), d->rig.laser_pol[0],
+                 d->rig.laser_pol[1], d->rig.laser_pol[2]);
+    else snprintf(how, sizeof how, "%s", P(BEAM_FRESNEL_UNPOL));
+    double dh = dm->target.kind == RG_T_HEIGHT ? dm->target.a : 0;
+    double dph = dm->target.kind == RG_T_HEIGHT ? dm->target.b / DEG : 0;
+    if (s->have_dose && s->ref_not_apex)
+        lm_say(d->io, LM_BOTH, P(BEAM_FRESNEL_NOAPEX), how, s->reflectance, dm->reflectance,
+               dh, dph, dm->theta / DEG, dm->refl_s, dm->refl_p, dm->s_frac);
+    else if (s->have_dose)
+        lm_say(d->io, LM_BOTH, P(BEAM_FRESNEL), how, s->reflectance, s->apex.reflectance,
+               dm->reflectance, dh, dph, dm->theta / DEG, dm->refl_s, dm->refl_p, dm->s_frac);
     if (s->have_dose && s->photons > 0)
         lm_say(d->io, LM_BOTH, P(BEAM_CENTROID_SCAN), s->big.sigma_major_um,
-               s->big.sigma_minor_um, s->small.sigma_major_um, s->small.sigma_minor_um);
+               s->big.sigma_minor_um, s->small.sigma_major_um, s->small.sigma_minor_um,
+               dm->sigma_major_um, dm->sigma_minor_um);
+    if (s->scan_best_is_none)
+        lm_say(d->io, LM_BOTH, P(BEAM_SCAN_LENS_NONE), s->scan_n, s->scan_at,
+               s->scan_best_cornea, s->scan_best_det, s->apexlens_worst_cornea,
+               s->apexlens_worst_det);
+    else
+        lm_say(d->io, LM_BOTH, P(BEAM_SCAN_LENS), s->scan_n, s->scan_at, s->scan_best_f,
+               s->scan_best_cornea, s->scan_best_det, s->apexlens_worst_cornea,
+               s->apexlens_worst_det);
 }
 
 /* The beam on the cornea and the detector (rig_api.spots): the engine computes,

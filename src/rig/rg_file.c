@@ -92,7 +92,7 @@ enum { G_CHIP, G_LASER, G_INTERLOCK, G_HEART, G_MAXON, G_TICK, G_HTIMEOUT, G_HOM
        G_SETTLE, G_SIMRT, G_SIMIL, G_SIMILMS, G_CAM, G_CPITCH, G_CPIX, G_CNOISE, G_CSEED,
        G_WAIST, G_EYESAFE, G_POWER, G_WAVE, G_BEAMD, G_KEY, G_INDIC, G_SHUT, G_EDELAY,
        G_SHUTMS, G_PULSE, G_LATE, G_DEBOUNCE, G_SIMILC, G_SIMKEY, G_STALLAT, G_STALL, G_MOVING,
-       G_WAISTAT, G_BEAMM2, G_LENS, NG };
+       G_WAISTAT, G_BEAMM2, G_LENS, G_LASERPOL, NG };
 static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "max_on_ms", "tick_us", "heartbeat_timeout_ms", "home_timeout_s", "settle_ms",
     "sim_realtime", "sim_interlock", "sim_interlock_open_ms", "camera", "camera_pitch",
@@ -101,7 +101,7 @@ static const char *const gkeys[NG] = {"chip", "laser", "interlock", "heartbeat",
     "key_switch", "emission_indicator", "shutter", "emission_delay_ms", "shutter_ms",
     "step_pulse_us", "max_late_us", "home_debounce_ms", "sim_interlock_close_ms",
     "sim_key_off_ms", "sim_stall_at_ms", "sim_stall_ms", "expose_moving",
-    "beam_waist_at_mm", "beam_m2", "focus_lens_mm"};
+    "beam_waist_at_mm", "beam_m2", "focus_lens_mm", "laser_polarization"};
 enum { A_STEP, A_DIR, A_ENABLE, A_HOME, A_STEPS, A_MIN, A_MAX, A_SPEED, A_ACCEL,
        A_HOMEAT, A_HOMEDIR, A_HOMESPEED, A_DIRINV, A_SIMHOME, A_LIMIT, A_PULLOFF,
        A_LOCATE, A_SIMLIMIT, A_SIMLOSE, NA };
@@ -127,8 +127,8 @@ static int global_key(reader *r, int k, char **w, int nw)
 {
     rg_rig *g = r->rig;
     const char *a = nw > 1 ? w[1] : NULL;
-    if (nw > (k == G_LASER || k == G_INTERLOCK || k == G_HEART || k == G_KEY ||
-              k == G_INDIC || k == G_SHUT || k == G_LENS ? 3 : 2))
+    if (nw > (k == G_LASERPOL ? 4 : k == G_LASER || k == G_INTERLOCK || k == G_HEART ||
+              k == G_KEY || k == G_INDIC || k == G_SHUT || k == G_LENS ? 3 : 2))
         return fail(r, "'%s' takes one value", w[0]);
     switch (k) {
     case G_CHIP:
@@ -227,6 +227,23 @@ static int global_key(reader *r, int k, char **w, int nw)
         g->lens_line = (int)r->line;
         return rc;
     }
+    case G_LASERPOL:    /* X Y Z (the field leaving the laser) or unpolarized */
+        g->laser_pol_line = (int)r->line;
+        if (nw == 2 && (!strcmp(a, "unpolarized") || !strcmp(a, "unpolarised"))) {
+            g->laser_pol_set = 0;
+            return 0;
+        }
+        if (nw != 4)
+            return fail(r, "'laser_polarization' needs X Y Z (the field's direction as the "
+                        "beam leaves the laser) or 'unpolarized'");
+        for (int i = 0; i < 3; i++) {
+            int rc = number(r, w[0], w[1 + i], &g->laser_pol[i]);
+            if (rc) return rc;
+        }
+        if (!(fabs(g->laser_pol[0]) + fabs(g->laser_pol[1]) + fabs(g->laser_pol[2]) > 0))
+            return fail(r, "'laser_polarization' 0 0 0: a field needs a direction");
+        g->laser_pol_set = 1;
+        return 0;
     }
     return 0;
 }

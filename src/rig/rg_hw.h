@@ -126,6 +126,7 @@ double rg_mpe(double wavelength_nm, double t, const char **limit);
 int  rg_dose_rig(const rg_rig *rig, double ms, long n, rg_dose *d, char *err, size_t cap);
 int  rg_dose_plan(const rg_machine *m, double ms, long n, rg_dose *d, char *err, size_t cap);
 /* rg_spots.c */
+#define RG_N_CORNEA 1.376       /* Gullstrand's cornea: its Fresnel reflectance */
 int  rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap);
 struct px_beam;
 /* The laser's beam to the cornea along path with a lens f at `at` before it (0: none). */

@@ -12,7 +12,6 @@
 #include "rig/rg_hw.h"
 #include "paraxial/paraxial.h"
 
-#define N_CORNEA 1.376          /* Gullstrand's cornea: the Fresnel reflectance */
 #define H_PLANCK 6.62607015e-34
 #define C_LIGHT 299792458.0
 
@@ -99,6 +98,19 @@ int rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
         return RG_EINVAL;
     }
     if (!geo || !geo->solve) return RG_EINVAL;
+    if (rig->laser_pol_set) {
+        const double *e = rig->laser_pol, *d = rig->geom.laser_dir;
+        double c[3] = {e[1] * d[2] - e[2] * d[1], e[2] * d[0] - e[0] * d[2],
+                       e[0] * d[1] - e[1] * d[0]};
+        if (!(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) >
+              1e-9 * sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) *
+                     sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))) {
+            snprintf(err, cap, "%s:%d: 'laser_polarization': the field %g %g %g lies along "
+                     "the beam (laser_dir): a field is across it", rig->path,
+                     rig->laser_pol_line, e[0], e[1], e[2]);
+            return RG_EINVAL;
+        }
+    }
     if (geo->solve(&rig->geom, &t, NULL, &sol, err, cap)) {
         /* a rig blind at the apex (the wide-zone rig: m2 in the way): the scan's first
          * target that solves (the spiral's heights grow) stands in for it */
@@ -181,7 +193,7 @@ int rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
     }
     /* the centroid: N photons, per-axis sigma of the spot's intensity w/2 */
     if (rig->laser_power_mw > 0 && rig->beam_diameter_mm > 0) {
-        double n = N_CORNEA;
+        double n = RG_N_CORNEA;
         s->have_dose = 1;
         s->reflectance = ((n - 1) / (n + 1)) * ((n - 1) / (n + 1));
         s->expose_ms = longest_exposure(rig);

@@ -17,8 +17,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define RIG_ABI 2               /* 2: rg_spot_pose, rg_spots' scan fields, cornea_curvature,
-                                   spot_chain, spot_pose (the cornea's oblique incidence) */
+#define RIG_ABI 3               /* 2: rg_spot_pose, rg_spots' scan fields, cornea_curvature,
+                                   spot_chain, spot_pose (the cornea's oblique incidence);
+                                   3: the laser's polarization, each pose's Fresnel
+                                   reflectance and photons, the lens balanced over the scan */
 #define RIG_API_SYMBOL "rig_get_api"
 
 enum { RG_OK = 0, RG_EINVAL = -1, RG_ENOMEM = -2, RG_EIO = -3, RG_ESTOP = -4,
@@ -312,6 +314,12 @@ typedef struct rg_rig {
                                    (mm, +-) AT mm before the cornea apex on the
                                    m2-cornea leg; lens_at 0: none */
     int lens_line;              /* its rig-file line (0: none) */
+    /* laser_polarization X Y Z | unpolarized: the field's direction as the beam leaves
+     * the laser (projected perpendicular to laser_dir; the mirrors ideal, rs = -rp),
+     * for the cornea's Fresnel reflectance pose by pose (rg_spotscan.c) */
+    int laser_pol_set;          /* 1: linear along laser_pol; 0: unpolarized (default) */
+    double laser_pol[3];
+    int laser_pol_line;         /* its rig-file line (0: none) */
 } rg_rig;
 
 /* Latched faults (LinuxCNC's estop_latch model): the first one is kept; laser off
@@ -448,7 +456,15 @@ typedef struct rg_spot_pose {
                                    (-pi/2, pi/2]; x': rig +x across the plane's normal,
                                    y' = normal x x') */
     double sigma_major_um, sigma_minor_um;  /* the centroid's shot-noise limit along
-                                   them: (axis/2)/sqrt(photons) (0: no dose) */
+                                   them: (axis/2)/sqrt(photons) (0: no dose); ABI 3:
+                                   with this pose's photons (below) */
+    /* ---- ABI 3: the cornea's Fresnel reflectance at this incidence (n 1.376) */
+    double refl_s, refl_p;      /* |rs|^2, |rp|^2 */
+    double s_frac;              /* the power's share in s (the laser's field carried by
+                                   the ideal mirrors; 0.5 unpolarized) */
+    double reflectance;         /* s_frac refl_s + (1 - s_frac) refl_p */
+    double photons;             /* rg_spots.photons scaled by reflectance / its normal-
+                                   incidence reflectance (0: no dose) */
 } rg_spot_pose;
 #define RG_SPOTS_POSES 200      /* the scan: targets besides the apex */
 typedef struct rg_spots {
@@ -485,6 +501,17 @@ typedef struct rg_spots {
                                    ref, the scan's first target that solves; apex stays
                                    zero and the scan does not count it */
     rg_target ref;              /* the pose those fields are for (apex: RG_T_ANGLES 0 0) */
+    /* ---- ABI 3: the lens balanced over the whole scan (a lens at scan_at before the
+     * point each pose's beam meets the cornea): the focal length whose worst pose --
+     * the larger of the beam radius on the cornea and the detector spot's major
+     * semi-axis, over every pose that solves -- is smallest; its worst figures and the
+     * apex-model lens's (best_f) on the same scan */
+    int laser_pol_set;          /* rg_rig's: 1 linear, 0 unpolarized */
+    int scan_best_is_none;      /* 1: no lens does better over the scan than none */
+    double scan_best_f, scan_best_cornea, scan_best_det;
+    double apexlens_worst_cornea, apexlens_worst_det;
+    double low_refl;            /* the scan's lowest reflectance ... */
+    rg_spot_pose dim;           /* ... at this pose */
 } rg_spots;
 /* ==== end of the machine ========================================================= */
 

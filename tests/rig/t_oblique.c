@@ -17,7 +17,12 @@
  *     formula (S. A. Self, Appl. Opt. 22, 658 (1983)) and w(z) = w0 sqrt(1 + (z/zR)^2);
  *     the footprint's area w_t w_s / cos(detector incidence);
  *  4. the scan's extremes against the tests' own loop over the documented targets,
- *     the centroid's sigma = (axis/2)/sqrt(N).
+ *     the centroid's sigma = (axis/2)/sqrt(N), N scaled by the pose's reflectance;
+ *  5. the cornea's Fresnel reflectance per pose against Hecht's formulas written
+ *     here; two laser fields at right angles sharing s and p (shares add to 1, the
+ *     reflectances average to the unpolarized one); laser_polarization's refusals;
+ *  6. the lens balanced over the scan recomputed pose by pose through spot_pose, no
+ *     better 0.5 % either side, nor with the apex model's lens or none.
  * argv[1]: golden/rig/example.rig, argv[2]: golden/rig/wide-zone.rig. */
 #define _DEFAULT_SOURCE
 #include "unit.h"
@@ -177,6 +182,173 @@ static void pose_checks(const char *name, const rg_rig *r, const rg_spots *s, in
               "%.1e", worst_cod);
 }
 
+/* Hecht's rs, rp from air onto n = 1.376 (Gullstrand's cornea), written again here */
+static void hecht_rsp(double th, double *Rs, double *Rp)
+{
+    const double n = 1.376;
+    double st = sin(th) / n, ct = sqrt(1 - st * st), ci = cos(th);
+    double rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
+    *Rs = rs * rs;
+    *Rp = rp * rp;
+}
+static double hecht_unpol(double th)
+{
+    double a, b;
+    hecht_rsp(th, &a, &b);
+    return 0.5 * (a + b);
+}
+
+/* 5. the cornea's Fresnel reflectance pose by pose: unpolarized = Hecht's mean at the
+ * pose's incidence; two laser fields at right angles share s and p between them (the
+ * ideal mirrors keep them at right angles), so their s shares add to 1 and their
+ * reflectances average to the unpolarized one at every pose; Brewster's angle from
+ * the p reflectance's zero */
+static void fresnel_checks(const char *name)
+{
+    rg_rig r, rx, ry;
+    rg_spots s, sx, sy;
+    rg_spot_pose p, px, py;
+    char err[RG_ERRMAX];
+    int ok = load(base, "", &r, err, sizeof err) == 0 && rg->spots(&r, &s, err, sizeof err) == 0 &&
+             s.photons > 0;
+    /* the example's laser_dir: fields across it, x and the third axis */
+    const double *ld = r.geom.laser_dir;
+    double e1[3], e2[3], a[3] = {1, 0, 0}, l = sqrt(ld[0] * ld[0] + ld[1] * ld[1] + ld[2] * ld[2]);
+    if (fabs(ld[0]) > 0.9 * l) { a[0] = 0; a[1] = 1; }
+    e1[0] = a[1] * ld[2] - a[2] * ld[1]; e1[1] = a[2] * ld[0] - a[0] * ld[2];
+    e1[2] = a[0] * ld[1] - a[1] * ld[0];
+    e2[0] = ld[1] * e1[2] - ld[2] * e1[1]; e2[1] = ld[2] * e1[0] - ld[0] * e1[2];
+    e2[2] = ld[0] * e1[1] - ld[1] * e1[0];
+    char kx[256], ky[256];
+    snprintf(kx, sizeof kx, "laser_polarization %.17g %.17g %.17g\n", e1[0], e1[1], e1[2]);
+    snprintf(ky, sizeof ky, "laser_polarization %.17g %.17g %.17g\n", e2[0], e2[1], e2[2]);
+    ok = ok && load(base, kx, &rx, err, sizeof err) == 0 && rg->spots(&rx, &sx, err, sizeof err) == 0 &&
+         load(base, ky, &ry, err, sizeof err) == 0 && rg->spots(&ry, &sy, err, sizeof err) == 0;
+    CHECK(ok && rx.laser_pol_set && !r.laser_pol_set, "%s: three lasers (unpolarized, two "
+          "fields at right angles): %s", name, ok ? "" : err);
+    if (!ok) return;
+    double wu = 0, wsum = 0, wavg = 0, smin = 1, smax = 0;
+    int n = 0;
+    for (int k = 0; k < RG_SPOTS_POSES; k++) {
+        rg_target t = {RG_T_HEIGHT, s.scan_h * sqrt((k + 0.5) / RG_SPOTS_POSES),
+                       fmod(k * 137.50776405, 360) * RT_DEG};
+        if (rg->spot_pose(&r, &s, &t, &p, err, sizeof err) ||
+            rg->spot_pose(&rx, &sx, &t, &px, err, sizeof err) ||
+            rg->spot_pose(&ry, &sy, &t, &py, err, sizeof err))
+            continue;
+        n++;
+        double Rs, Rp;
+        hecht_rsp(p.theta, &Rs, &Rp);
+        wu = fmax(wu, rel(p.reflectance, 0.5 * (Rs + Rp)));
+        wsum = fmax(wsum, fabs(px.s_frac + py.s_frac - 1));
+        wavg = fmax(wavg, rel(0.5 * (px.reflectance + py.reflectance), p.reflectance));
+        smin = fmin(smin, px.s_frac);
+        smax = fmax(smax, px.s_frac);
+        wu = fmax(wu, rel(px.photons, s.photons * px.reflectance / s.reflectance));
+    }
+    CHECK(n > 50 && wu < 1e-12, "%s: %d poses: unpolarized R = (Rs + Rp)/2 of Hecht's at each "
+          "incidence, photons scaled by R/R0 (worst %.1e)", name, n, wu);
+    CHECK(n > 50 && wsum < 1e-12 && wavg < 1e-12 && smax - smin > 0.01,
+          "%s: fields at right angles: s shares add to 1 (%.1e), R average to the "
+          "unpolarized (%.1e); the share varies over the scan (%.3f..%.3f)", name, wsum, wavg,
+          smin, smax);
+    /* the s share by the test's own forward model (tests/rig/rt.h) and the mirrors'
+     * Fresnel form in their own s, p frames (rs = -1, rp = +1, Hecht), not a
+     * Householder reflection as the engine writes it */
+    double wshare = 0;
+    int m = 0;
+    for (int k = 0; k < RG_SPOTS_POSES; k += 7) {
+        rg_target t = {RG_T_HEIGHT, s.scan_h * sqrt((k + 0.5) / RG_SPOTS_POSES),
+                       fmod(k * 137.50776405, 360) * RT_DEG};
+        rt_path tp;
+        if (rg->spot_pose(&rx, &sx, &t, &px, err, sizeof err) || rt_forward(&rx.geom, &px.pose, &tp))
+            continue;
+        double E[3], k0[3], *ks[3] = {k0, tp.d1, tp.d2}, *ns[3] = {tp.n1, tp.n2, tp.nc};
+        memcpy(k0, ld, sizeof k0);
+        rt_unit(k0);
+        memcpy(E, e1, sizeof E);
+        rt_unit(E);
+        for (int q = 0; q < 3; q++) {
+            const double *ki = ks[q], *nn = ns[q];
+            double sv[3] = {ki[1] * nn[2] - ki[2] * nn[1], ki[2] * nn[0] - ki[0] * nn[2],
+                            ki[0] * nn[1] - ki[1] * nn[0]};
+            rt_unit(sv);
+            if (q == 2) {           /* at the cornea: the share in s */
+                double c = rt_dot(E, sv);
+                wshare = fmax(wshare, fabs(c * c - px.s_frac));
+                m++;
+                break;
+            }
+            double ko[3], pin[3], pout[3], es = rt_dot(E, sv);
+            rt_reflect(ki, nn, ko);
+            pin[0] = ki[1] * sv[2] - ki[2] * sv[1]; pin[1] = ki[2] * sv[0] - ki[0] * sv[2];
+            pin[2] = ki[0] * sv[1] - ki[1] * sv[0];
+            pout[0] = ko[1] * sv[2] - ko[2] * sv[1]; pout[1] = ko[2] * sv[0] - ko[0] * sv[2];
+            pout[2] = ko[0] * sv[1] - ko[1] * sv[0];
+            double ep = rt_dot(E, pin);
+            for (int i = 0; i < 3; i++) E[i] = -es * sv[i] + ep * pout[i];
+        }
+    }
+    CHECK(m > 10 && wshare < 1e-9, "%s: the s share at %d poses = the test's own forward "
+          "model with Fresnel's mirror form in s, p frames (worst %.1e)", name, m, wshare);
+    /* refusals */
+    CHECK(load(base, "laser_polarization 1 0\n", &rx, err, sizeof err) != 0 &&
+          strstr(err, "x.rig:") && strstr(err, "laser_polarization"), "laser_polarization with "
+          "two numbers refused: %s", err);
+    CHECK(load(base, "laser_polarization 0 0 0\n", &rx, err, sizeof err) != 0,
+          "laser_polarization 0 0 0 refused: %s", err);
+    char along[256];
+    snprintf(along, sizeof along, "laser_polarization %.17g %.17g %.17g\n", ld[0], ld[1], ld[2]);
+    CHECK(load(base, along, &rx, err, sizeof err) == 0 && rg->spots(&rx, &sx, err, sizeof err) != 0 &&
+          strstr(err, "lies along the beam"), "a field along laser_dir refused at its line: %s", err);
+    CHECK(load(base, "laser_polarization unpolarized\n", &rx, err, sizeof err) == 0 &&
+          !rx.laser_pol_set, "laser_polarization unpolarized taken");
+}
+
+/* 6. the lens balanced over the scan, recomputed through the public API: every pose of
+ * the scan with that lens (spot_pose with s's lens set to it), its worst, no better
+ * with f 0.5 % either side, no worse than the apex model's lens or none there */
+static double worst_with(const rg_rig *r, const rg_spots *s0, double f, double at, double *c,
+                         double *d)
+{
+    rg_spots s = *s0;
+    rg_spot_pose p;
+    char err[RG_ERRMAX];
+    double w = 0;
+    s.lens_f = f;
+    s.lens_at = f != 0 ? at : 0;
+    *c = *d = 0;
+    rg_target t0 = {RG_T_ANGLES, 0, 0};
+    for (int k = -1; k < RG_SPOTS_POSES; k++) {
+        rg_target t = k < 0 ? t0 : (rg_target){RG_T_HEIGHT, s.scan_h * sqrt((k + 0.5) / RG_SPOTS_POSES),
+                                               fmod(k * 137.50776405, 360) * RT_DEG};
+        if (k < 0 && s.ref_not_apex) continue;
+        if (rg->spot_pose(r, &s, &t, &p, err, sizeof err)) continue;
+        *c = fmax(*c, p.w_cornea);
+        *d = fmax(*d, p.foot_major);
+        w = fmax(w, fmax(p.w_cornea, p.foot_major));
+    }
+    return w;
+}
+
+static void lens_checks(const char *name, const rg_rig *r, const rg_spots *s)
+{
+    double c, d, c1, d1, c2, d2, ca, da, cn, dn;
+    double w = worst_with(r, s, s->scan_best_is_none ? 0 : s->scan_best_f, s->scan_at, &c, &d);
+    double wp = worst_with(r, s, s->scan_best_f * 1.005, s->scan_at, &c1, &d1);
+    double wm = worst_with(r, s, s->scan_best_f * 0.995, s->scan_at, &c2, &d2);
+    double wa = worst_with(r, s, s->best_is_none ? 0 : s->best_f, s->scan_at, &ca, &da);
+    double wn = worst_with(r, s, 0, s->scan_at, &cn, &dn);
+    CHECK(rel(c, s->scan_best_cornea) < 1e-12 && rel(d, s->scan_best_det) < 1e-12 &&
+          rel(ca, s->apexlens_worst_cornea) < 1e-12 && rel(da, s->apexlens_worst_det) < 1e-12,
+          "%s: the scan-balanced lens f %.6g mm: worst cornea %.4g, detector %.4g mm as "
+          "recomputed pose by pose; the apex model's lens %.4g, %.4g mm", name, s->scan_best_f,
+          c, d, ca, da);
+    CHECK(w <= wp && w <= wm && w <= wa && w <= wn, "%s: no better 0.5 %% either side (%.6g, "
+          "%.6g against %.6g), nor with the apex model's lens (%.6g) or none (%.6g)", name, wm,
+          wp, w, wa, wn);
+}
+
 static void scan_checks(const char *name, const rg_rig *r, const rg_spots *s)
 {
     char err[RG_ERRMAX];
@@ -200,9 +372,12 @@ static void scan_checks(const char *name, const rg_rig *r, const rg_spots *s)
           name, got, bad, s->big.foot_major, s->big.foot_minor, s->big.target.a,
           s->big.theta / RT_DEG, s->small.foot_major, s->small.foot_minor, s->steep.theta / RT_DEG);
     if (s->photons > 0)
-        CHECK(rel(s->big.sigma_major_um, 1e3 * s->big.foot_major / 2 / sqrt(s->photons)) < 1e-12 &&
-              rel(s->small.sigma_minor_um, 1e3 * s->small.foot_minor / 2 / sqrt(s->photons)) < 1e-12,
-              "%s: centroid sigma (axis/2)/sqrt(N): %.3g x %.3g um at the largest spot, "
+        CHECK(rel(s->big.sigma_major_um, 1e3 * s->big.foot_major / 2 /
+                  sqrt(s->photons * hecht_unpol(s->big.theta) / hecht_unpol(0))) < 1e-12 &&
+              rel(s->small.sigma_minor_um, 1e3 * s->small.foot_minor / 2 /
+                  sqrt(s->photons * hecht_unpol(s->small.theta) / hecht_unpol(0))) < 1e-12,
+              "%s: centroid sigma (axis/2)/sqrt(N), N the photons scaled by the pose's unpolarized "
+              "Fresnel reflectance: %.3g x %.3g um at the largest spot, "
               "%.3g x %.3g um at the smallest", name, s->big.sigma_major_um,
               s->big.sigma_minor_um, s->small.sigma_major_um, s->small.sigma_minor_um);
 }
@@ -294,9 +469,15 @@ int main(int argc, char **argv)
           "wide-zone rig: %s", err);
     pose_checks("wide zone", &r, &s, 0);
     scan_checks("wide zone", &r, &s);
+    lens_checks("wide zone", &r, &s);
     CHECK(load(base, "", &r, err, sizeof err) == 0 && rg->spots(&r, &s, err, sizeof err) == 0,
           "example: %s", err);
     scan_checks("example", &r, &s);
+    lens_checks("example", &r, &s);
+    CHECK(load(base, "focus_lens_mm 40 20\n", &r, err, sizeof err) == 0 &&
+          rg->spots(&r, &s, err, sizeof err) == 0, "example + lens: %s", err);
+    lens_checks("example, lens 40 mm at 20", &r, &s);
+    fresnel_checks("example");
 
     /* the curvature's own face: a point off the surface is refused */
     {
