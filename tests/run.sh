@@ -31,13 +31,13 @@ check() { n=$1; shift; if "$@" >"$WORK/check.out" 2>&1; then pass "$n"
           elif lsan_tool_failed "$WORK/check.out" && echo "# $n: LeakSanitizer's tracer crashed (the tool, no finding): again" &&
                "$@" >"$WORK/check.out" 2>&1; then pass "$n"
           else fail "$n"; sed 's/^/    /' "$WORK/check.out" | head -20; fi; }
-# unit BINARY: counts the PASS/FAIL lines a C unit test prints
+# unit BINARY [ARGS...]: runs it with ARGS, counts the PASS/FAIL lines a C unit test prints
 unit() {
     if [ ! -x "$1" ]; then fail "$1 (not built)"; return; fi
-    "$1" > "$WORK/unit.out" 2>&1; rc=$?
+    "$@" > "$WORK/unit.out" 2>&1; rc=$?
     if [ "$rc" -ne 0 ] && lsan_tool_failed "$WORK/unit.out"; then
         echo "# $1: LeakSanitizer's tracer crashed (the tool, no finding): again"
-        "$1" > "$WORK/unit.out" 2>&1; rc=$?
+        "$@" > "$WORK/unit.out" 2>&1; rc=$?
     fi
     p=$(grep -c '^PASS' "$WORK/unit.out"); f=$(grep -c '^FAIL' "$WORK/unit.out")
     PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
