@@ -5,6 +5,7 @@
 
 # (with the paraxial engine's glass catalogue, which the scene reader names glasses by)
 SCENE_READERS := src/trace/scene_lex.c src/trace/scene_mesh.c src/trace/scene_read.c \
+                 src/trace/scene_fields.c \
                  src/trace/scene_axial.c src/trace/scene_polar.c
 build/fuzz_trace_scene: tests/fuzz_trace_scene.c $(SCENE_READERS) \
                         src/trace/scene_geom.c src/trace/scene.h $(wildcard src/paraxial/*.c) \

@@ -1,6 +1,7 @@
 /* scene_int.h -- what the trace front end's readers share (scene_lex.c, scene_mesh.c,
- * scene_read.c, scene_axial.c): the line and token reader with its FILE:LINE errors,
- * growable arrays of doubles, and the axial-surface checks of a parsed scene.  Not part
+ * scene_read.c, scene_fields.c, scene_axial.c): the line and token reader with its
+ * FILE:LINE errors, a directive's fields, growable arrays of doubles, and the
+ * axial-surface checks of a parsed scene.  Not part
  * of the module's face (that is scene.h). */
 #ifndef SCENE_INT_H
 #define SCENE_INT_H
@@ -49,6 +50,38 @@ static inline void cross3(const double *a, const double *b, double *c)
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
+
+/* The fields of one directive line (scene_fields.c): per key of the scene files'
+ * table, whether the line gave it, its numbers (count of them), its word (a file or a
+ * coating name), for a key read by its own reader the first token, and for an index
+ * key the glass named ("": a number). */
+#define SC_NKEYS 42
+typedef struct fields {
+    int has[SC_NKEYS];
+    double num[SC_NKEYS][SC_MAXCOEF];
+    int count[SC_NKEYS];
+    tok word[SC_NKEYS];
+    int at[SC_NKEYS];
+    char glass[SC_NKEYS][2][SC_GLASSMAX];
+} fields;
+/* Key k's index in the table, or -1. */
+int sf_key_index(const tok *t);
+/* Read t[first..] as key/value groups allowed by `allowed` (space-separated key names)
+ * into f; 0 or -1 (FILE:LINE in r->err, dname naming the directive). */
+int sf_parse_fields(reader *r, int first, const char *dname, const char *allowed, fields *f);
+int sf_has(const fields *f, const char *k);
+const double *sf_val(const fields *f, const char *k);
+char *sf_tok_dup(const tok *t);
+/* Key k as a unit vector (a zero one refused). */
+int sf_unit_vec(reader *r, const fields *f, const char *dname, const char *k, double *u);
+/* Every key of the space-separated list given, else "'KEY' is missing". */
+int sf_need(reader *r, const fields *f, const char *dname, const char *list);
+int sf_positive(reader *r, const char *dname, const char *what, double v);
+/* Key k's value as an integer in [lo, hi]. */
+int sf_int_val(reader *r, const fields *f, const char *dname, const char *k, long lo,
+               long hi, long *out);
+/* `up` projected perpendicular to the unit direction d (none: some perpendicular). */
+int sf_up_vector(reader *r, const fields *f, const char *dname, const double *d, double *u);
 
 /* Axial surfaces along one axis: consecutive ones whose sags cross within their
  * apertures are an error (err, FILE:LINE of both); media that disagree are counted

@@ -1,9 +1,10 @@
 /* scene_read.c -- the trace front end's scene-file parser: one directive per line
  * (surfaces, sources, settings), each checked to its FILE:LINE.  Buffers in, plain
  * data out; nothing here prints, opens a file or needs Embree, so it is fuzzed alone
- * (tests/fuzz_trace_scene.c).  Its siblings: the token reader (scene_lex.c), the mesh
- * readers (scene_mesh.c), the axial-surface checks (scene_axial.c); reading a scene
- * from disk with its meshes is scene_load.c. */
+ * (tests/fuzz_trace_scene.c).  Its siblings: the token reader (scene_lex.c), a
+ * directive's keys and values (scene_fields.c), the mesh readers (scene_mesh.c), the
+ * axial-surface checks (scene_axial.c); reading a scene from disk with its meshes is
+ * scene_load.c. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -18,234 +19,7 @@
 
 #define MAXSURF 100000
 #define MAXSOURCE 10000
-
-/* ---- scene files -------------------------------------------------------------- */
-
-/* The keys a directive may carry, with their number of values.  ARGS_WORD: one
- * word (a file name); ARGS_VAR: numbers up to the next key; ARGS_WL: wavelengths up
- * to the next key (px_wavelength: nm above 100, else um, or F d C e g hene);
- * ARGS_TOKS: words and numbers up to the next key, read by the key's own reader.  The
- * values of `refract` and `medium` are indices: a number, or a glass (a catalogue
- * name, a model glass ND/VD, a medium of the seed), optionally after the word
- * `glass`. */
-enum { ARGS_WORD = -1, ARGS_VAR = -2, ARGS_WL = -3, ARGS_TOKS = -4 };
-typedef struct keydef { const char *name; int nargs; } keydef;
-static const keydef keys[] = {
-    {"refract", 2}, {"mirror", 0}, {"absorb", 0}, {"detect", 0}, {"media", ARGS_WORD},
-    {"at", 3}, {"normal", 3}, {"disc", 1}, {"hole", 1}, {"rect", 2}, {"up", 3},
-    {"center", 3}, {"radius", 1}, {"vertex", 3}, {"axis", 3}, {"conic", 1},
-    {"coef", ARGS_VAR}, {"aperture", 1}, {"tessellate", 1}, {"refine", 0},
-    {"file", ARGS_WORD}, {"sphere", 4},
-    {"from", 3}, {"dir", 3}, {"to", 6}, {"angle", 1}, {"rays", 1}, {"rings", 1},
-    {"toward", 3}, {"grid", 1}, {"waist", 1}, {"wavelength", 1}, {"trunc", 1},
-    {"power", 1}, {"medium", 1}, {"pol", ARGS_TOKS}, {"lambda", ARGS_WL},
-    {"polarizer", 3}, {"retarder", 4}, {"qwp", 3}, {"hwp", 3}, {"coating", ARGS_WORD},
-};
 #define POLKEYS " polarizer retarder qwp hwp coating"   /* refracting surfaces */
-#define NKEYS (int)(sizeof keys / sizeof keys[0])
-
-/* The values found on one directive line. */
-typedef struct fields {
-    int has[NKEYS];
-    double num[NKEYS][SC_MAXCOEF];
-    int count[NKEYS];
-    tok word[NKEYS];
-    int at[NKEYS];                       /* ARGS_TOKS: the first token (count: how many) */
-    char glass[NKEYS][2][SC_GLASSMAX];   /* index keys: a glass named ("": a number) */
-} fields;
-
-static int key_index(const tok *t)
-{
-    for (int i = 0; i < NKEYS; i++)
-        if (sl_tok_is(t, keys[i].name)) return i;
-    return -1;
-}
-
-static int has(const fields *f, const char *k)
-{
-    for (int i = 0; i < NKEYS; i++)
-        if (!strcmp(keys[i].name, k)) return f->has[i];
-    return 0;
-}
-static const double *val(const fields *f, const char *k)
-{
-    for (int i = 0; i < NKEYS; i++)
-        if (!strcmp(keys[i].name, k)) return f->num[i];
-    return NULL;
-}
-
-static int word_in(const char *list, const char *w)
-{
-    size_t n = strlen(w);
-    for (const char *p = list; (p = strstr(p, w)); p += n)
-        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) return 1;
-    return 0;
-}
-
-static int is_index_key(int k)
-{
-    return !strcmp(keys[k].name, "refract") || !strcmp(keys[k].name, "medium");
-}
-
-/* Does the token look like a number (only the characters of one)? */
-static int tok_numeric(const tok *t)
-{
-    for (size_t i = 0; i < t->n; i++)
-        if (!strchr("0123456789+-.eE", t->s[i])) return 0;
-    return t->n > 0;
-}
-
-/* A glass as an index value at r->t[*i] (after an optional word `glass`): its name
- * into name, its index at the d line (or mid-range, for a glass with none at d) into
- * *n; *i is left on its last token.  0 or -1 (error reported). */
-static int index_glass(reader *r, const char *what, int *i, char *name, double *n)
-{
-    const tok *t = &r->t[*i];
-    const px_glass_rec *g;
-    if (sl_tok_is(t, "glass")) {
-        if (*i + 1 == r->nt || key_index(&r->t[*i + 1]) >= 0)
-            return sl_fail(r, "%s: 'glass' needs a glass name", what);
-        t = &r->t[++*i];
-    }
-    if (t->n >= SC_GLASSMAX)
-        return sl_fail(r, "%s: '%.24s...' is too long for a glass name", what, t->s);
-    memcpy(name, t->s, t->n);
-    name[t->n] = '\0';
-    int rc = px_glass_index(name, PX_LAMBDA_D, n);
-    if (rc == PX_GLASS_RANGE && (g = px_glass_find(name)))
-        rc = px_glass_index(name, 0.5 * (g->lmin + g->lmax), n);
-    if (rc != PX_OK)
-        return sl_fail(r, "%s: '%s' is neither a number nor a glass of the catalogue (a name "
-                    "such as N-BK7, a model glass ND/VD such as 1.5168/64.17, or a medium "
-                    "such as water)", what, name);
-    if ((g = px_glass_find(name))) strcpy(name, g->name);   /* the catalogue's spelling */
-    return 0;
-}
-
-/* Parse the items from t[first] on as key/value groups allowed by `allowed`
- * (space-separated key names). */
-static int parse_fields(reader *r, int first, const char *dname, const char *allowed,
-                        fields *f)
-{
-    memset(f, 0, sizeof *f);
-    for (int i = first; i < r->nt;) {
-        int k = key_index(&r->t[i]);
-        char w[32], what[64];
-        snprintf(w, sizeof w, "%.*s", (int)(r->t[i].n < 24 ? r->t[i].n : 24), r->t[i].s);
-        if (k < 0 || !word_in(allowed, keys[k].name))
-            return sl_fail(r, "%s: unexpected '%s' (expected one of: %s)", dname, w, allowed);
-        if (f->has[k]) return sl_fail(r, "%s: '%s' given twice", dname, w);
-        f->has[k] = 1;
-        i++;
-        if (keys[k].nargs == ARGS_WORD) {
-            if (i == r->nt) return sl_fail(r, "%s: '%s' needs a file name", dname, w);
-            f->word[k] = r->t[i++];
-            continue;
-        }
-        snprintf(what, sizeof what, "%s: '%s'", dname, w);
-        if (keys[k].nargs == ARGS_TOKS) {
-            for (f->at[k] = i; i < r->nt && key_index(&r->t[i]) < 0; i++) f->count[k]++;
-            continue;
-        }
-        if (keys[k].nargs == ARGS_WL) {
-            while (i < r->nt && key_index(&r->t[i]) < 0) {
-                char b[NUMLEN];
-                double um;
-                snprintf(b, sizeof b, "%.*s", (int)(r->t[i].n < NUMLEN - 1 ? r->t[i].n :
-                                                    NUMLEN - 1), r->t[i].s);
-                if (f->count[k] == SC_MAXWL)
-                    return sl_fail(r, "%s: more than %d wavelengths", dname, SC_MAXWL);
-                if (r->t[i].n >= NUMLEN || px_wavelength(b, &um) != PX_OK)
-                    return sl_fail(r, "%s: '%s' is not a wavelength (nm above 100, else um, "
-                                "or F d C e g hene)", what, b);
-                for (int j = 0; j < f->count[k]; j++)   /* (587.5618 is d) */
-                    if (fabs(f->num[k][j] - um) <= 1e-12 * um)
-                        return sl_fail(r, "%s: wavelength '%s' given twice", what, b);
-                f->num[k][f->count[k]++] = um;
-                i++;
-            }
-            if (!f->count[k]) return sl_fail(r, "%s: '%s' needs at least one wavelength", dname, w);
-            continue;
-        }
-        if (keys[k].nargs == ARGS_VAR) {
-            while (i < r->nt && key_index(&r->t[i]) < 0) {
-                if (f->count[k] == SC_MAXCOEF)
-                    return sl_fail(r, "%s: more than %d '%s' values", dname, SC_MAXCOEF, w);
-                if (sl_tok_num(r, &r->t[i], what, &f->num[k][f->count[k]++])) return -1;
-                i++;
-            }
-            if (!f->count[k]) return sl_fail(r, "%s: '%s' needs at least one number", dname, w);
-            continue;
-        }
-        for (int j = 0; j < keys[k].nargs; j++, i++) {
-            if (i == r->nt || key_index(&r->t[i]) >= 0)
-                return sl_fail(r, "%s: '%s' needs %d number%s, found %d", dname, w,
-                            keys[k].nargs, keys[k].nargs == 1 ? "" : "s", j);
-            if (is_index_key(k) && !tok_numeric(&r->t[i])) {
-                if (index_glass(r, what, &i, f->glass[k][j], &f->num[k][j])) return -1;
-                continue;
-            }
-            if (sl_tok_num(r, &r->t[i], what, &f->num[k][j])) return -1;
-        }
-        f->count[k] = keys[k].nargs;
-    }
-    return 0;
-}
-
-static char *tok_dup(const tok *t)
-{
-    char *s = malloc(t->n + 1);
-    if (s) {
-        memcpy(s, t->s, t->n);
-        s[t->n] = '\0';
-    }
-    return s;
-}
-
-/* A unit vector from key k; fails on a zero vector. */
-static int unit_vec(reader *r, const fields *f, const char *dname, const char *k,
-                    double *u)
-{
-    const double *v = val(f, k);
-    double m = sqrt(dot3(v, v));
-    if (!(m > 0) || !isfinite(m))
-        return sl_fail(r, "%s: '%s' %g %g %g is a zero-length direction", dname, k, v[0],
-                    v[1], v[2]);
-    for (int i = 0; i < 3; i++) u[i] = v[i] / m;
-    return 0;
-}
-
-static int need(reader *r, const fields *f, const char *dname, const char *list)
-{
-    char k[32];
-    const char *p = list;
-    while (*p) {
-        size_t n = strcspn(p, " ");
-        snprintf(k, sizeof k, "%.*s", (int)n, p);
-        if (!has(f, k)) return sl_fail(r, "%s: '%s' is missing", dname, k);
-        p += n;
-        while (*p == ' ') p++;
-    }
-    return 0;
-}
-
-static int positive(reader *r, const char *dname, const char *what, double v)
-{
-    if (!(v > 0)) return sl_fail(r, "%s: %s = %g must be positive", dname, what, v);
-    return 0;
-}
-
-/* An integer value within [lo, hi]. */
-static int int_val(reader *r, const fields *f, const char *dname, const char *k,
-                   long lo, long hi, long *out)
-{
-    double v = val(f, k)[0];
-    if (v != floor(v) || v < (double)lo || v > (double)hi)
-        return sl_fail(r, "%s: '%s' %g must be an integer from %ld to %ld", dname, k, v, lo,
-                    hi);
-    *out = (long)v;
-    return 0;
-}
 
 /* The kind of a surface: exactly one of refract / mirror / absorb / detect (media:
  * meshes only). */
@@ -254,14 +28,14 @@ static int surface_kind(reader *r, const fields *f, const char *dname, sc_surfac
     static const char *const kinds[] = {"refract", "mirror", "absorb", "detect", "media"};
     int n = 0;
     for (int i = 0; i < 5; i++)
-        if (has(f, kinds[i])) { s->kind = i; n++; }
+        if (sf_has(f, kinds[i])) { s->kind = i; n++; }
     if (n != 1)
         return sl_fail(r, "%s: give exactly one of refract N1 N2, %smirror, absorb, detect",
                     dname, s->shape == SC_MESH ? "media FILE, " : "");
     if (s->kind == SC_REFRACT) {
-        int k = key_index(&(tok){"refract", 7});
-        s->n1 = val(f, "refract")[0];
-        s->n2 = val(f, "refract")[1];
+        int k = sf_key_index(&(tok){"refract", 7});
+        s->n1 = sf_val(f, "refract")[0];
+        s->n2 = sf_val(f, "refract")[1];
         memcpy(s->glass, f->glass[k], sizeof s->glass);
         if (!(s->n1 > 0) || !(s->n2 > 0))
             return sl_fail(r, "%s: refract %g %g: an index of refraction must be positive",
@@ -277,8 +51,8 @@ static int surface_polar(reader *r, const fields *f, const char *dname, sc_surfa
     static const char *const el[] = {"polarizer", "retarder", "qwp", "hwp"};
     int n = 0;
     for (int i = 0; i < 4; i++)
-        if (has(f, el[i])) {
-            const double *v = val(f, el[i]);
+        if (sf_has(f, el[i])) {
+            const double *v = sf_val(f, el[i]);
             double m = sqrt(dot3(v, v));
             if (n++ || m == 0)
                 return sl_fail(r, "%s: %s", dname, m == 0 ? "a polarizer's or retarder's "
@@ -288,8 +62,8 @@ static int surface_polar(reader *r, const fields *f, const char *dname, sc_surfa
             s->pol_el = i ? TRACE_POL_RETARDER : TRACE_POL_POLARIZER;
             s->pol_ret = (i == 1 ? v[3] : i == 2 ? 90 : 180) * 0.017453292519943295;
         }
-    if (has(f, "coating")) {
-        const tok *w = &f->word[key_index(&(tok){"coating", 7})];
+    if (sf_has(f, "coating")) {
+        const tok *w = &f->word[sf_key_index(&(tok){"coating", 7})];
         if (w->n >= SC_GLASSMAX) return sl_fail(r, "%s: coating: the name is too long", dname);
         memcpy(s->coat_name, w->s, w->n);
         n++;
@@ -297,33 +71,6 @@ static int surface_polar(reader *r, const fields *f, const char *dname, sc_surfa
     if (n && s->kind != SC_REFRACT)
         return sl_fail(r, "%s: polarizer, retarder, qwp, hwp and coating go on a refracting "
                        "surface (refract N1 N2)", dname);
-    return 0;
-}
-
-/* Some unit vector perpendicular to the unit vector d (or `up` projected). */
-static void perpendicular(const double *d, double *u)
-{
-    double a[3] = {0, 0, 0}, m;
-    int k = fabs(d[0]) < fabs(d[1]) ? (fabs(d[0]) < fabs(d[2]) ? 0 : 2)
-                                    : (fabs(d[1]) < fabs(d[2]) ? 1 : 2);
-    a[k] = 1;
-    m = dot3(a, d);
-    for (int i = 0; i < 3; i++) a[i] -= m * d[i];
-    m = sqrt(dot3(a, a));
-    for (int i = 0; i < 3; i++) u[i] = a[i] / m;
-}
-
-static int up_vector(reader *r, const fields *f, const char *dname, const double *d,
-                     double *u)
-{
-    double m, p;
-    if (!has(f, "up")) { perpendicular(d, u); return 0; }
-    if (unit_vec(r, f, dname, "up", u)) return -1;
-    p = dot3(u, d);
-    for (int i = 0; i < 3; i++) u[i] -= p * d[i];
-    m = sqrt(dot3(u, u));
-    if (m < 1e-9) return sl_fail(r, "%s: 'up' is parallel to the direction", dname);
-    for (int i = 0; i < 3; i++) u[i] /= m;
     return 0;
 }
 
@@ -372,72 +119,72 @@ static int read_surface(reader *r, sc_scene *sc, const char *dname, int shape)
     s.src = sc->name;
     s.line = r->line;
     s.axis[2] = 1;
-    if (parse_fields(r, 1, dname, allowed[shape], &f) || need(r, &f, dname, required[shape])
+    if (sf_parse_fields(r, 1, dname, allowed[shape], &f) || sf_need(r, &f, dname, required[shape])
         || surface_kind(r, &f, dname, &s) || surface_polar(r, &f, dname, &s))
         return -1;
-    if (has(&f, "tessellate")) {
+    if (sf_has(&f, "tessellate")) {
         long t;
-        if (int_val(r, &f, dname, "tessellate", 1, 1000, &t)) return -1;
+        if (sf_int_val(r, &f, dname, "tessellate", 1, 1000, &t)) return -1;
         s.tessellate = (int)t;
     }
-    s.refine = has(&f, "refine");
+    s.refine = sf_has(&f, "refine");
     if (s.refine && !s.tessellate)
         return sl_fail(r, "%s: 'refine' applies to a tessellated surface (tessellate N)", dname);
     switch (shape) {
     case SC_PLANE:
-        memcpy(s.at, val(&f, "at"), sizeof s.at);
-        if (unit_vec(r, &f, dname, "normal", s.axis)) return -1;
-        if (has(&f, "disc") == has(&f, "rect"))
+        memcpy(s.at, sf_val(&f, "at"), sizeof s.at);
+        if (sf_unit_vec(r, &f, dname, "normal", s.axis)) return -1;
+        if (sf_has(&f, "disc") == sf_has(&f, "rect"))
             return sl_fail(r, "plane: give its bounds, either disc R or rect W H");
-        if (has(&f, "disc")) {
-            s.aperture = val(&f, "disc")[0];
-            if (positive(r, dname, "the disc radius", s.aperture)) return -1;
-            if (has(&f, "hole")) {
-                s.hole = val(&f, "hole")[0];
+        if (sf_has(&f, "disc")) {
+            s.aperture = sf_val(&f, "disc")[0];
+            if (sf_positive(r, dname, "the disc radius", s.aperture)) return -1;
+            if (sf_has(&f, "hole")) {
+                s.hole = sf_val(&f, "hole")[0];
                 if (!(s.hole > 0 && s.hole < s.aperture))
                     return sl_fail(r, "plane: hole %g must lie between 0 and the disc radius %g",
                                 s.hole, s.aperture);
                 if (s.tessellate) return sl_fail(r, "plane: a disc with a hole cannot be tessellated");
             }
         } else {
-            if (has(&f, "hole")) return sl_fail(r, "plane: 'hole' goes with 'disc'");
-            s.rect[0] = val(&f, "rect")[0];
-            s.rect[1] = val(&f, "rect")[1];
-            if (positive(r, dname, "the width", s.rect[0]) ||
-                positive(r, dname, "the height", s.rect[1]))
+            if (sf_has(&f, "hole")) return sl_fail(r, "plane: 'hole' goes with 'disc'");
+            s.rect[0] = sf_val(&f, "rect")[0];
+            s.rect[1] = sf_val(&f, "rect")[1];
+            if (sf_positive(r, dname, "the width", s.rect[0]) ||
+                sf_positive(r, dname, "the height", s.rect[1]))
                 return -1;
         }
-        if (up_vector(r, &f, dname, s.axis, s.up)) return -1;
+        if (sf_up_vector(r, &f, dname, s.axis, s.up)) return -1;
         break;
     case SC_SPHERE:
-        memcpy(s.at, val(&f, "center"), sizeof s.at);
-        s.radius = val(&f, "radius")[0];
-        if (positive(r, dname, "the radius", s.radius)) return -1;
+        memcpy(s.at, sf_val(&f, "center"), sizeof s.at);
+        s.radius = sf_val(&f, "radius")[0];
+        if (sf_positive(r, dname, "the radius", s.radius)) return -1;
         break;
     case SC_MESH:
-        s.mesh_file = tok_dup(&f.word[key_index(&(tok){"file", 4})]);
-        if (has(&f, "media"))
-            s.media_file = tok_dup(&f.word[key_index(&(tok){"media", 5})]);
-        if (!s.mesh_file || (has(&f, "media") && !s.media_file)) {
+        s.mesh_file = sf_tok_dup(&f.word[sf_key_index(&(tok){"file", 4})]);
+        if (sf_has(&f, "media"))
+            s.media_file = sf_tok_dup(&f.word[sf_key_index(&(tok){"media", 5})]);
+        if (!s.mesh_file || (sf_has(&f, "media") && !s.media_file)) {
             free(s.mesh_file);
             free(s.media_file);
             return sl_fail(r, "out of memory");
         }
-        if (has(&f, "sphere")) {
-            memcpy(s.sphere, val(&f, "sphere"), sizeof s.sphere);
-            if (positive(r, dname, "the sphere's radius", s.sphere[3])) goto mesh_bad;
+        if (sf_has(&f, "sphere")) {
+            memcpy(s.sphere, sf_val(&f, "sphere"), sizeof s.sphere);
+            if (sf_positive(r, dname, "the sphere's radius", s.sphere[3])) goto mesh_bad;
         }
         break;
     default:   /* cap, conic, asphere */
-        memcpy(s.at, val(&f, "vertex"), sizeof s.at);
-        if (has(&f, "axis") && unit_vec(r, &f, dname, "axis", s.axis)) return -1;
-        s.radius = val(&f, "radius")[0];
-        s.aperture = val(&f, "aperture")[0];
-        if (positive(r, dname, "the aperture (semi-diameter)", s.aperture)) return -1;
-        if (has(&f, "conic")) s.conic = val(&f, "conic")[0];
-        if (has(&f, "coef")) {
-            s.ncoef = f.count[key_index(&(tok){"coef", 4})];
-            memcpy(s.coef, val(&f, "coef"), (size_t)s.ncoef * sizeof *s.coef);
+        memcpy(s.at, sf_val(&f, "vertex"), sizeof s.at);
+        if (sf_has(&f, "axis") && sf_unit_vec(r, &f, dname, "axis", s.axis)) return -1;
+        s.radius = sf_val(&f, "radius")[0];
+        s.aperture = sf_val(&f, "aperture")[0];
+        if (sf_positive(r, dname, "the aperture (semi-diameter)", s.aperture)) return -1;
+        if (sf_has(&f, "conic")) s.conic = sf_val(&f, "conic")[0];
+        if (sf_has(&f, "coef")) {
+            s.ncoef = f.count[sf_key_index(&(tok){"coef", 4})];
+            memcpy(s.coef, sf_val(&f, "coef"), (size_t)s.ncoef * sizeof *s.coef);
         }
         if (axial_check(r, dname, &s)) return -1;
     }
@@ -485,7 +232,7 @@ static int read_source(reader *r, sc_scene *sc)
         return sl_fail(r, "source: unknown kind '%.*s' (ray, fan, point, cone, collimated, "
                     "gaussian)", (int)(r->t[1].n < 24 ? r->t[1].n : 24), r->t[1].s);
     snprintf(dname, sizeof dname, "source %s", types[t].name);
-    if (parse_fields(r, 2, dname, types[t].allowed, &f) || need(r, &f, dname, types[t].required))
+    if (sf_parse_fields(r, 2, dname, types[t].allowed, &f) || sf_need(r, &f, dname, types[t].required))
         return -1;
     memset(&s, 0, sizeof s);
     s.type = t;
@@ -493,59 +240,59 @@ static int read_source(reader *r, sc_scene *sc)
     s.line = r->line;
     s.power = 1;
     s.medium = 1;
-    memcpy(s.from, val(&f, "from"), sizeof s.from);
-    if (has(&f, "dir") && unit_vec(r, &f, dname, "dir", s.dir)) return -1;
-    if (has(&f, "power")) {
-        s.power = val(&f, "power")[0];
-        if (positive(r, dname, "power", s.power)) return -1;
+    memcpy(s.from, sf_val(&f, "from"), sizeof s.from);
+    if (sf_has(&f, "dir") && sf_unit_vec(r, &f, dname, "dir", s.dir)) return -1;
+    if (sf_has(&f, "power")) {
+        s.power = sf_val(&f, "power")[0];
+        if (sf_positive(r, dname, "power", s.power)) return -1;
     }
-    if (has(&f, "lambda")) {
-        int k = key_index(&(tok){"lambda", 6});
+    if (sf_has(&f, "lambda")) {
+        int k = sf_key_index(&(tok){"lambda", 6});
         s.nlambda = f.count[k];
         memcpy(s.lambda, f.num[k], (size_t)s.nlambda * sizeof *s.lambda);
     }
-    if (has(&f, "medium")) {
-        memcpy(s.glass, f.glass[key_index(&(tok){"medium", 6})][0], sizeof s.glass);
-        s.medium = val(&f, "medium")[0];
+    if (sf_has(&f, "medium")) {
+        memcpy(s.glass, f.glass[sf_key_index(&(tok){"medium", 6})][0], sizeof s.glass);
+        s.medium = sf_val(&f, "medium")[0];
         if (!(s.medium > 0))
             return sl_fail(r, "%s: medium %g: an index of refraction must be positive", dname,
                         s.medium);
     }
-    int kp = key_index(&(tok){"pol", 3});
+    int kp = sf_key_index(&(tok){"pol", 3});
     if (f.has[kp] && sc_source_pol(r, f.at[kp], f.count[kp], dname, &s)) return -1;
-    if (has(&f, "angle")) {
-        s.angle = val(&f, "angle")[0];
+    if (sf_has(&f, "angle")) {
+        s.angle = sf_val(&f, "angle")[0];
         if (s.angle < 0 || s.angle >= (t == SC_FAN ? 180 : 90))
             return sl_fail(r, "%s: half angle %g must lie in [0, %d) degrees", dname, s.angle,
                         t == SC_FAN ? 180 : 90);
     }
-    if (has(&f, "radius")) {
-        s.radius = val(&f, "radius")[0];
-        if (positive(r, dname, "the radius", s.radius)) return -1;
+    if (sf_has(&f, "radius")) {
+        s.radius = sf_val(&f, "radius")[0];
+        if (sf_positive(r, dname, "the radius", s.radius)) return -1;
     }
-    if (has(&f, "rays")) {
-        if (int_val(r, &f, dname, "rays", 1, 100000000L, &v)) return -1;
+    if (sf_has(&f, "rays")) {
+        if (sf_int_val(r, &f, dname, "rays", 1, 100000000L, &v)) return -1;
         s.count = v;
     }
-    if (has(&f, "grid")) {
-        if (int_val(r, &f, dname, "grid", 1, 10000, &v)) return -1;
+    if (sf_has(&f, "grid")) {
+        if (sf_int_val(r, &f, dname, "grid", 1, 10000, &v)) return -1;
         s.count = v;
     }
-    if (has(&f, "rings")) {
-        if (int_val(r, &f, dname, "rings", 0, t == SC_POINT ? 500 : 5000, &v)) return -1;
+    if (sf_has(&f, "rings")) {
+        if (sf_int_val(r, &f, dname, "rings", 0, t == SC_POINT ? 500 : 5000, &v)) return -1;
         s.rings = (int)v;
     }
     switch (t) {
     case SC_FAN:
-        if (has(&f, "to") == has(&f, "dir"))
+        if (sf_has(&f, "to") == sf_has(&f, "dir"))
             return sl_fail(r, "%s: give either dir D angle A [up U], or to P1 P2 (rays toward "
                         "points on the segment P1-P2, as opticrt)", dname);
-        if (has(&f, "to")) {
+        if (sf_has(&f, "to")) {
             double a[3], b[3], c[3];
-            if (has(&f, "angle") || has(&f, "up"))
+            if (sf_has(&f, "angle") || sf_has(&f, "up"))
                 return sl_fail(r, "%s: 'angle' and 'up' go with 'dir', not with 'to'", dname);
             s.has_to = 1;
-            memcpy(s.to, val(&f, "to"), sizeof s.to);
+            memcpy(s.to, sf_val(&f, "to"), sizeof s.to);
             sub3(s.to[0], s.from, a);
             sub3(s.to[1], s.from, b);
             if (dot3(a, a) == 0 || (s.count > 1 && dot3(b, b) == 0))
@@ -556,27 +303,27 @@ static int read_source(reader *r, sc_scene *sc)
                 return sl_fail(r, "%s: the segment P1-P2 passes through the source point "
                             "(a zero-direction ray)", dname);
         } else {
-            if (!has(&f, "angle")) return sl_fail(r, "%s: 'angle' is missing", dname);
-            if (up_vector(r, &f, dname, s.dir, s.up)) return -1;
+            if (!sf_has(&f, "angle")) return sl_fail(r, "%s: 'angle' is missing", dname);
+            if (sf_up_vector(r, &f, dname, s.dir, s.up)) return -1;
         }
         break;
     case SC_POINT: {
         double d[3];
-        memcpy(s.toward, val(&f, "toward"), sizeof s.toward);
+        memcpy(s.toward, sf_val(&f, "toward"), sizeof s.toward);
         sub3(s.toward, s.from, d);
         if (dot3(d, d) == 0)
             return sl_fail(r, "%s: 'toward' is the source point: a zero-direction ray", dname);
         break;
     }
     case SC_GAUSSIAN:
-        s.waist = val(&f, "waist")[0];
-        s.wavelength = val(&f, "wavelength")[0];
-        if (positive(r, dname, "the waist", s.waist) ||
-            positive(r, dname, "the wavelength", s.wavelength))
+        s.waist = sf_val(&f, "waist")[0];
+        s.wavelength = sf_val(&f, "wavelength")[0];
+        if (sf_positive(r, dname, "the waist", s.waist) ||
+            sf_positive(r, dname, "the wavelength", s.wavelength))
             return -1;
-        if (has(&f, "trunc")) {
-            s.trunc = val(&f, "trunc")[0];
-            if (positive(r, dname, "trunc", s.trunc)) return -1;
+        if (sf_has(&f, "trunc")) {
+            s.trunc = sf_val(&f, "trunc")[0];
+            if (sf_positive(r, dname, "trunc", s.trunc)) return -1;
         }
         if (s.wavelength / (PI * s.waist) > 0.5)
             return sl_fail(r, "%s: wavelength %g against waist %g: divergence %g rad is beyond "
@@ -648,7 +395,7 @@ static int read_setting(reader *r, sc_scene *sc)
         if (all) {   /* one HDF5 file with every table */
             for (int i = 0; i < 3; i++) {
                 if (*slot[i]) return sl_fail(r, "output %s given twice", what[i]);
-                if (!(*slot[i] = tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
+                if (!(*slot[i] = sf_tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
                 sc->out_format[i] = SC_OUT_H5;
             }
             if (out_format_of(sc->out_summary, f) != SC_OUT_H5)
@@ -659,7 +406,7 @@ static int read_setting(reader *r, sc_scene *sc)
         for (int i = 0; i < 3; i++)
             if (sl_tok_is(&r->t[1], what[i])) {
                 if (*slot[i]) return sl_fail(r, "output %s given twice", what[i]);
-                if (!(*slot[i] = tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
+                if (!(*slot[i] = sf_tok_dup(&r->t[2]))) return sl_fail(r, "out of memory");
                 sc->out_format[i] = (int)out_format_of(*slot[i], f);
                 if (i == 2 && sc->out_format[i] != SC_OUT_TEXT && sc->out_format[i] != SC_OUT_H5)
                     return sl_fail(r, "output summary: text or h5");
