@@ -40,12 +40,11 @@ static inline int leaves(const trace_scene *sc, int last, const tr_surf *f)
            (last >= 0 && f->group >= 0 && sc->surf[last]->group == f->group);
 }
 
-void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
+/* Analytic surface f offered to the query: kept in x->best_* (and as rh's hit) if the
+ * true ray meets it nearer than what rh holds. */
+static void offer_analytic(tr_ctx *x, const tr_surf *f, struct RTCRayHit *rh,
+                           unsigned geomID)
 {
-    if (a->N != 1 || !a->valid[0]) return;
-    tr_ctx *x = (tr_ctx *)a->context;
-    const tr_surf *f = a->geometryUserPtr;
-    struct RTCRayHit *rh = (struct RTCRayHit *)a->rayhit;
     double t, n[3], p[3];
     int leaving = leaves(x->sc, x->last_surf, f), ok;
     if (x->float_hits) ok = tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n);
@@ -57,7 +56,7 @@ void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
     float tf = (float)(t - x->ta);
     if (tf > rh->ray.tfar) return;          /* a triangle is clearly nearer */
     rh->ray.tfar = tf;
-    rh->hit.geomID = a->geomID;
+    rh->hit.geomID = geomID;
     rh->hit.primID = 0;
     rh->hit.u = rh->hit.v = 0;
     rh->hit.Ng_x = (float)n[0];
@@ -70,6 +69,21 @@ void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
     v_set(x->best_n, n);
     x->best_far = ok == 2 && !x->float_hits;
     if (x->best_far) tr_shape_world(&f->shape, p, x->best_q);
+}
+
+void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
+{
+    if (a->N != 1 || !a->valid[0]) return;
+    offer_analytic((tr_ctx *)a->context, a->geometryUserPtr, (struct RTCRayHit *)a->rayhit,
+                   a->geomID);
+}
+
+/* The scene's inline analytic surfaces (TR_INLINE_MAX), before Embree's query: as if
+ * Embree had visited them first, so its tfar already stops at the nearest. */
+static inline void offer_inline(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh)
+{
+    for (int i = 0; i < sc->ninline; i++)
+        offer_analytic(x, sc->surf[sc->inl[i]], rh, (unsigned)sc->inl[i]);
 }
 
 void tr_user_occluded(const struct RTCOccludedFunctionNArguments *a)
@@ -208,6 +222,7 @@ static void near_edge(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         rh->ray.tfar = INFINITY;
         rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
+        offer_inline(sc, x, rh);
         rtcIntersect1(sc->scn, &x->ec, rh);
     }
 }
@@ -258,6 +273,7 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    offer_inline(sc, &x, &rh);
     rtcIntersect1(sc->scn, &x.ec, &rh);
     if (sc->nclosed && !float_hits && last_surf >= 0 && last_prim >= 0 &&
         rh.hit.geomID != (unsigned)last_surf) {
