@@ -47,9 +47,15 @@ static void offer_analytic(tr_ctx *x, const tr_surf *f, struct RTCRayHit *rh,
 {
     double t, n[3], p[3];
     int leaving = leaves(x->sc, x->last_surf, f), ok;
-    if (x->float_hits) ok = tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n);
-    else if ((ok = tr_shape_hit_t(&f->shape, x->o, x->d, leaving, &t, p)))
-        tr_shape_hit_normal(&f->shape, p, n);
+    const tr_shape *g = &f->shape;
+    if (x->float_hits) ok = tr_shape_hit_float(g, x->o, x->d, leaving, &t, n);
+    else {
+        /* tr_shape_hit_t's own cases, its inline ones called here directly */
+        if (g->fast == TR_FAST_PLANE) ok = tr_plane_hit(g, x->o, x->d, leaving, &t, p);
+        else if (g->fast == TR_FAST_CONIC) ok = tr_conic_hit(g, x->o, x->d, leaving, &t, p);
+        else ok = tr_shape_hit_t(g, x->o, x->d, leaving, &t, p);
+        if (ok) tr_shape_hit_normal(g, p, n);
+    }
     /* at a tie the lower surface id, whatever order Embree visits them in: the lens
      * shortcut's candidates (seq_hit) are in id order and take the first */
     if (!ok || !(t < x->best_t || (t == x->best_t && f->id < x->best_surf))) return;
@@ -100,15 +106,22 @@ static void tri_normal(const tr_surf *f, long prim, double n[3])
     v_cross(e1, e2, n);
 }
 
-/* Distance along the ray to the triangle's plane, in double. */
-static double tri_plane_t(const tr_surf *f, long prim, const double o[3], const double d[3])
+/* Distance along the ray to the plane of triangle prim (its tri_normal n), in
+ * double. */
+static inline double plane_t_n(const tr_surf *f, long prim, const double n[3],
+                               const double o[3], const double d[3])
 {
-    double n[3];
     const double *a = f->vtx + 3 * f->idx[3 * prim];
-    tri_normal(f, prim, n);
     double den = v_dot(n, d);
     double q[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
     return den != 0 ? v_dot(n, q) / den : INFINITY;
+}
+
+static double tri_plane_t(const tr_surf *f, long prim, const double o[3], const double d[3])
+{
+    double n[3];
+    tri_normal(f, prim, n);
+    return plane_t_n(f, prim, n, o, d);
 }
 
 /* Leaving a mesh: never its own triangle again, nor another one "here". */
@@ -300,9 +313,10 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     const tr_surf *f = sc->surf[rh.hit.geomID];
     if (!f->is_mesh) return analytic_hit(&x, f->id, h);
     long prim = rh.hit.primID;
-    double t = float_hits ? ta + rh.ray.tfar : tri_plane_t(f, prim, o, d), n[3];
+    double n[3];
+    tri_normal(f, prim, n);             /* once: the plane's distance and the normal */
+    double t = float_hits ? ta + rh.ray.tfar : plane_t_n(f, prim, n, o, d);
     if (!(t > 0 && isfinite(t))) t = ta + rh.ray.tfar;
-    tri_normal(f, prim, n);
     v_unit(n);
     if (f->has_under && f->refine != TRACE_REFINE_NONE && !float_hits) {
         double tt, p[3], an[3];
