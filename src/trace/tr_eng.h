@@ -49,6 +49,11 @@ typedef struct tr_surf {
  * (or unbounded) stay out of its BVH and are tested in double on every query, and
  * Embree's rays start where they enter the box of what it holds (see nearest()). */
 #define TR_EMBREE_MAX 1e15
+/* A scene with meshes and at most this many analytic surfaces (in range, none
+ * coincident) asks those in double before each Embree query instead of holding them
+ * as user geometry: Embree's traversal of a second BVH and its callback per query
+ * cost more than the test (a detector plane: a few ns). */
+#define TR_INLINE_MAX 4
 
 struct trace_scene {
     char err[512];
@@ -62,6 +67,9 @@ struct trace_scene {
     int built;
     double build_ms;
     int *far, nfar;            /* surfaces outside Embree's range, tested in double */
+    int inl[TR_INLINE_MAX], ninline;   /* a mesh scene's few analytic surfaces, asked
+                                  in double before Embree, not as its user geometry
+                                  (tr_build, tr_hit.c) */
     int nembree;               /* surfaces Embree holds */
     int ngroup;                /* surfaces in a group of coincident ones */
     int nclosed;               /* closed meshes */

@@ -40,24 +40,29 @@ static inline int leaves(const trace_scene *sc, int last, const tr_surf *f)
            (last >= 0 && f->group >= 0 && sc->surf[last]->group == f->group);
 }
 
-void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
+/* Analytic surface f offered to the query: kept in x->best_* (and as rh's hit) if the
+ * true ray meets it nearer than what rh holds. */
+static void offer_analytic(tr_ctx *x, const tr_surf *f, struct RTCRayHit *rh,
+                           unsigned geomID)
 {
-    if (a->N != 1 || !a->valid[0]) return;
-    tr_ctx *x = (tr_ctx *)a->context;
-    const tr_surf *f = a->geometryUserPtr;
-    struct RTCRayHit *rh = (struct RTCRayHit *)a->rayhit;
     double t, n[3], p[3];
     int leaving = leaves(x->sc, x->last_surf, f), ok;
-    if (x->float_hits) ok = tr_shape_hit_float(&f->shape, x->o, x->d, leaving, &t, n);
-    else if ((ok = tr_shape_hit_t(&f->shape, x->o, x->d, leaving, &t, p)))
-        tr_shape_hit_normal(&f->shape, p, n);
+    const tr_shape *g = &f->shape;
+    if (x->float_hits) ok = tr_shape_hit_float(g, x->o, x->d, leaving, &t, n);
+    else {
+        /* tr_shape_hit_t's own cases, its inline ones called here directly */
+        if (g->fast == TR_FAST_PLANE) ok = tr_plane_hit(g, x->o, x->d, leaving, &t, p);
+        else if (g->fast == TR_FAST_CONIC) ok = tr_conic_hit(g, x->o, x->d, leaving, &t, p);
+        else ok = tr_shape_hit_t(g, x->o, x->d, leaving, &t, p);
+        if (ok) tr_shape_hit_normal(g, p, n);
+    }
     /* at a tie the lower surface id, whatever order Embree visits them in: the lens
      * shortcut's candidates (seq_hit) are in id order and take the first */
     if (!ok || !(t < x->best_t || (t == x->best_t && f->id < x->best_surf))) return;
     float tf = (float)(t - x->ta);
     if (tf > rh->ray.tfar) return;          /* a triangle is clearly nearer */
     rh->ray.tfar = tf;
-    rh->hit.geomID = a->geomID;
+    rh->hit.geomID = geomID;
     rh->hit.primID = 0;
     rh->hit.u = rh->hit.v = 0;
     rh->hit.Ng_x = (float)n[0];
@@ -70,6 +75,21 @@ void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
     v_set(x->best_n, n);
     x->best_far = ok == 2 && !x->float_hits;
     if (x->best_far) tr_shape_world(&f->shape, p, x->best_q);
+}
+
+void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a)
+{
+    if (a->N != 1 || !a->valid[0]) return;
+    offer_analytic((tr_ctx *)a->context, a->geometryUserPtr, (struct RTCRayHit *)a->rayhit,
+                   a->geomID);
+}
+
+/* The scene's inline analytic surfaces (TR_INLINE_MAX), before Embree's query: as if
+ * Embree had visited them first, so its tfar already stops at the nearest. */
+static inline void offer_inline(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh)
+{
+    for (int i = 0; i < sc->ninline; i++)
+        offer_analytic(x, sc->surf[sc->inl[i]], rh, (unsigned)sc->inl[i]);
 }
 
 void tr_user_occluded(const struct RTCOccludedFunctionNArguments *a)
@@ -86,15 +106,22 @@ static void tri_normal(const tr_surf *f, long prim, double n[3])
     v_cross(e1, e2, n);
 }
 
-/* Distance along the ray to the triangle's plane, in double. */
-static double tri_plane_t(const tr_surf *f, long prim, const double o[3], const double d[3])
+/* Distance along the ray to the plane of triangle prim (its tri_normal n), in
+ * double. */
+static inline double plane_t_n(const tr_surf *f, long prim, const double n[3],
+                               const double o[3], const double d[3])
 {
-    double n[3];
     const double *a = f->vtx + 3 * f->idx[3 * prim];
-    tri_normal(f, prim, n);
     double den = v_dot(n, d);
     double q[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
     return den != 0 ? v_dot(n, q) / den : INFINITY;
+}
+
+static double tri_plane_t(const tr_surf *f, long prim, const double o[3], const double d[3])
+{
+    double n[3];
+    tri_normal(f, prim, n);
+    return plane_t_n(f, prim, n, o, d);
 }
 
 /* Leaving a mesh: never its own triangle again, nor another one "here". */
@@ -208,6 +235,7 @@ static void near_edge(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         rh->ray.tfar = INFINITY;
         rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
+        offer_inline(sc, x, rh);
         rtcIntersect1(sc->scn, &x->ec, rh);
     }
 }
@@ -258,6 +286,7 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    offer_inline(sc, &x, &rh);
     rtcIntersect1(sc->scn, &x.ec, &rh);
     if (sc->nclosed && !float_hits && last_surf >= 0 && last_prim >= 0 &&
         rh.hit.geomID != (unsigned)last_surf) {
@@ -284,9 +313,10 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     const tr_surf *f = sc->surf[rh.hit.geomID];
     if (!f->is_mesh) return analytic_hit(&x, f->id, h);
     long prim = rh.hit.primID;
-    double t = float_hits ? ta + rh.ray.tfar : tri_plane_t(f, prim, o, d), n[3];
+    double n[3];
+    tri_normal(f, prim, n);             /* once: the plane's distance and the normal */
+    double t = float_hits ? ta + rh.ray.tfar : plane_t_n(f, prim, n, o, d);
     if (!(t > 0 && isfinite(t))) t = ta + rh.ray.tfar;
-    tri_normal(f, prim, n);
     v_unit(n);
     if (f->has_under && f->refine != TRACE_REFINE_NONE && !float_hits) {
         double tt, p[3], an[3];

@@ -87,7 +87,7 @@ static void drop_embree(trace_scene *sc)
     sc->built = 0;
     free(sc->far);
     sc->far = NULL;
-    sc->nfar = sc->nembree = 0;
+    sc->nfar = sc->nembree = sc->ninline = 0;
 }
 
 void tr_scene_free(trace_scene *sc)
@@ -719,11 +719,20 @@ int tr_build(trace_scene *sc, double *ms)
     sc->wt_all = ex && *ex && strcmp(ex, "0") != 0;
     group_coincident(sc);
     if (sc->seq_nsurf != sc->nsurf && !sc->ngroup) tr_seq_detect(sc);
+    /* a mesh scene's few analytic surfaces go before Embree (TR_INLINE_MAX) */
+    int nmesh = 0, nan = 0;
+    for (int i = 0; i < sc->nsurf; i++) {
+        if (sc->surf[i]->is_mesh) nmesh++;
+        else if (in_range(sc->surf[i])) nan++;
+    }
+    int inl = nmesh > 0 && nan <= TR_INLINE_MAX && !sc->ngroup;
+    sc->ninline = 0;
     for (int i = 0; i < sc->nsurf; i++) {
         tr_surf *f = sc->surf[i];
         if (!f->is_mesh && !in_range(f)) { sc->far[sc->nfar++] = i; continue; }
         f->pad = f->is_mesh ? mesh_pad(sc, f) : sc->epad;
         f->eoff = sc->eoff;
+        if (!f->is_mesh && inl) { sc->inl[sc->ninline++] = i; continue; }
         sc->nembree++;
         int rc = f->is_mesh ? attach_mesh(sc, f) : attach_user(sc, f);
         if (rc) {
