@@ -257,22 +257,29 @@ so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int stokes, int 
     return t;
 }
 
-/* Room for one more binary row: a full chunk goes to the queue; HDF5 keeps growing. */
-static unsigned char *row_slot(so_table *t)
+/* Room for at least one more binary row (a full chunk goes to the queue; HDF5 keeps
+ * growing): how many rows fit now, 0 after a write error or out of memory. */
+static size_t room(so_table *t)
 {
     if (t->used + t->row > t->cap) {
         if (t->q) {
-            if (soq_submit(t->q, t->used)) return NULL;
+            if (soq_submit(t->q, t->used)) return 0;
             t->buf = soq_rows(t->q);
             t->used = 0;
         } else {
             size_t cap = t->cap ? t->cap * 2 : 65536;
             unsigned char *b = realloc(t->buf, cap);
-            if (!b) return NULL;
+            if (!b) return 0;
             t->buf = b;
             t->cap = cap;
         }
     }
+    return (t->cap - t->used) / t->row;
+}
+
+static unsigned char *row_slot(so_table *t)
+{
+    if (!room(t)) return NULL;
     unsigned char *p = t->buf + t->used;
     t->used += t->row;
     t->nrows++;
@@ -281,27 +288,14 @@ static unsigned char *row_slot(so_table *t)
 
 #define PUT(p, v) (memcpy((p), &(v), sizeof (v)), (p) += sizeof (v))
 
-int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double stokes[4])
+/* Hit h's binary row at p (hit_cols' order; sv: its S0..S3, for a table with them). */
+static inline void pack_hit(so_table *t, unsigned char *p, const trace_hit *h, uint64_t ray,
+                            const double *sv)
 {
-    static const double none[4] = {NAN, NAN, NAN, NAN};
-    const double *sv = stokes ? stokes : none;
     /* the double columns, in hit_cols' order */
     const double v[11] = {h->pos[0], h->pos[1], h->pos[2], h->dir[0], h->dir[1], h->dir[2],
                           h->power_s, h->power_p, h->power_s + h->power_p, h->length,
                           h->opl};
-    if (t->fmt == SC_OUT_CSV17) {   /* the bytes of before, number for number */
-        if (fprintf(f, "%llu,%d,%d,%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
-                    "%.17g,%.17g,%.17g,%.17g", (unsigned long long)ray, h->depth,
-                    h->surface, h->prim, v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
-                    v[8], v[9], v[10]) < 0)
-            return 1;
-        if (t->wl && fprintf(f, ",%.10g", h->lambda * 1e3) < 0) return 1;
-        if (t->st && fprintf(f, ",%.17g,%.17g,%.17g,%.17g", sv[0], sv[1], sv[2], sv[3]) < 0)
-            return 1;
-        return fputs("\n", f) < 0;
-    }
-    unsigned char *p = row_slot(t);
-    if (!p) return 1;
     int32_t depth = h->depth, surf = h->surface;
     int64_t prim = h->prim;
     PUT(p, ray);
@@ -315,6 +309,50 @@ int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double 
         PUT(p, nm);
     }
     if (t->st) memcpy(p, sv, 4 * sizeof *sv);
+}
+
+static const double no_stokes[4] = {NAN, NAN, NAN, NAN};
+
+int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double stokes[4])
+{
+    const double *sv = stokes ? stokes : no_stokes;
+    if (t->fmt == SC_OUT_CSV17) {   /* the bytes of before, number for number */
+        const double *p = h->pos, *d = h->dir;
+        if (fprintf(f, "%llu,%d,%d,%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+                    "%.17g,%.17g,%.17g,%.17g", (unsigned long long)ray, h->depth,
+                    h->surface, h->prim, p[0], p[1], p[2], d[0], d[1], d[2], h->power_s,
+                    h->power_p, h->power_s + h->power_p, h->length, h->opl) < 0)
+            return 1;
+        if (t->wl && fprintf(f, ",%.10g", h->lambda * 1e3) < 0) return 1;
+        if (t->st && fprintf(f, ",%.17g,%.17g,%.17g,%.17g", sv[0], sv[1], sv[2], sv[3]) < 0)
+            return 1;
+        return fputs("\n", f) < 0;
+    }
+    unsigned char *p = row_slot(t);
+    if (!p) return 1;
+    pack_hit(t, p, h, ray, sv);
+    return 0;
+}
+
+int so_hits(so_table *t, FILE *f, const trace_hit *h, size_t n, uint64_t ray0)
+{
+    if (t->fmt == SC_OUT_CSV17) {
+        for (size_t i = 0; i < n; i++)
+            if (so_hit(t, f, h + i, h[i].ray + ray0, NULL)) return 1;
+        return 0;
+    }
+    while (n) {   /* as many rows as the chunk holds, in one loop */
+        size_t k = room(t);
+        if (!k) return 1;
+        if (k > n) k = n;
+        unsigned char *p = t->buf + t->used;
+        for (size_t i = 0; i < k; i++, p += t->row)
+            pack_hit(t, p, h + i, h[i].ray + ray0, no_stokes);
+        t->used += k * t->row;
+        t->nrows += k;
+        h += k;
+        n -= k;
+    }
     return 0;
 }
 

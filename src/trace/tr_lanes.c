@@ -139,6 +139,16 @@ static int lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr
     return 0;
 }
 
+/* buf_move for a lane's hits: mostly its one hit at the detector, copied as a record of
+ * known size (inline) rather than by memcpy's variable-length call. */
+static inline int hit_move(tr_buf *b, tr_buf *a)
+{
+    if (a->n != 1 || b->n == b->cap) return buf_move(b, a);
+    memcpy((trace_hit *)b->p + b->n++, a->p, sizeof(trace_hit));   /* padding too */
+    a->n = 0;
+    return 0;
+}
+
 /* Rays i0 .. i0+TR_LANES-1 of the worker side by side while each stays on the lens
  * shortcut, step by step in a packet (tr_pk_kernel.h); a lane that leaves it (no
  * candidate hit, depth limit, a ray going back, TIR, reflections waiting) is finished
@@ -207,7 +217,7 @@ static void tr_trace_lanes(tr_worker *w, uint64_t i0, int *k)
             lane_leave(L, &pk[cur], l, last);
             L->state = LANE_SLOW;
         }
-        if (buf_move(&w->out.seg, &L->out.seg) || buf_move(&w->out.hit, &L->out.hit))
+        if (buf_move(&w->out.seg, &L->out.seg) || hit_move(&w->out.hit, &L->out.hit))
             w->nomem = 1;
         if (L->state == LANE_SLOW)
             tr_trace_rest(w, &w->out, L->ty, L->stack, L->sp, &L->r, L->live, L->ray, L->p0);
