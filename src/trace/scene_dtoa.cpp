@@ -15,6 +15,12 @@
 #include <cstring>
 #if defined(__has_include) && __has_include(<fmt/format.h>) && !defined(SC_DTOA_DC)
 #define FMT_HEADER_ONLY
+// the whole table of powers of ten (about 10 KB) rather than a third of it and a
+// multiplication to make the others: to_decimal 16.5 -> 12.5 ns, a number 31 -> 25 ns
+// on the triplet's hits (2 M values, best of 10, loaded 2-core EPYC); the same digits
+#ifndef FMT_USE_FULL_CACHE_DRAGONBOX
+#define FMT_USE_FULL_CACHE_DRAGONBOX 1
+#endif
 #include <fmt/format.h>
 #if FMT_VERSION >= 80000 && FMT_VERSION < 130000   // dragonbox::to_decimal as in 8 .. 12
 #define SC_DRAGONBOX 1

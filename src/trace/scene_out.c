@@ -128,28 +128,36 @@ static long npy_header(const so_table *t, uint64_t n, char *out, long len)
 
 /* ---- CSV lines (in the formatter threads) ----------------------------------------- */
 
-/* A formatter's own memory of each column's last value and its digits (a detector
- * plane's z, a constant length: the digits are made once a run of them). */
+/* A formatter's own memory: the wavelength's text (made once a run of them). */
 typedef struct {
-    uint64_t last[NHIT];
-    char text[NHIT][40];
-    unsigned char len[NHIT];
     double nm_of;
     char nm_text[40];
     unsigned char nm_len;
 } csv_cache;
 
 /* The longest a CSV field can be ("-2.2250738585072014e-308", a 20-digit integer) and
- * its comma; the digit writer's copies reach 11 bytes past a number (the slack). */
+ * its comma; a number's digits are written with 8-byte stores that reach up to 32
+ * bytes from where it starts (sc_dtoa), and a repeated field is copied 32 bytes at a
+ * time: the slack after the last field. */
 enum { FIELD_MAX = 25, LINE_SLACK = 64 };
 
 static char *put_u64(char *p, uint64_t v)
 {
+    static const char d2[201] =
+        "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+        "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+        "8081828384858687888990919293949596979899";
     char tmp[24];
-    int n = 0;
-    do tmp[n++] = (char)('0' + v % 10); while (v /= 10);
-    while (n) *p++ = tmp[--n];
-    return p;
+    int n = 24;
+    while (v >= 100) {
+        n -= 2;
+        memcpy(tmp + n, d2 + 2 * (v % 100), 2);
+        v /= 100;
+    }
+    if (v >= 10) { n -= 2; memcpy(tmp + n, d2 + 2 * v, 2); }
+    else tmp[--n] = (char)('0' + v);
+    memcpy(p, tmp + n, (size_t)(24 - n));
+    return p + 24 - n;
 }
 
 static char *put_i64(char *p, int64_t v)
@@ -158,12 +166,18 @@ static char *put_i64(char *p, int64_t v)
     return put_u64(p, (uint64_t)v);
 }
 
-/* n bytes of binary hit rows as CSV lines at `text`; their length. */
+/* n bytes of binary hit rows as CSV lines at `text`; their length.  A field whose value
+ * (its bits) is the one before in its column -- a detector plane's z, the depth, the
+ * surface -- is copied from where it was written in this text (a row back: long
+ * written, so the copy does not wait on the stores) instead of made again. */
 static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n, char *text)
 {
     const so_table *t = ctx;
     const column *col = cols(t);
     csv_cache *c = cache;
+    const char *at[NHIT] = {0};   /* column i's last text in this chunk, its bits */
+    uint64_t last[NHIT];
+    unsigned char len[NHIT];
     char *p = text;
     for (const unsigned char *end = r + n; r < end; ) {
         for (int i = 0; i < t->ncol; i++) {
@@ -171,22 +185,7 @@ static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n,
             int32_t i32;
             double v;
             if (i) *p++ = ',';
-            switch (col[i].type) {
-            case C_U64: memcpy(&u, r, 8); p = put_u64(p, u); r += 8; break;
-            case C_I32: memcpy(&i32, r, 4); p = put_i64(p, i32); r += 4; break;
-            case C_I64: memcpy(&u, r, 8); p = put_i64(p, (int64_t)u); r += 8; break;
-            case C_F64:
-                memcpy(&u, r, 8);
-                r += 8;
-                if (!c->len[i] || u != c->last[i]) {
-                    memcpy(&v, &u, 8);
-                    c->last[i] = u;
-                    c->len[i] = (unsigned char)sc_dtoa(v, c->text[i]);
-                }
-                memcpy(p, c->text[i], 32);   /* the rest is the next field's room */
-                p += c->len[i];
-                break;
-            default:   /* C_NM: the um value, printed as "%.10g" of nm */
+            if (col[i].type == C_NM) {   /* the um value, printed as "%.10g" of nm */
                 memcpy(&v, r, 8);
                 r += 8;
                 if (!c->nm_len || v != c->nm_of) {
@@ -196,7 +195,30 @@ static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n,
                 }
                 memcpy(p, c->nm_text, c->nm_len);
                 p += c->nm_len;
+                continue;
             }
+            if (col[i].type == C_I32) {
+                memcpy(&i32, r, 4);
+                u = (uint64_t)(int64_t)i32;
+                r += 4;
+            } else {
+                memcpy(&u, r, 8);
+                r += 8;
+            }
+            if (at[i] && u == last[i]) {
+                memmove(p, at[i], 32);   /* the rest is the next field's room */
+                p += len[i];
+                continue;
+            }
+            char *q = p;
+            switch (col[i].type) {
+            case C_U64: p = put_u64(p, u); break;
+            case C_F64: memcpy(&v, &u, 8); p += sc_dtoa(v, p); break;
+            default: p = put_i64(p, (int64_t)u);   /* C_I32, C_I64 */
+            }
+            at[i] = q;
+            last[i] = u;
+            len[i] = (unsigned char)(p - q);
         }
         *p++ = '\n';
     }
