@@ -205,8 +205,11 @@ static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n,
                 memcpy(&u, r, 8);
                 r += 8;
             }
-            if (at[i] && u == last[i]) {
-                memmove(p, at[i], 32);   /* the rest is the next field's room */
+            if (at[i] && u == last[i]) {   /* 32 bytes (the rest is the next field's
+                                              room), loaded before any is stored */
+                char b[32];
+                memcpy(b, at[i], 32);
+                memcpy(p, b, 32);
                 p += len[i];
                 continue;
             }
