@@ -313,22 +313,28 @@ static unsigned char *row_slot(so_table *t)
 
 #define PUT(p, v) (memcpy((p), &(v), sizeof (v)), (p) += sizeof (v))
 
-/* Hit h's binary row at p (hit_cols' order; sv: its S0..S3, for a table with them). */
+/* Hit h's binary row at p (hit_cols' order; sv: its S0..S3, for a table with them).
+ * Field by field from the record to the row: x..dz and the two pairs after the powers
+ * lie in the record as in the row (no copy through a stack array, whose 8-byte
+ * stores a 16-byte load cannot take: it waits for them). */
 static inline void pack_hit(so_table *t, unsigned char *p, const trace_hit *h, uint64_t ray,
                             const double *sv)
 {
-    /* the double columns, in hit_cols' order */
-    const double v[11] = {h->pos[0], h->pos[1], h->pos[2], h->dir[0], h->dir[1], h->dir[2],
-                          h->power_s, h->power_p, h->power_s + h->power_p, h->length,
-                          h->opl};
     int32_t depth = h->depth, surf = h->surface;
     int64_t prim = h->prim;
+    double power = h->power_s + h->power_p;
     PUT(p, ray);
     PUT(p, depth);
     PUT(p, surf);
     PUT(p, prim);
-    memcpy(p, v, sizeof v);
-    p += sizeof v;
+    memcpy(p, h->pos, 3 * sizeof(double));
+    memcpy(p + 24, h->dir, 3 * sizeof(double));
+    memcpy(p + 48, &h->power_s, sizeof(double));
+    memcpy(p + 56, &h->power_p, sizeof(double));
+    memcpy(p + 64, &power, sizeof(double));
+    memcpy(p + 72, &h->length, sizeof(double));
+    memcpy(p + 80, &h->opl, sizeof(double));
+    p += 88;
     if (t->wl) {   /* CSV: the wavelength as it came (the formatter prints it) */
         double nm = t->fmt == SC_OUT_TEXT ? h->lambda : nm_of(t, h->lambda);
         PUT(p, nm);
