@@ -140,8 +140,9 @@ static int lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr
 }
 
 /* buf_move for a lane's hits: mostly its one hit at the detector, copied as a record of
- * known size (inline) rather than by memcpy's variable-length call. */
-static inline int hit_move(tr_buf *b, tr_buf *a)
+ * known size rather than by memcpy's variable-length call.  Out of line, called only
+ * when there are hits: the loop of a run without hit sinks keeps its code. */
+static __attribute__((noinline)) int hit_move(tr_buf *b, tr_buf *a)
 {
     if (a->n != 1 || b->n == b->cap) return buf_move(b, a);
     memcpy((trace_hit *)b->p + b->n++, a->p, sizeof(trace_hit));   /* padding too */
@@ -217,7 +218,8 @@ static void tr_trace_lanes(tr_worker *w, uint64_t i0, int *k)
             lane_leave(L, &pk[cur], l, last);
             L->state = LANE_SLOW;
         }
-        if (buf_move(&w->out.seg, &L->out.seg) || hit_move(&w->out.hit, &L->out.hit))
+        if (buf_move(&w->out.seg, &L->out.seg) ||
+            (L->out.hit.n && hit_move(&w->out.hit, &L->out.hit)))
             w->nomem = 1;
         if (L->state == LANE_SLOW)
             tr_trace_rest(w, &w->out, L->ty, L->stack, L->sp, &L->r, L->live, L->ray, L->p0);
