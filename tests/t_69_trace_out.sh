@@ -9,6 +9,10 @@
 # (golden/trace/scenes.sha256 holds the sums of both).
 
 cd "$TOP" || return 1
+# the engine's batch sink, which the writers take the records from, against the
+# one-by-one sink: the same bytes (tests/trace/t_batch.c)
+unit "$TOP/build/obj/trace_tests/t_batch"
+unit "$TOP/build/asan/trace_tests/t_batch"
 TO=$WORK/traceout
 mkdir -p "$TO"
 # a Python with NumPy and h5py (a pyenv shim may hide the system's)

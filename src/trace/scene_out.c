@@ -128,28 +128,36 @@ static long npy_header(const so_table *t, uint64_t n, char *out, long len)
 
 /* ---- CSV lines (in the formatter threads) ----------------------------------------- */
 
-/* A formatter's own memory of each column's last value and its digits (a detector
- * plane's z, a constant length: the digits are made once a run of them). */
+/* A formatter's own memory: the wavelength's text (made once a run of them). */
 typedef struct {
-    uint64_t last[NHIT];
-    char text[NHIT][40];
-    unsigned char len[NHIT];
     double nm_of;
     char nm_text[40];
     unsigned char nm_len;
 } csv_cache;
 
 /* The longest a CSV field can be ("-2.2250738585072014e-308", a 20-digit integer) and
- * its comma; the digit writer's copies reach 11 bytes past a number (the slack). */
+ * its comma; a number's digits are written with 8-byte stores that reach up to 32
+ * bytes from where it starts (sc_dtoa), and a repeated field is copied 32 bytes at a
+ * time: the slack after the last field. */
 enum { FIELD_MAX = 25, LINE_SLACK = 64 };
 
 static char *put_u64(char *p, uint64_t v)
 {
+    static const char d2[201] =
+        "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+        "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+        "8081828384858687888990919293949596979899";
     char tmp[24];
-    int n = 0;
-    do tmp[n++] = (char)('0' + v % 10); while (v /= 10);
-    while (n) *p++ = tmp[--n];
-    return p;
+    int n = 24;
+    while (v >= 100) {
+        n -= 2;
+        memcpy(tmp + n, d2 + 2 * (v % 100), 2);
+        v /= 100;
+    }
+    if (v >= 10) { n -= 2; memcpy(tmp + n, d2 + 2 * v, 2); }
+    else tmp[--n] = (char)('0' + v);
+    memcpy(p, tmp + n, (size_t)(24 - n));
+    return p + 24 - n;
 }
 
 static char *put_i64(char *p, int64_t v)
@@ -158,12 +166,18 @@ static char *put_i64(char *p, int64_t v)
     return put_u64(p, (uint64_t)v);
 }
 
-/* n bytes of binary hit rows as CSV lines at `text`; their length. */
+/* n bytes of binary hit rows as CSV lines at `text`; their length.  A field whose value
+ * (its bits) is the one before in its column -- a detector plane's z, the depth, the
+ * surface -- is copied from where it was written in this text (a row back: long
+ * written, so the copy does not wait on the stores) instead of made again. */
 static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n, char *text)
 {
     const so_table *t = ctx;
     const column *col = cols(t);
     csv_cache *c = cache;
+    const char *at[NHIT] = {0};   /* column i's last text in this chunk, its bits */
+    uint64_t last[NHIT];
+    unsigned char len[NHIT];
     char *p = text;
     for (const unsigned char *end = r + n; r < end; ) {
         for (int i = 0; i < t->ncol; i++) {
@@ -171,22 +185,7 @@ static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n,
             int32_t i32;
             double v;
             if (i) *p++ = ',';
-            switch (col[i].type) {
-            case C_U64: memcpy(&u, r, 8); p = put_u64(p, u); r += 8; break;
-            case C_I32: memcpy(&i32, r, 4); p = put_i64(p, i32); r += 4; break;
-            case C_I64: memcpy(&u, r, 8); p = put_i64(p, (int64_t)u); r += 8; break;
-            case C_F64:
-                memcpy(&u, r, 8);
-                r += 8;
-                if (!c->len[i] || u != c->last[i]) {
-                    memcpy(&v, &u, 8);
-                    c->last[i] = u;
-                    c->len[i] = (unsigned char)sc_dtoa(v, c->text[i]);
-                }
-                memcpy(p, c->text[i], 32);   /* the rest is the next field's room */
-                p += c->len[i];
-                break;
-            default:   /* C_NM: the um value, printed as "%.10g" of nm */
+            if (col[i].type == C_NM) {   /* the um value, printed as "%.10g" of nm */
                 memcpy(&v, r, 8);
                 r += 8;
                 if (!c->nm_len || v != c->nm_of) {
@@ -196,7 +195,33 @@ static size_t csv_rows(void *ctx, void *cache, const unsigned char *r, size_t n,
                 }
                 memcpy(p, c->nm_text, c->nm_len);
                 p += c->nm_len;
+                continue;
             }
+            if (col[i].type == C_I32) {
+                memcpy(&i32, r, 4);
+                u = (uint64_t)(int64_t)i32;
+                r += 4;
+            } else {
+                memcpy(&u, r, 8);
+                r += 8;
+            }
+            if (at[i] && u == last[i]) {   /* 32 bytes (the rest is the next field's
+                                              room), loaded before any is stored */
+                char b[32];
+                memcpy(b, at[i], 32);
+                memcpy(p, b, 32);
+                p += len[i];
+                continue;
+            }
+            char *q = p;
+            switch (col[i].type) {
+            case C_U64: p = put_u64(p, u); break;
+            case C_F64: memcpy(&v, &u, 8); p += sc_dtoa(v, p); break;
+            default: p = put_i64(p, (int64_t)u);   /* C_I32, C_I64 */
+            }
+            at[i] = q;
+            last[i] = u;
+            len[i] = (unsigned char)(p - q);
         }
         *p++ = '\n';
     }
@@ -257,22 +282,29 @@ so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int stokes, int 
     return t;
 }
 
-/* Room for one more binary row: a full chunk goes to the queue; HDF5 keeps growing. */
-static unsigned char *row_slot(so_table *t)
+/* Room for at least one more binary row (a full chunk goes to the queue; HDF5 keeps
+ * growing): how many rows fit now, 0 after a write error or out of memory. */
+static size_t room(so_table *t)
 {
     if (t->used + t->row > t->cap) {
         if (t->q) {
-            if (soq_submit(t->q, t->used)) return NULL;
+            if (soq_submit(t->q, t->used)) return 0;
             t->buf = soq_rows(t->q);
             t->used = 0;
         } else {
             size_t cap = t->cap ? t->cap * 2 : 65536;
             unsigned char *b = realloc(t->buf, cap);
-            if (!b) return NULL;
+            if (!b) return 0;
             t->buf = b;
             t->cap = cap;
         }
     }
+    return (t->cap - t->used) / t->row;
+}
+
+static unsigned char *row_slot(so_table *t)
+{
+    if (!room(t)) return NULL;
     unsigned char *p = t->buf + t->used;
     t->used += t->row;
     t->nrows++;
@@ -281,19 +313,46 @@ static unsigned char *row_slot(so_table *t)
 
 #define PUT(p, v) (memcpy((p), &(v), sizeof (v)), (p) += sizeof (v))
 
+/* Hit h's binary row at p (hit_cols' order; sv: its S0..S3, for a table with them).
+ * Field by field from the record to the row: x..dz and the two pairs after the powers
+ * lie in the record as in the row (no copy through a stack array, whose 8-byte
+ * stores a 16-byte load cannot take: it waits for them). */
+static inline void pack_hit(so_table *t, unsigned char *p, const trace_hit *h, uint64_t ray,
+                            const double *sv)
+{
+    int32_t depth = h->depth, surf = h->surface;
+    int64_t prim = h->prim;
+    double power = h->power_s + h->power_p;
+    PUT(p, ray);
+    PUT(p, depth);
+    PUT(p, surf);
+    PUT(p, prim);
+    memcpy(p, h->pos, 3 * sizeof(double));
+    memcpy(p + 24, h->dir, 3 * sizeof(double));
+    memcpy(p + 48, &h->power_s, sizeof(double));
+    memcpy(p + 56, &h->power_p, sizeof(double));
+    memcpy(p + 64, &power, sizeof(double));
+    memcpy(p + 72, &h->length, sizeof(double));
+    memcpy(p + 80, &h->opl, sizeof(double));
+    p += 88;
+    if (t->wl) {   /* CSV: the wavelength as it came (the formatter prints it) */
+        double nm = t->fmt == SC_OUT_TEXT ? h->lambda : nm_of(t, h->lambda);
+        PUT(p, nm);
+    }
+    if (t->st) memcpy(p, sv, 4 * sizeof *sv);
+}
+
+static const double no_stokes[4] = {NAN, NAN, NAN, NAN};
+
 int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double stokes[4])
 {
-    static const double none[4] = {NAN, NAN, NAN, NAN};
-    const double *sv = stokes ? stokes : none;
-    /* the double columns, in hit_cols' order */
-    const double v[11] = {h->pos[0], h->pos[1], h->pos[2], h->dir[0], h->dir[1], h->dir[2],
-                          h->power_s, h->power_p, h->power_s + h->power_p, h->length,
-                          h->opl};
+    const double *sv = stokes ? stokes : no_stokes;
     if (t->fmt == SC_OUT_CSV17) {   /* the bytes of before, number for number */
+        const double *p = h->pos, *d = h->dir;
         if (fprintf(f, "%llu,%d,%d,%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
                     "%.17g,%.17g,%.17g,%.17g", (unsigned long long)ray, h->depth,
-                    h->surface, h->prim, v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7],
-                    v[8], v[9], v[10]) < 0)
+                    h->surface, h->prim, p[0], p[1], p[2], d[0], d[1], d[2], h->power_s,
+                    h->power_p, h->power_s + h->power_p, h->length, h->opl) < 0)
             return 1;
         if (t->wl && fprintf(f, ",%.10g", h->lambda * 1e3) < 0) return 1;
         if (t->st && fprintf(f, ",%.17g,%.17g,%.17g,%.17g", sv[0], sv[1], sv[2], sv[3]) < 0)
@@ -302,19 +361,29 @@ int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double 
     }
     unsigned char *p = row_slot(t);
     if (!p) return 1;
-    int32_t depth = h->depth, surf = h->surface;
-    int64_t prim = h->prim;
-    PUT(p, ray);
-    PUT(p, depth);
-    PUT(p, surf);
-    PUT(p, prim);
-    memcpy(p, v, sizeof v);
-    p += sizeof v;
-    if (t->wl) {   /* CSV: the wavelength as it came (the formatter prints it) */
-        double nm = t->fmt == SC_OUT_TEXT ? h->lambda : nm_of(t, h->lambda);
-        PUT(p, nm);
+    pack_hit(t, p, h, ray, sv);
+    return 0;
+}
+
+int so_hits(so_table *t, FILE *f, const trace_hit *h, size_t n, uint64_t ray0)
+{
+    if (t->fmt == SC_OUT_CSV17) {
+        for (size_t i = 0; i < n; i++)
+            if (so_hit(t, f, h + i, h[i].ray + ray0, NULL)) return 1;
+        return 0;
     }
-    if (t->st) memcpy(p, sv, 4 * sizeof *sv);
+    while (n) {   /* as many rows as the chunk holds, in one loop */
+        size_t k = room(t);
+        if (!k) return 1;
+        if (k > n) k = n;
+        unsigned char *p = t->buf + t->used;
+        for (size_t i = 0; i < k; i++, p += t->row)
+            pack_hit(t, p, h + i, h[i].ray + ray0, no_stokes);
+        t->used += k * t->row;
+        t->nrows += k;
+        h += k;
+        n -= k;
+    }
     return 0;
 }
 
@@ -498,7 +567,17 @@ int so_h5_write(FILE *f, const so_table *hits, const so_table *segs, const so_su
     if (!rc && H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) rc = -1;
     if (!rc && (size = H5Fget_file_image(file, NULL, 0)) > 0 && (img = malloc((size_t)size)) &&
         H5Fget_file_image(file, img, (size_t)size) == size) {
-        if (fwrite(img, 1, (size_t)size, f) != (size_t)size) {
+        /* 1 MB a write: one write(2) of the whole image (120 MB for the triplet's
+         * hits) spent 10 times longer in the kernel's copy into the page cache
+         * (perf: copy_folio_from_iter_atomic, 0.9-1.1 of the trace's samples, against
+         * 0.03-0.08 so) */
+        size_t done = 0;
+        while (done < (size_t)size) {
+            size_t k = (size_t)size - done < (1u << 20) ? (size_t)size - done : 1u << 20;
+            if (fwrite((char *)img + done, 1, k, f) != k) break;
+            done += k;
+        }
+        if (done != (size_t)size) {
             snprintf(err, errmax, "write error");
             rc = -1;
         }

@@ -19,6 +19,9 @@ so_table *so_open(FILE *f, sc_out_format fmt, int hits, int wl, int stokes, int 
 /* One row (stokes: the hit's S0..S3 for a table with them, NULL: NaN); 0, or non-zero
  * on a write error (or out of memory). */
 int so_hit(so_table *t, FILE *f, const trace_hit *h, uint64_t ray, const double stokes[4]);
+/* n hits at once, each numbered h[i].ray + ray0 (the Stokes columns, if any, NaN): the
+ * bytes so_hit would write for each; 0 or non-zero as so_hit. */
+int so_hits(so_table *t, FILE *f, const trace_hit *h, size_t n, uint64_t ray0);
 int so_segment(so_table *t, FILE *f, const trace_segment *s);
 /* The table's end (.npy: the rest of the rows, the header's row count); 0 or -1. */
 int so_finish(so_table *t, FILE *f, char *err, size_t errmax);

@@ -8,11 +8,23 @@
  * that makes rows faster than the formatters can take them gives its own time to the
  * digits, and a machine without spare cores is no slower than doing it inline.
  * The chunks live in a ring indexed by their number (chunk s in slot s % nslot): they
- * are written in order, so a slot is free again once its chunk is out. */
+ * are written in order, so a slot is free again once its chunk is out.
+ * A regular file is committed with an fsync (src/common/lm_out.c): the writer starts
+ * the disk writes of what it has written every few MB (Linux: sync_file_range, no
+ * wait), so that the fsync at the end waits for the last few MB, not for the whole
+ * file, and the writeback's work is done beside the trace instead of after it. */
+#ifdef __linux__
+#define _GNU_SOURCE 1           /* sync_file_range */
+#include <fcntl.h>
+#endif
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
 #include "scene_out.h"
+
+enum { SYNC_EVERY = 8 << 20 };   /* bytes between two starts of writeback */
 
 enum { Q_FREE, Q_FILL, Q_READY, Q_BUSY, Q_DONE };
 
@@ -37,7 +49,24 @@ struct soq {
     pthread_cond_t cv;
     pthread_t *th;
     void *own_cache;           /* the filling thread's, when it formats */
+    int sync_fd;               /* a regular file's descriptor (early writeback), or -1 */
+    off_t synced;              /* where the last writeback started */
 };
+
+/* After a write: the disk writes of the file from where the last ones started, once
+ * SYNC_EVERY more bytes are in it (the writer's thread, lock not held; a hint: its
+ * failure changes nothing, the fsync at the commit still reports any error). */
+static void start_writeback(soq *q)
+{
+#ifdef __linux__
+    off_t at = q->sync_fd >= 0 ? ftello(q->f) : -1;
+    if (at < 0 || at - q->synced < SYNC_EVERY) return;
+    sync_file_range(q->sync_fd, q->synced, at - q->synced, SYNC_FILE_RANGE_WRITE);
+    q->synced = at;
+#else
+    (void)q;
+#endif
+}
 
 /* Format slot s (lock not held), with the formatter's cache c. */
 static void format_slot(soq *q, q_slot *s, void *c)
@@ -58,6 +87,7 @@ static void write_ready(soq *q)
         const void *b = q->fmt ? (const void *)s->text : (const void *)s->rows;
         size_t n = q->fmt ? s->tlen : s->n;
         int bad = !q->err && n && fwrite(b, 1, n, q->f) != n;
+        if (!bad) start_writeback(q);
         pthread_mutex_lock(&q->mu);
         q->err |= bad;
         s->state = Q_FREE;
@@ -145,6 +175,8 @@ soq *soq_new(FILE *f, int nthread, size_t chunk, size_t text_cap, soq_format fmt
         if (!q->slot[i].rows || (fmt && !q->slot[i].text)) goto bad;
     }
     q->slot[0].state = Q_FILL;
+    struct stat st;
+    q->sync_fd = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) ? fileno(f) : -1;
     pthread_mutex_init(&q->mu, NULL);
     pthread_cond_init(&q->cv, NULL);
     /* without threads (none could be made) the filling thread does it all */

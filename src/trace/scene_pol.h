@@ -24,8 +24,6 @@ int sp_open(const sc_scene *sc, sp_out *po, char *err);
  * ray0: elements, coatings, the table's rows.  0 or -1 (err: FILE:LINE). */
 int sp_engine(const trace_api *tr, trace_scene *ts, const sc_scene *sc, double l,
               uint64_t ray0, sp_out *po, char *err);
-/* A hit sink that keeps nothing (the engine hands its records only with hits). */
-int sp_nohit(void *ctx, const trace_hit *h);
 /* Commit the table when ok, else keep it as .part; 0 or -1 (err). */
 int sp_finish(sp_out *po, int ok, char *err);
 #endif

@@ -137,13 +137,6 @@ int sp_engine(const trace_api *tr, trace_scene *ts, const sc_scene *sc, double l
     return 0;
 }
 
-int sp_nohit(void *ctx, const trace_hit *h)
-{
-    (void)ctx;
-    (void)h;
-    return 0;
-}
-
 int sp_finish(sp_out *po, int ok, char *err)
 {
     char why[SC_ERRMAX];

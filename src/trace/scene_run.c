@@ -385,6 +385,46 @@ static int w_hit(void *ctx, const trace_hit *h)
     return rc;
 }
 
+/* The batch sink's side (trace_batch_sink): the same rows and the same polls as the
+ * callbacks above, record for record.  How many of n records go before the next poll
+ * (counted as poll_records counts: a poll before every 4096th); 0: stop. */
+static size_t poll_run(out *o, size_t n)
+{
+    if (o->records == 4095) {
+        o->records = 0;
+        return stop_now(o) ? 0 : 1;
+    }
+    size_t k = 4095 - o->records;
+    if (k > n) k = n;
+    o->records += (unsigned)k;
+    return k;
+}
+
+static int w_segments(void *ctx, const trace_segment *s, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (w_segment(ctx, s + i)) return 1;
+    return 0;
+}
+
+static int w_hits(void *ctx, const trace_hit *h, size_t n)
+{
+    out *o = ctx;
+    if (!o->hit_t) return 0;   /* no hits output: taken for polarization's records */
+    if (o->stokes) {           /* one at a time: each after its polarization record */
+        for (size_t i = 0; i < n; i++)
+            if (w_hit(ctx, h + i)) return 1;
+        return 0;
+    }
+    while (n) {
+        size_t k = poll_run(o, n);
+        if (!k || so_hits(o->hit_t, o->hit, h, k, o->ray0)) return 1;
+        h += k;
+        n -= k;
+    }
+    return 0;
+}
+
 /* A progress line on stderr, only on a terminal and once the trace has run 1 s. */
 static int w_progress(void *ctx, uint64_t done, uint64_t total)
 {
@@ -566,7 +606,7 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
     const trace_api *tr = engine();
     trace_scene *ts = NULL;
     trace_options opt;
-    trace_sink sink = {0};
+    trace_batch_sink sink = {0};
     out o = {0};
     sp_out po = {0};                /* polarization: scene_polout.c */
     int rc = TRACE_OK, nwl;
@@ -605,24 +645,24 @@ static int run(const sc_scene *sc, sc_result *res, char *err)
         if (!(o.seg = open_part(sc->out_segments, &o.seg_out, err)) ||
             !(o.seg_t = table(sc, o.seg, sc->out_format[0], 0, o.wl, sc->out_segments, err)))
             goto out;
-        sink.segment = w_segment;
+        sink.segments = w_segments;
     }
     if (sc->out_hits) {
         if ((!h5_shared(sc, 1) && !(o.hit = open_part(sc->out_hits, &o.hit_out, err))) ||
             !(o.hit_t = table(sc, o.hit, sc->out_format[1], 1, o.wl, sc->out_hits, err)))
             goto out;
-        sink.hit = w_hit;
+        sink.hits = w_hits;
     }
     if (sc->out_polar) {
         if (sp_open(sc, &po, err)) goto out;
-        if (!sink.hit) sink.hit = sp_nohit;   /* the records come with the hits */
+        if (!sink.hits) sink.hits = w_hits;   /* the records come with hits (none kept) */
     }
     /* one run per wavelength, in the order the sources name them; rays are numbered on
      * from one run to the next */
     for (int k = 0; k < nwl && rc >= 0; k++) {
         if (!ts && build_scene(tr, sc, wl[k], &ts, err)) goto out;
         if (sc->polar && sp_engine(tr, ts, sc, wl[k], o.ray0, &po, err)) goto out;
-        rc = stop_now(&o) ? TRACE_ECANCEL : tr->run(ts, &opt, &sink, &per[k]);
+        rc = stop_now(&o) ? TRACE_ECANCEL : tr->run_batches(ts, &opt, &sink, &per[k]);
         add_summary(&res->sum, &per[k]);
         o.ray0 += per[k].rays;
         if (rc >= 0) { tr->scene_free(ts); ts = NULL; }

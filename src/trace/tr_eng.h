@@ -316,6 +316,8 @@ void tr_trace_batch(tr_worker *w);
 void tr_options_default(trace_options *o);
 int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
            trace_summary *sum);
+int tr_run_batches(trace_scene *sc, const trace_options *oin, const trace_batch_sink *sink,
+                   trace_summary *sum);
 
 #pragma GCC visibility pop
 #endif

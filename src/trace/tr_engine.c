@@ -45,6 +45,7 @@ static const trace_api api = {
     tr_polarization,
     tr_set_polar,
     tr_prt_interface,
+    tr_run_batches,
 };
 
 const trace_api *trace_get_api(int abi)

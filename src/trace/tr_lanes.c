@@ -139,6 +139,13 @@ static int lane_books(tr_worker *w, tr_lane *L, int l, const tr_pk *in, const tr
     return 0;
 }
 
+/* buf_move for a lane's hits, out of line (the lanes loop copies a lane's one hit
+ * itself: below). */
+static __attribute__((noinline)) int hits_move(tr_buf *b, tr_buf *a)
+{
+    return buf_move(b, a);
+}
+
 /* Rays i0 .. i0+TR_LANES-1 of the worker side by side while each stays on the lens
  * shortcut, step by step in a packet (tr_pk_kernel.h); a lane that leaves it (no
  * candidate hit, depth limit, a ray going back, TIR, reflections waiting) is finished
@@ -207,8 +214,16 @@ static void tr_trace_lanes(tr_worker *w, uint64_t i0, int *k)
             lane_leave(L, &pk[cur], l, last);
             L->state = LANE_SLOW;
         }
-        if (buf_move(&w->out.seg, &L->out.seg) || buf_move(&w->out.hit, &L->out.hit))
+        if (buf_move(&w->out.seg, &L->out.seg)) w->nomem = 1;
+        if (L->out.hit.n == 1 && w->out.hit.n < w->out.hit.cap) {
+            /* mostly the lane's one hit at the detector: a copy of known size (padding
+             * too), not memcpy's variable-length call */
+            trace_hit *to = (trace_hit *)w->out.hit.p + w->out.hit.n++;
+            memcpy(to, L->out.hit.p, sizeof(trace_hit));
+            L->out.hit.n = 0;
+        } else if (L->out.hit.n && hits_move(&w->out.hit, &L->out.hit)) {
             w->nomem = 1;
+        }
         if (L->state == LANE_SLOW)
             tr_trace_rest(w, &w->out, L->ty, L->stack, L->sp, &L->r, L->live, L->ray, L->p0);
         tr_fold(w, i0 + (uint64_t)l, L->ty);

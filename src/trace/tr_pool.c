@@ -1,6 +1,7 @@
 /* tr_pool.c -- the run: options, the thread pool and its window of batches, the
- * delivery of records to the sinks in ray order, and the summary summed in ray order
- * (so every result is the same to the last bit for any thread count). */
+ * delivery of records to the sinks in ray order (one by one, or a batch at a time),
+ * and the summary summed in ray order (so every result is the same to the last bit
+ * for any thread count). */
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -172,23 +173,43 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
-/* Hand a batch's records to the sinks (segments, then hits: each in ray order). */
-static int deliver(const trace_scene *sc, const tr_slot *s, const trace_sink *k)
+/* The sinks of a run: trace_sink's (one record a call) or trace_batch_sink's (a batch's
+ * records a call), whichever the run was given. */
+typedef struct tr_sinks {
+    void *ctx;
+    int (*segment)(void *ctx, const trace_segment *seg);
+    int (*hit)(void *ctx, const trace_hit *hit);
+    int (*segments)(void *ctx, const trace_segment *seg, size_t n);
+    int (*hits)(void *ctx, const trace_hit *hit, size_t n);
+    int (*progress)(void *ctx, uint64_t done, uint64_t total);
+} tr_sinks;
+
+/* Hand a batch's records to the sinks (segments, then hits: each in ray order; a hit's
+ * polarization record just before it). */
+static int deliver(const trace_scene *sc, const tr_slot *s, const tr_sinks *k)
 {
-    for (size_t i = 0; k->segment && i < s->out.seg.n; i++)
-        if (k->segment(k->ctx, (const trace_segment *)s->out.seg.p + i))
+    const trace_segment *seg = s->out.seg.p;
+    const trace_hit *hit = s->out.hit.p;
+    size_t nseg = s->out.seg.n, nhit = s->out.hit.n;
+    size_t npol = s->out.pol.n < nhit ? s->out.pol.n : nhit;
+    if (k->segments && nseg && k->segments(k->ctx, seg, nseg)) return TRACE_ECANCEL;
+    for (size_t i = 0; k->segment && i < nseg; i++)
+        if (k->segment(k->ctx, seg + i)) return TRACE_ECANCEL;
+    if (!k->hit && !k->hits) return TRACE_OK;
+    for (size_t i = 0; i < nhit; i++) {
+        if (k->hits && i >= npol)   /* the rest (all, without polarization) at once */
+            return k->hits(k->ctx, hit + i, nhit - i) ? TRACE_ECANCEL : TRACE_OK;
+        if (i < npol && tr_polar_deliver(sc, (const trace_polar_hit *)s->out.pol.p + i))
             return TRACE_ECANCEL;
-    for (size_t i = 0; k->hit && i < s->out.hit.n; i++) {
-        if (i < s->out.pol.n && tr_polar_deliver(sc, (const trace_polar_hit *)s->out.pol.p + i))
+        if (k->hits ? k->hits(k->ctx, hit + i, 1) : k->hit(k->ctx, hit + i))
             return TRACE_ECANCEL;
-        if (k->hit(k->ctx, (const trace_hit *)s->out.hit.p + i)) return TRACE_ECANCEL;
     }
     return TRACE_OK;
 }
 
 /* The caller's loop: deliver the next batch when it is done, else trace one, else
  * wait.  Returns TRACE_OK or the first error; the tallies go into *sum. */
-static int drive(trace_scene *sc, tr_pool *p, tr_worker *w, const trace_sink *sink,
+static int drive(trace_scene *sc, tr_pool *p, tr_worker *w, const tr_sinks *sink,
                  trace_summary *sum)
 {
     int rc = TRACE_OK;
@@ -334,24 +355,22 @@ static int lens_surfaces(const trace_scene *sc, const trace_options *o)
     return n;
 }
 
-int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
-               trace_summary *sum)
+static int run_sinks(trace_scene *sc, const trace_options *oin, const tr_sinks *sink,
+                     trace_summary *sum)
 {
     trace_options o;
     trace_summary s;
-    trace_sink none = {0};
     tr_pool p;
     int rc;
     if (!sc) return TRACE_EINVAL;
     if (oin) o = *oin; else tr_options_default(&o);
-    if (!sink) sink = &none;
     memset(&s, 0, sizeof s);
     if (sum) memset(sum, 0, sizeof *sum);
     if ((rc = check_options(sc, &o))) return rc;
     if ((rc = tr_build(sc, &s.build_ms))) return rc;
     int nthr = o.threads ? o.threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
     if (nthr < 1) nthr = 1;
-    int want_seg = sink->segment != NULL, want_hit = sink->hit != NULL;
+    int want_seg = sink->segment || sink->segments, want_hit = sink->hit || sink->hits;
     memset(&p, 0, sizeof p);
     p.sc = sc;
     p.nslot = nthr == 1 ? 1 : 2 * nthr + 2;   /* one thread: trace, deliver, again */
@@ -416,4 +435,30 @@ int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
     free(tid);
     if (sum) *sum = s;
     return rc;
+}
+
+int tr_run(trace_scene *sc, const trace_options *oin, const trace_sink *sink,
+           trace_summary *sum)
+{
+    tr_sinks k = {0};
+    if (sink) {
+        k.ctx = sink->ctx;
+        k.segment = sink->segment;
+        k.hit = sink->hit;
+        k.progress = sink->progress;
+    }
+    return run_sinks(sc, oin, &k, sum);
+}
+
+int tr_run_batches(trace_scene *sc, const trace_options *oin, const trace_batch_sink *sink,
+                   trace_summary *sum)
+{
+    tr_sinks k = {0};
+    if (sink) {
+        k.ctx = sink->ctx;
+        k.segments = sink->segments;
+        k.hits = sink->hits;
+        k.progress = sink->progress;
+    }
+    return run_sinks(sc, oin, &k, sum);
 }

@@ -240,6 +240,21 @@ typedef struct trace_sink {
     int (*progress)(void *ctx, uint64_t done, uint64_t total);   /* per batch */
 } trace_sink;
 
+/* The same records a batch at a time (trace_api.run_batches, added after
+ * prt_interface): segments() gets a batch's segments, hits() its hits, as arrays of n
+ * records (n >= 1) in the order trace_sink's callbacks would get them one by one, from
+ * the same thread; the array is the engine's and holds until the call returns.  One
+ * call per callback and batch -- except with polarization on, whose record for each hit
+ * comes just before the call holding that hit: such hits come one per call.  Cuts a
+ * call per record (and lets the caller copy a batch in one loop).  Each returns 0 to
+ * go on, non-zero to cancel (TRACE_ECANCEL); NULL: not wanted. */
+typedef struct trace_batch_sink {
+    void *ctx;
+    int (*segments)(void *ctx, const trace_segment *seg, size_t n);
+    int (*hits)(void *ctx, const trace_hit *hit, size_t n);
+    int (*progress)(void *ctx, uint64_t done, uint64_t total);   /* per batch */
+} trace_batch_sink;
+
 typedef struct trace_summary {
     uint64_t rays;             /* source rays */
     uint64_t segments;
@@ -507,6 +522,12 @@ typedef struct trace_api {
     int (*prt_interface)(const double k_in[3], const double nrm[3], double n1, double n2,
                          const trace_polar_surface *ps, double lambda, int reflect,
                          double P[3][3][2], double k_out[3]);
+
+    /* run() with a sink that takes each batch's records at once (trace_batch_sink,
+     * above; added after prt_interface): the same records in the same order, the same
+     * summary, the same return codes.  sink may be NULL; sum may be NULL. */
+    int (*run_batches)(trace_scene *sc, const trace_options *o,
+                       const trace_batch_sink *sink, trace_summary *sum);
 } trace_api;
 
 typedef const trace_api *(*trace_get_api_fn)(int abi);
