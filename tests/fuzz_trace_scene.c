@@ -1,6 +1,6 @@
 /* fuzz_trace_scene.c -- libFuzzer target for the trace front end's readers
- * (src/trace/scene_lex.c, scene_mesh.c, scene_read.c, scene_axial.c) and tessellation
- * (scene_geom.c).  The first byte picks
+ * (src/trace/scene_lex.c, scene_mesh.c, scene_read.c, scene_fields.c, scene_axial.c)
+ * and tessellation (scene_geom.c).  The first byte picks
  * the reader: 's' scene file, 't' triangle file, 'n' media file (for as many
  * triangles as the second byte says), 'o' OBJ; anything else: all of them.  Every
  * input must give 0 or -1 with a "NAME:LINE: ..." message, never a crash, a leak or

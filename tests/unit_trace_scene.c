@@ -11,6 +11,7 @@
 #include "../src/trace/scene_lex.c"
 #include "../src/trace/scene_mesh.c"
 #include "../src/trace/scene_read.c"
+#include "../src/trace/scene_fields.c"
 #include "../src/trace/scene_axial.c"
 #include "../src/trace/scene_polar.c"
 #include "../src/trace/scene_geom.c"
