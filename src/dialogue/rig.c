@@ -502,7 +502,7 @@ static void beam_oblique(rdlg *d, const rg_spots *s)
     spot_line(d, P(BEAM_SPOT_SMALL), &s->small);
     const rg_spot_pose *dm = &s->dim;
     char how[96];
-    if (s->laser_pol_set)
+    if (d->rig.laser_pol_set)
         snprintf(how, sizeof how, P(BEAM_FRESNEL_LIN), d->rig.laser_pol[0],
                  d->rig.laser_pol[1], d->rig.laser_pol[2]);
     else snprintf(how, sizeof how, "%s", P(BEAM_FRESNEL_UNPOL));

@@ -10,16 +10,11 @@
 #include <math.h>
 #include <stdio.h>
 #include "rig/rg_hw.h"
+#include "rig/rg_vec.h"
 #include "paraxial/paraxial.h"
 
 #define H_PLANCK 6.62607015e-34
 #define C_LIGHT 299792458.0
-
-static double dist(const double a[3], const double b[3])
-{
-    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                (a[2] - b[2]) * (a[2] - b[2]));
-}
 
 typedef struct chain {
     const rg_spots *s;          /* the laser's waist (w0, waist_before_m1) and path */
@@ -100,11 +95,9 @@ int rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
     if (!geo || !geo->solve) return RG_EINVAL;
     if (rig->laser_pol_set) {
         const double *e = rig->laser_pol, *d = rig->geom.laser_dir;
-        double c[3] = {e[1] * d[2] - e[2] * d[1], e[2] * d[0] - e[0] * d[2],
-                       e[0] * d[1] - e[1] * d[0]};
-        if (!(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) >
-              1e-9 * sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) *
-                     sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))) {
+        double c[3];
+        v3cross(c, e, d);
+        if (!(v3len(c) > 1e-9 * v3len(e) * v3len(d))) {
             snprintf(err, cap, "%s:%d: 'laser_polarization': the field %g %g %g lies along "
                      "the beam (laser_dir): a field is across it", rig->path,
                      rig->laser_pol_line, e[0], e[1], e[2]);
@@ -124,10 +117,10 @@ int rg_spots_run(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
         s->ref_not_apex = 1;
     }
     s->ref = t;
-    s->path[0] = dist(rig->geom.laser_at, sol.beam.h1);
-    s->path[1] = dist(sol.beam.h1, sol.beam.h2);
-    s->path[2] = dist(sol.beam.h2, sol.beam.spot);
-    s->path[3] = dist(sol.beam.spot, sol.beam.det);
+    s->path[0] = v3dist(rig->geom.laser_at, sol.beam.h1);
+    s->path[1] = v3dist(sol.beam.h1, sol.beam.h2);
+    s->path[2] = v3dist(sol.beam.h2, sol.beam.spot);
+    s->path[3] = v3dist(sol.beam.spot, sol.beam.det);
     if (!isfinite(s->path[3])) {
         snprintf(err, cap, "the beam from the apex never crosses the detector plane");
         return RG_EINVAL;

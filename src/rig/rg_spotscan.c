@@ -102,7 +102,7 @@ typedef struct pgeom {
     rg_target t;
     rg_pose pose;
     double path[4], theta, K[3];
-    double tout[3], es[3], d3[3], e1[3], e2[3], det_inc, s_frac;
+    double tout[3], es[3], e1[3], e2[3], det_inc, s_frac;
 } pgeom;
 
 static int pose_geom(const rg_rig *rig, const rg_target *t, pgeom *q, char *err, size_t cap)
@@ -140,7 +140,6 @@ static int pose_geom(const rg_rig *rig, const rg_target *t, pgeom *q, char *err,
     q->t = *t;
     q->pose = sol.pose;
     q->theta = bm->inc3;
-    v3copy(q->d3, bm->d3);
     v3axpy(q->tout, et, -v3dot(et, bm->d3), bm->d3);
     v3norm(q->tout);
     v3sub(wn, g->detector, g->cornea.trans);
@@ -214,8 +213,7 @@ int rg_spot_pose_run(const rg_rig *rig, const rg_spots *s, const rg_target *t,
 {
     pgeom q;
     int rc;
-    memset(p, 0, sizeof *p);
-    if ((rc = pose_geom(rig, t, &q, err, cap))) return rc;
+    if ((rc = pose_geom(rig, t, &q, err, cap))) { memset(p, 0, sizeof *p); return rc; }
     return pose_beam(s, &q, s->lens_at > 0 ? s->lens_f : 0, s->lens_at, p, err, cap);
 }
 
@@ -298,7 +296,6 @@ int rg_spots_scan(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
     }
     s->scan_h = rg_spots_height(rig);
     s->scan_n = s->scan_bad = 0;
-    s->laser_pol_set = rig->laser_pol_set;
     if (!s->ref_not_apex) {
         if ((rc = pose_geom(rig, &t, &q[0], err, cap)) ||
             (rc = pose_beam(s, &q[0], s->lens_at > 0 ? s->lens_f : 0, s->lens_at, &s->apex,
@@ -328,7 +325,6 @@ int rg_spots_scan(const rg_rig *rig, rg_spots *s, char *err, size_t cap)
         snprintf(err, cap, "no pose of the scan has a beam to the detector: %s", e);
         return RG_EINVAL;
     }
-    s->low_refl = s->dim.reflectance;
     scan_lens(s, q, n);
     free(q);
     return RG_OK;

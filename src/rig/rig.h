@@ -506,12 +506,10 @@ typedef struct rg_spots {
      * the larger of the beam radius on the cornea and the detector spot's major
      * semi-axis, over every pose that solves -- is smallest; its worst figures and the
      * apex-model lens's (best_f) on the same scan */
-    int laser_pol_set;          /* rg_rig's: 1 linear, 0 unpolarized */
     int scan_best_is_none;      /* 1: no lens does better over the scan than none */
     double scan_best_f, scan_best_cornea, scan_best_det;
     double apexlens_worst_cornea, apexlens_worst_det;
-    double low_refl;            /* the scan's lowest reflectance ... */
-    rg_spot_pose dim;           /* ... at this pose */
+    rg_spot_pose dim;           /* the pose of the scan's lowest reflectance */
 } rg_spots;
 /* ==== end of the machine ========================================================= */
 

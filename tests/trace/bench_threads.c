@@ -57,18 +57,8 @@ static run timed(trace_scene *sc, int threads)
 
 static trace_scene *lens_scene(void)
 {
-    trace_lens_surface s[TT_NSURF];
-    trace_lens l;
-    tt_triplet(s, &l, 1);
-    l.z_detector = tt_paraxial_image(&l, -INFINITY);
-    trace_scene *sc = tr->scene_new();
-    if (tr->add_lens(sc, &l) < 0) { fprintf(stderr, "%s\n", tr->error(sc)); exit(1); }
-    trace_source src = {0};
-    src.type = TRACE_SRC_GRID;
-    src.at[2] = -5; src.dir[2] = 1; src.up[1] = 1;
-    src.radius = TT_EPD / 2;
-    src.count = 800;
-    tr->add_source(sc, &src, NULL);
+    trace_scene *sc = tt_triplet_grid(tr, 800, TT_EPD / 2);
+    if (!sc) { fprintf(stderr, "bench_threads: the triplet scene was refused\n"); exit(1); }
     return sc;
 }
 

@@ -91,20 +91,8 @@ static int pol(void *c, const trace_polar_hit *ph)
  * count x count rays over the pupil; polar: polarization on (record sink x). */
 static trace_scene *triplet(long count, int polar, rec *x)
 {
-    trace_lens_surface s[TT_NSURF];
-    trace_lens l;
-    tt_triplet(s, &l, 1);
-    l.z_detector = tt_paraxial_image(&l, -INFINITY);
-    trace_scene *sc = tr->scene_new();
-    trace_source src = {0};
-    src.type = TRACE_SRC_GRID;
-    src.dir[2] = 1;
-    src.at[2] = -5;
-    src.radius = TT_EPD / 2 * 1.3;   /* some rays on the mounts */
-    src.count = count;
-    src.up[1] = 1;
-    if (!sc || tr->add_lens(sc, &l) < 0 || tr->add_source(sc, &src, NULL) < 0 ||
-        (polar && tr->polarization(sc, 1, NULL, pol, x) != TRACE_OK)) {
+    trace_scene *sc = tt_triplet_grid(tr, count, TT_EPD / 2 * 1.3);   /* some on the mounts */
+    if (!sc || (polar && tr->polarization(sc, 1, NULL, pol, x) != TRACE_OK)) {
         printf("FAIL cannot make the triplet scene\n");
         exit(1);
     }

@@ -111,18 +111,7 @@ static int keep(void *ctx, const trace_hit *h) { return push(ctx, h, sizeof *h);
  * grid of count x count rays filling the pupil. */
 static trace_scene *triplet_grid(const trace_api *tr, long count)
 {
-    trace_lens_surface s[TT_NSURF];
-    trace_lens l;
-    tt_triplet(s, &l, 1);
-    l.z_detector = tt_paraxial_image(&l, -INFINITY);
-    trace_scene *sc = tr->scene_new();
-    trace_source src = {0};
-    src.type = TRACE_SRC_GRID;
-    src.dir[2] = 1; src.at[2] = -5; src.radius = TT_EPD / 2; src.count = count;
-    src.up[1] = 1;
-    tr->add_lens(sc, &l);
-    tr->add_source(sc, &src, NULL);
-    return sc;
+    return tt_triplet_grid(tr, count, TT_EPD / 2);
 }
 
 static void threads_bitwise(const trace_api *tr)

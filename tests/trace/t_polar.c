@@ -75,7 +75,9 @@ static trace_scene *one_ray(const double o[3], const double d[3], const double *
     return sc;
 }
 
-static int run(trace_scene *sc, rec *x, int reflections, trace_summary *sum)
+/* Trace with polarization on, the Stokes frame's reference xref (NULL: +x), records into x. */
+static int run_ref(trace_scene *sc, rec *x, int reflections, const double xref[3],
+                   trace_summary *sum)
 {
     trace_options o;
     tr->options_default(&o);
@@ -84,22 +86,13 @@ static int run(trace_scene *sc, rec *x, int reflections, trace_summary *sum)
     o.threads = 1;
     trace_sink k = {x, NULL, keep_hit, NULL};
     x->n = x->np = 0;
-    if (tr->polarization(sc, 1, NULL, keep_pol, x)) return -1;
+    if (tr->polarization(sc, 1, xref, keep_pol, x)) return -1;
     return tr->run(sc, &o, &k, sum);
 }
 
-/* run() with the Stokes frame's reference xref */
-static int run_ref(trace_scene *sc, rec *x, const double xref[3], trace_summary *sum)
+static int run(trace_scene *sc, rec *x, int reflections, trace_summary *sum)
 {
-    trace_options o;
-    tr->options_default(&o);
-    o.reflections = 0;
-    o.cutoff = 0;
-    o.threads = 1;
-    trace_sink k = {x, NULL, keep_hit, NULL};
-    x->n = x->np = 0;
-    if (tr->polarization(sc, 1, xref, keep_pol, x)) return -1;
-    return tr->run(sc, &o, &k, sum);
+    return run_ref(sc, x, reflections, NULL, sum);
 }
 
 static int balance_ok(const trace_summary *s)
@@ -261,7 +254,7 @@ static double two_tirs(double th1, double th2, double psi, double phi, const dou
     add_plane(sc, C, k2, 2, TRACE_DETECT, n, n);
     static rec x;
     trace_summary sum;
-    int rc = run_ref(sc, &x, xref, &sum);
+    int rc = run_ref(sc, &x, 0, xref, &sum);
     tr->scene_free(sc);
     *ntir = (int)sum.tir;
     return rc == 0 && x.np == 1 ? x.p[0].retardance : NAN;

@@ -62,6 +62,28 @@ static double tt_paraxial_image(const trace_lens *l, double z_obj)
     return z - y / u;
 }
 
+/* The triplet with mounts and a detector at its paraxial focus in a new scene, lit from
+ * z = -5 by a collimated grid of count x count rays over a disc of the given radius
+ * (TT_EPD / 2: the pupil); NULL if the engine refuses it (add_lens copies the lens). */
+static trace_scene *tt_triplet_grid(const trace_api *tr, long count, double radius)
+{
+    trace_lens_surface s[TT_NSURF];
+    trace_lens l;
+    tt_triplet(s, &l, 1);
+    l.z_detector = tt_paraxial_image(&l, -INFINITY);
+    trace_scene *sc = tr->scene_new();
+    trace_source src = {0};
+    src.type = TRACE_SRC_GRID;
+    src.at[2] = -5; src.dir[2] = 1; src.up[1] = 1;
+    src.radius = radius;
+    src.count = count;
+    if (sc && (tr->add_lens(sc, &l) < 0 || tr->add_source(sc, &src, NULL) < 0)) {
+        tr->scene_free(sc);
+        return NULL;
+    }
+    return sc;
+}
+
 /* Effective focal length (paraxial, object at infinity). */
 static double tt_efl(const trace_lens *l)
 {
