@@ -5,6 +5,11 @@
 # scene without the mesh; the peak resident memory of each lensmat process (getrusage
 # of the child: VmHWM) in the same run:
 #   trace_mesh_bytes_per_tri   (peak with the mesh - peak without) / triangles (<= 120)
+#   trace_mesh_bytes_per_tri_one_bvh   the same with the mesh as one BVH
+#                              (LENSMAT_TRACE_CHUNK=0: the layout before chunks)
+#   trace_mesh_chunked_vs_one_bvh   what the chunks cost in speed: the same mesh traced
+#                              by 125 676 rays (1.06 M segments), trace time as one BVH
+#                              over the time in chunks, three alternated rounds, medians
 # Then tests/trace/bench_mesh.c: trace_mesh_vs_raw_embree (see there).
 # BENCH_QUICK=1: 248 000 triangles, smaller grids.
 set -e
@@ -37,7 +42,7 @@ printf '%s\n' "plane detect at 0 0 30 normal 0 0 1 disc 100" \
 { echo "mesh refract 1 1.5 file ball.obj"; cat "$W/empty.scene"; } > "$W/mesh.scene"
 # peak KB of one lensmat run on SCENE (a child of its own python, so getrusage sees it alone)
 peak() {
-    python3 - "$LM" "$W" "$1" <<'PY'
+    LENSMAT_TRACE_CHUNK=$2 python3 - "$LM" "$W" "$1" <<'PY'
 import resource, subprocess, sys
 lm, w, scene = sys.argv[1:4]
 p = subprocess.run([lm, "--trace", "-i", "/dev/stdin", w + "/r.rec"], cwd=w,
@@ -52,6 +57,19 @@ echo "# $nt triangles ($(($(wc -c < "$W/ball.obj") / 1048576)) MB OBJ): peak RSS
 awk -v e1="$e1" -v e2="$e2" -v m1="$m1" -v m2="$m2" -v n="$nt" 'BEGIN {
     e = e1 < e2 ? e1 : e2; m = m1 < m2 ? m1 : m2
     printf "BENCH trace_mesh_bytes_per_tri %.1f bytes\n", (m - e) * 1024 / n }'
+o1=$(peak mesh.scene 0); o2=$(peak mesh.scene 0)
+awk -v e1="$e1" -v e2="$e2" -v m1="$o1" -v m2="$o2" -v n="$nt" 'BEGIN {
+    e = e1 < e2 ? e1 : e2; m = m1 < m2 ? m1 : m2
+    printf "BENCH trace_mesh_bytes_per_tri_one_bvh %.1f bytes\n", (m - e) * 1024 / n }'
+sed 's/radius 5 grid 10/radius 9.9 grid 400/' "$W/mesh.scene" > "$W/speed.scene"
+tms() {   # trace ms of speed.scene with LENSMAT_TRACE_CHUNK=$1 (empty: the default)
+    (cd "$W" && printf 'scene\nspeed.scene\nn\n' | LENSMAT_TRACE_CHUNK=$1 "$LM" --trace -i /dev/stdin s.rec) |
+        sed -n 's/^Build .* ms, trace \([0-9.e+]*\) ms.*/\1/p'
+}
+c1=$(tms ""); b1=$(tms 0); c2=$(tms ""); b2=$(tms 0); c3=$(tms ""); b3=$(tms 0)
+echo "# in chunks: $c1 $c2 $c3 ms; one BVH: $b1 $b2 $b3 ms (load $(cut -d' ' -f1 /proc/loadavg))"
+echo "$c1 $c2 $c3 $b1 $b2 $b3" | awk 'function med(a, b, c) { return a + b + c - (a > b ? (a > c ? a : c) : (b > c ? b : c)) - (a < b ? (a < c ? a : c) : (b < c ? b : c)) }
+    { printf "BENCH trace_mesh_chunked_vs_one_bvh %.3f ratio\n", med($4, $5, $6) / med($1, $2, $3) }'
 # the BVH path against bare Embree, per segment, on the scenes users trace
 # (tests/trace/bench_mesh.c: trace_mesh_vs_raw_embree and its _alone, _mirror, _tir,
 # _mix variants)

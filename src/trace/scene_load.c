@@ -103,6 +103,12 @@ static int from_scene(const sc_surface *s, char *err)
  * with some room: 186 a triangle on the 998 000-triangle sphere (174 measured), 266 on
  * the same as a triangle soup (3 vertices a triangle; 242 without the text) */
 #define SC_MESH_BYTES_PER_TRI 170.0
+/* a mesh of more than SC_MESH_CHUNK triangles (the engine's TR_CHUNK_TRI) goes to
+ * Embree in chunks, each one's grown triangles and build temporaries gone before the
+ * next (tr_meshbvh.c): 62 bytes a triangle less (112 measured on the sphere, estimated
+ * 124) */
+#define SC_MESH_CHUNK 131072
+#define SC_MESH_CHUNKED_PER_TRI 108.0
 #define SC_MESH_RES_PER_VTX 32.0
 #define SC_MESH_BYTES_PER_VTX 48.0     /* while parsing (with the array's growth) */
 #define SC_MESH_VBYTES_PER_TRI 320.0   /* address space */
@@ -184,8 +190,9 @@ static int mesh_fits(const char *path, int obj, char *err)
         return 0;   /* the reader says what is wrong with it */
     double text = (double)st.st_size, mb = 1048576;
     double nvk = obj ? nv : 3 * nt;      /* a triangle file: three vertices each */
+    double per = nt > SC_MESH_CHUNK ? SC_MESH_CHUNKED_PER_TRI : SC_MESH_BYTES_PER_TRI;
     double need = fmax(text + nv * SC_MESH_BYTES_PER_VTX + nt * 24,
-                       nt * SC_MESH_BYTES_PER_TRI + nvk * SC_MESH_RES_PER_VTX);
+                       nt * per + nvk * SC_MESH_RES_PER_VTX);
     /* address space: Embree's allocator and each thread's malloc arena reserve more
      * than they touch (measured: a limit of 475 MB lets a 1e6-triangle OBJ trace on
      * one thread, 325 MB 5e5, 300 MB 1.8e5, with 70 MB mapped before): 320 bytes a
@@ -197,7 +204,7 @@ static int mesh_fits(const char *path, int obj, char *err)
         return snprintf(err, SC_ERRMAX, "%s: %.0f triangles need about %.0f MB to trace "
                         "(%.0f bytes a triangle and %.0f a vertex, the file's %.0f MB while "
                         "it is read), more than the %.0f MB of memory available "
-                        "(MemAvailable): not read", path, nt, need / mb, SC_MESH_BYTES_PER_TRI,
+                        "(MemAvailable): not read", path, nt, need / mb, per,
                         SC_MESH_RES_PER_VTX, text / mb, avail / mb), -1;
     if (room >= 0 && vneed > room)
         return snprintf(err, SC_ERRMAX, "%s: %.0f triangles need about %.0f MB of address "

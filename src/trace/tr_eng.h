@@ -32,6 +32,9 @@ typedef struct tr_surf {
     uint32_t *weld;            /* mesh: nv, the first vertex at each one's coordinates */
     uint32_t *vt_start, *vt_tri;   /* mesh: the triangles around each welded vertex
                                   (tr_wt.c): vt_tri[vt_start[w] .. vt_start[w + 1]) */
+    uint32_t *perm;            /* mesh in chunks (tr_meshbvh.c): the triangles in
+                                  their spatial order, chunk after chunk; NULL: one BVH */
+    int ch0;                   /* ... the Embree instance ID of its first chunk */
     int seq[4], nseq;          /* lens: the only surfaces a forward ray can meet next */
     const tr_shape *seqg[4];   /* ... and their shapes */
     tr_pk_set pk;              /* ... laid out for the packet */
@@ -71,6 +74,11 @@ struct trace_scene {
                                   in double before Embree, not as its user geometry
                                   (tr_build, tr_hit.c) */
     int nembree;               /* surfaces Embree holds */
+    long chunk;                /* a mesh of more triangles than this goes to Embree in
+                                  chunks of this many (tr_meshbvh.c); 0: never */
+    int *ch_surf, nch;         /* each chunk's mesh; chunk k is Embree instance
+                                  ch_base + k */
+    int ch_base;
     int ngroup;                /* surfaces in a group of coincident ones */
     int nclosed;               /* closed meshes */
     double elo[3], ehi[3];     /* ... their box, grown by epad */
@@ -263,6 +271,17 @@ int tr_set_absorption(trace_scene *sc, int id, double alpha_front, double alpha_
 int tr_build(trace_scene *sc, double *ms);
 /* ---- a sequential lens inside any scene (tr_seqscan.c): the lens hints ---- */
 void tr_seq_detect(trace_scene *sc);
+/* ---- a mesh's Embree geometry (tr_meshbvh.c) ---- */
+#define TR_CHUNK_TRI 131072
+int tr_mesh_attach(trace_scene *sc, tr_surf *f);
+/* The mesh triangle behind Embree's primID in the instance instID (a chunk), or in
+ * the mesh itself (instID invalid). */
+static inline long tr_mesh_prim(const trace_scene *sc, unsigned inst, unsigned prim)
+{
+    if (inst == RTC_INVALID_GEOMETRY_ID) return prim;
+    const tr_surf *f = sc->surf[sc->ch_surf[inst - (unsigned)sc->ch_base]];
+    return f->perm[(size_t)(inst - (unsigned)f->ch0) * (size_t)sc->chunk + prim];
+}
 /* ---- the next hit (tr_hit.c) ---- */
 /* Embree's callbacks (tr_build attaches them). */
 void tr_user_intersect(const struct RTCIntersectFunctionNArguments *a);

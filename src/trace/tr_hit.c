@@ -26,6 +26,18 @@ typedef struct tr_ctx {
     int nx;
 } tr_ctx;
 
+/* Embree's query; a hit in a mesh's chunk (tr_meshbvh.c) told as the mesh's own:
+ * its surface and triangle number. */
+static inline void query(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh)
+{
+    rtcIntersect1(sc->scn, &x->ec, rh);
+    unsigned k = rh->hit.instID[0];
+    if (k == RTC_INVALID_GEOMETRY_ID) return;
+    rh->hit.primID = (unsigned)tr_mesh_prim(sc, k, rh->hit.primID);
+    rh->hit.geomID = (unsigned)sc->ch_surf[k - (unsigned)sc->ch_base];
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
 /* Front-facing unit normal of an analytic surface from tr_shape_hit's. */
 static void front_normal(const tr_shape *g, double n[3])
 {
@@ -130,7 +142,8 @@ void tr_mesh_filter(const struct RTCFilterFunctionNArguments *a)
     if (a->N != 1 || !a->valid[0]) return;
     const tr_ctx *x = (const tr_ctx *)a->context;
     const tr_surf *f = a->geometryUserPtr;
-    long prim = ((const unsigned *)a->hit)[5];    /* RTCHit.primID for N = 1 */
+    const unsigned *hu = (const unsigned *)a->hit;  /* RTCHitN for N = 1: Ng, u, v, */
+    long prim = tr_mesh_prim(x->sc, hu[7], hu[5]); /* primID, geomID, instID[0] */
     if (x->xs == f)
         for (int i = 0; i < x->nx; i++)
             if (x->xp[i] == (uint32_t)prim) { a->valid[0] = 0; return; }
@@ -176,8 +189,9 @@ static void closed_retry(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         r2.ray.dir_x = (float)dd[0]; r2.ray.dir_y = (float)dd[1]; r2.ray.dir_z = (float)dd[2];
         r2.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         r2.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        r2.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         tr_ctx keep = *x;                   /* analytic hits are the true ray's already */
-        rtcIntersect1(sc->scn, &x->ec, &r2);
+        query(sc, x, &r2);
         x->best_surf = keep.best_surf;
         x->best_t = keep.best_t;
         v_set(x->best_n, keep.best_n);
@@ -236,7 +250,7 @@ static void near_edge(const trace_scene *sc, tr_ctx *x, struct RTCRayHit *rh,
         rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh->hit.primID = RTC_INVALID_GEOMETRY_ID;
         offer_inline(sc, x, rh);
-        rtcIntersect1(sc->scn, &x->ec, rh);
+        query(sc, x, rh);
     }
 }
 
@@ -287,7 +301,7 @@ static int embree_nearest(const trace_scene *sc, int float_hits, const double o[
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     offer_inline(sc, &x, &rh);
-    rtcIntersect1(sc->scn, &x.ec, &rh);
+    query(sc, &x, &rh);
     if (sc->nclosed && !float_hits && last_surf >= 0 && last_prim >= 0 &&
         rh.hit.geomID != (unsigned)last_surf) {
         const tr_surf *m = sc->surf[last_surf];

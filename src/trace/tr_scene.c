@@ -88,6 +88,9 @@ static void drop_embree(trace_scene *sc)
     free(sc->far);
     sc->far = NULL;
     sc->nfar = sc->nembree = sc->ninline = 0;
+    free(sc->ch_surf);
+    sc->ch_surf = NULL;
+    sc->nch = 0;
 }
 
 void tr_scene_free(trace_scene *sc)
@@ -103,6 +106,7 @@ void tr_scene_free(trace_scene *sc)
         free(sc->surf[i]->weld);
         free(sc->surf[i]->vt_start);
         free(sc->surf[i]->vt_tri);
+        free(sc->surf[i]->perm);
         free(sc->surf[i]);
     }
     free(sc->surf);
@@ -370,6 +374,7 @@ bad:
     free(f->weld);
     free(f->vt_start);
     free(f->vt_tri);
+    free(f->perm);
     free(f);
     return rc;
 }
@@ -423,40 +428,6 @@ static void user_bounds(const struct RTCBoundsFunctionArguments *a)
     b->upper_x = nextafterf((float)(f->shape.hi[0] - c[0] + f->pad), INFINITY);
     b->upper_y = nextafterf((float)(f->shape.hi[1] - c[1] + f->pad), INFINITY);
     b->upper_z = nextafterf((float)(f->shape.hi[2] - c[2] + f->pad), INFINITY);
-}
-
-/* A mesh goes to Embree with every triangle grown about its centroid until each edge
- * has moved out by 2 epad (what a float ray may stray from the double one, and more
- * than the vertices' own rounding), by a tenth at most: Embree then never misses
- * a triangle the double ray meets, at a shared edge or vertex or a mesh's boundary,
- * and tr_hit.c decides the hits within that margin of an edge in double
- * (tr_wt_margin).  So each triangle has its own three float vertices. */
-static int attach_mesh(trace_scene *sc, tr_surf *f)
-{
-    RTCGeometry g = rtcNewGeometry(sc->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    if (!g) return -1;
-    float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                       3 * sizeof(float), (size_t)f->ntri * 3);
-    unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                           3 * sizeof(unsigned), (size_t)f->ntri);
-    if (!v || !ix) { rtcReleaseGeometry(g); return -1; }
-    for (long t = 0; t < f->ntri; t++) {
-        double c[3] = {0, 0, 0}, k = tr_wt_margin(f, t, 2 * f->pad);
-        for (int q = 0; q < 3; q++)
-            for (int j = 0; j < 3; j++) c[j] += (f->vtx[3 * f->idx[3 * t + q] + j] - sc->eoff[j]) / 3;
-        for (int q = 0; q < 3; q++) {
-            const double *p = f->vtx + 3 * f->idx[3 * t + q];
-            for (int j = 0; j < 3; j++)
-                v[9 * t + 3 * q + j] = (float)(c[j] + (p[j] - sc->eoff[j] - c[j]) * (1 + k));
-            ix[3 * t + q] = (unsigned)(3 * t + q);
-        }
-    }
-    rtcSetGeometryUserData(g, f);
-    rtcSetGeometryIntersectFilterFunction(g, tr_mesh_filter);
-    rtcCommitGeometry(g);
-    rtcAttachGeometryByID(sc->scn, g, (unsigned)f->id);
-    rtcReleaseGeometry(g);
-    return 0;
 }
 
 static int attach_user(trace_scene *sc, tr_surf *f)
@@ -717,6 +688,11 @@ int tr_build(trace_scene *sc, double *ms)
      * no bit (tests/t_64_mesh.sh) */
     const char *ex = getenv("LENSMAT_TRACE_EXACT");
     sc->wt_all = ex && *ex && strcmp(ex, "0") != 0;
+    /* LENSMAT_TRACE_CHUNK=N: meshes of more than N triangles in chunks of N (0: one
+     * BVH each), to test the chunks on small meshes (tests/t_64_mesh.sh) */
+    const char *ch = getenv("LENSMAT_TRACE_CHUNK");
+    sc->chunk = ch && *ch ? atol(ch) : TR_CHUNK_TRI;
+    sc->ch_base = sc->nsurf;
     group_coincident(sc);
     if (sc->seq_nsurf != sc->nsurf && !sc->ngroup) tr_seq_detect(sc);
     /* a mesh scene's few analytic surfaces go before Embree (TR_INLINE_MAX) */
@@ -734,7 +710,7 @@ int tr_build(trace_scene *sc, double *ms)
         f->eoff = sc->eoff;
         if (!f->is_mesh && inl) { sc->inl[sc->ninline++] = i; continue; }
         sc->nembree++;
-        int rc = f->is_mesh ? attach_mesh(sc, f) : attach_user(sc, f);
+        int rc = f->is_mesh ? tr_mesh_attach(sc, f) : attach_user(sc, f);
         if (rc) {
             drop_embree(sc);
             return fail(sc, TRACE_EEMBREE, sc->err[0] ? NULL : "Embree geometry failed");
